@@ -1,0 +1,115 @@
+//! Lookups shared by the precomputation passes and the evaluation API: transmittance
+//! between points and to the sun from the transmittance table (Bruneton 2017
+//! `GetTransmittance`, `GetTransmittanceToSun`), irradiance and scattering lookups.
+
+use super::params::{self, Radii, TableSizes};
+use super::table::{Table2, Table4};
+use crate::atmosphere::Model;
+use crate::geometry::{safe_sqrt, distance_to_top_atmosphere_boundary};
+
+/// What a lookup needs: the model's radii, the sizes and the transmittance table.
+pub struct Lookup<'a> {
+    /// Radii and μ_s,min.
+    pub radii: Radii,
+    /// Table sizes.
+    pub sizes: TableSizes,
+    /// Transmittance to the top of the atmosphere, T(r, μ).
+    pub transmittance: &'a Table2,
+    /// Sun angular radius (rad).
+    pub sun_angular_radius: f64,
+}
+
+impl<'a> Lookup<'a> {
+    /// Lookup context for a model.
+    pub fn new(model: &Model, sizes: TableSizes, transmittance: &'a Table2) -> Self {
+        Lookup {
+            radii: Radii { bottom: model.bottom_radius_m, top: model.top_radius_m, mu_s_min: model.mu_s_min },
+            sizes,
+            transmittance,
+            sun_angular_radius: model.sun_angular_radius_rad,
+        }
+    }
+
+    /// T(r, μ) to the top of the atmosphere (ray assumed not to hit the ground).
+    #[inline]
+    pub fn transmittance_to_top(&self, r: f64, mu: f64, out: &mut [f64]) {
+        let (u, v) = params::transmittance_uv(&self.radii, r, mu, self.sizes.transmittance_mu, self.sizes.transmittance_r);
+        self.transmittance.sample_into(u, v, out);
+    }
+
+    /// Transmittance over `d` metres from (r, μ), from ratios of table values; uses the
+    /// reversed ray when it hits the ground (Bruneton 2017 `GetTransmittance`).
+    #[inline]
+    pub fn transmittance(&self, r: f64, mu: f64, d: f64, ground: bool, out: &mut [f64]) {
+        let g = &self.radii;
+        let r_d = safe_sqrt(d * d + 2.0 * r * mu * d + r * r).clamp(g.bottom, g.top);
+        let mu_d = ((r * mu + d) / r_d).clamp(-1.0, 1.0);
+        let n = out.len();
+        let mut a = [0.0f64; 64];
+        let mut b = [0.0f64; 64];
+        let (a, b) = if n <= 64 { (&mut a[..n], &mut b[..n]) } else { unreachable!("at most 64 wavelengths") };
+        if ground {
+            self.transmittance_to_top(r_d, -mu_d, a);
+            self.transmittance_to_top(r, -mu, b);
+        } else {
+            self.transmittance_to_top(r, mu, a);
+            self.transmittance_to_top(r_d, mu_d, b);
+        }
+        for k in 0..n {
+            out[k] = if b[k] > 0.0 { (a[k] / b[k]).min(1.0) } else { 0.0 };
+        }
+    }
+
+    /// Transmittance to the sun times the visible fraction of the solar disk above the
+    /// planet's horizon (Bruneton 2017 `GetTransmittanceToSun`, smoothstep approximation).
+    #[inline]
+    pub fn transmittance_to_sun(&self, r: f64, mu_s: f64, out: &mut [f64]) {
+        let fraction = self.sun_visible_fraction(r, mu_s);
+        if fraction <= 0.0 {
+            out.iter_mut().for_each(|o| *o = 0.0);
+            return;
+        }
+        self.transmittance_to_top(r, mu_s, out);
+        out.iter_mut().for_each(|o| *o *= fraction);
+    }
+
+    /// Visible fraction of the sun's disk above the planet at (r, μ_s), smoothstep in μ_s
+    /// around the horizon over ± the sun's angular radius.
+    #[inline]
+    pub fn sun_visible_fraction(&self, r: f64, mu_s: f64) -> f64 {
+        let sin_theta_h = self.radii.bottom / r;
+        let cos_theta_h = -safe_sqrt(1.0 - sin_theta_h * sin_theta_h);
+        let e = sin_theta_h * self.sun_angular_radius;
+        smoothstep(-e, e, mu_s - cos_theta_h)
+    }
+
+    /// Irradiance-table lookup at (r, μ_s).
+    #[inline]
+    pub fn irradiance(&self, table: &Table2, r: f64, mu_s: f64, out: &mut [f64]) {
+        let (u, v) = params::irradiance_uv(&self.radii, r, mu_s, self.sizes.irradiance_mu_s, self.sizes.irradiance_r);
+        table.sample_into(u, v, out);
+    }
+
+    /// Scattering-table lookup at (r, μ, μ_s, ν).
+    #[inline]
+    pub fn scattering(&self, table: &Table4, r: f64, mu: f64, mu_s: f64, nu: f64, ground: bool, out: &mut [f64]) {
+        let uvwz = params::scattering_uvwz(&self.radii, &self.sizes, r, mu, mu_s, nu, ground);
+        table.sample_into(uvwz, out);
+    }
+
+    /// Distance to the top along (r, μ).
+    #[inline]
+    pub fn distance_to_top(&self, r: f64, mu: f64) -> f64 {
+        distance_to_top_atmosphere_boundary(r, mu, self.radii.top)
+    }
+}
+
+/// GLSL smoothstep.
+#[inline]
+pub fn smoothstep(e0: f64, e1: f64, x: f64) -> f64 {
+    if e1 <= e0 {
+        return if x < e0 { 0.0 } else { 1.0 };
+    }
+    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}

@@ -1,0 +1,327 @@
+//! Table parameterisations of Bruneton & Neyret 2008 §4 as refined in Bruneton 2017
+//! (`functions.glsl`): texel-centre-exact mappings, `u_r = ρ/H`, a `u_μ` split at the
+//! horizon into rays that hit the ground and rays that do not, a non-linear `u_μs` with a
+//! minimum sun elevation, and a linear `u_ν`. All in f64; (r, μ) as in [`crate::geometry`].
+
+use crate::geometry::{clamp_cosine, distance_to_top_atmosphere_boundary, safe_sqrt};
+
+/// Table sizes. Defaults from Bruneton 2017 / SPEC §3.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TableSizes {
+    /// Transmittance width (μ).
+    pub transmittance_mu: usize,
+    /// Transmittance height (r).
+    pub transmittance_r: usize,
+    /// Scattering r size.
+    pub scattering_r: usize,
+    /// Scattering μ size (even: two halves).
+    pub scattering_mu: usize,
+    /// Scattering μ_s size.
+    pub scattering_mu_s: usize,
+    /// Scattering ν size.
+    pub scattering_nu: usize,
+    /// Irradiance width (μ_s).
+    pub irradiance_mu_s: usize,
+    /// Irradiance height (r).
+    pub irradiance_r: usize,
+}
+
+impl Default for TableSizes {
+    fn default() -> Self {
+        TableSizes {
+            transmittance_mu: 256,
+            transmittance_r: 64,
+            scattering_r: 32,
+            scattering_mu: 128,
+            scattering_mu_s: 32,
+            scattering_nu: 8,
+            irradiance_mu_s: 64,
+            irradiance_r: 16,
+        }
+    }
+}
+
+impl TableSizes {
+    /// Small tables for fast tests.
+    pub fn small() -> Self {
+        TableSizes {
+            transmittance_mu: 128,
+            transmittance_r: 32,
+            scattering_r: 16,
+            scattering_mu: 64,
+            scattering_mu_s: 16,
+            scattering_nu: 8,
+            irradiance_mu_s: 32,
+            irradiance_r: 8,
+        }
+    }
+
+    /// Check sizes: every dimension ≥ 2, μ even, and at most `max` texels per table.
+    pub fn validate(&self) -> crate::Result<()> {
+        let dims = [
+            ("transmittance_mu", self.transmittance_mu),
+            ("transmittance_r", self.transmittance_r),
+            ("scattering_r", self.scattering_r),
+            ("scattering_mu", self.scattering_mu),
+            ("scattering_mu_s", self.scattering_mu_s),
+            ("scattering_nu", self.scattering_nu),
+            ("irradiance_mu_s", self.irradiance_mu_s),
+            ("irradiance_r", self.irradiance_r),
+        ];
+        for (name, v) in dims {
+            if !(2..=4096).contains(&v) {
+                return Err(crate::Error::invalid(format!("tables.{name}"), v, "an integer in [2, 4096]"));
+            }
+        }
+        if self.scattering_mu % 2 != 0 || self.scattering_mu < 4 {
+            return Err(crate::Error::invalid("tables.scattering_mu", self.scattering_mu, "an even integer ≥ 4 (two halves split at the horizon)"));
+        }
+        let texels = self.scattering_r * self.scattering_mu * self.scattering_mu_s * self.scattering_nu;
+        if texels > 64 << 20 {
+            return Err(crate::Error::invalid("tables", format!("{texels} scattering texels"), "at most 67108864 texels"));
+        }
+        Ok(())
+    }
+}
+
+/// Texel-centre-exact mapping of x ∈ [0,1] to a texture coordinate for `n` texels
+/// (Bruneton 2017 `GetTextureCoordFromUnitRange`).
+#[inline]
+pub fn texcoord_from_unit(x: f64, n: usize) -> f64 {
+    0.5 / n as f64 + x * (1.0 - 1.0 / n as f64)
+}
+
+/// Inverse of [`texcoord_from_unit`].
+#[inline]
+pub fn unit_from_texcoord(u: f64, n: usize) -> f64 {
+    (u - 0.5 / n as f64) / (1.0 - 1.0 / n as f64)
+}
+
+/// Geometry constants the mappings need (metres).
+#[derive(Clone, Copy, Debug)]
+pub struct Radii {
+    /// Ground radius.
+    pub bottom: f64,
+    /// Top radius.
+    pub top: f64,
+    /// cos of the largest sun zenith angle covered.
+    pub mu_s_min: f64,
+}
+
+impl Radii {
+    /// H = sqrt(R_t² − R_g²): the distance to the top along the horizon from the ground.
+    #[inline]
+    pub fn h(&self) -> f64 {
+        (self.top * self.top - self.bottom * self.bottom).sqrt()
+    }
+}
+
+/// (u, v) ∈ [0,1]² of the transmittance table for (r, μ) (paper §4, Bruneton 2017).
+#[inline]
+pub fn transmittance_uv(g: &Radii, r: f64, mu: f64, nu_: usize, nr: usize) -> (f64, f64) {
+    let h = g.h();
+    let rho = safe_sqrt(r * r - g.bottom * g.bottom);
+    let d = distance_to_top_atmosphere_boundary(r, mu, g.top);
+    let d_min = g.top - r;
+    let d_max = rho + h;
+    let x_mu = if d_max > d_min { (d - d_min) / (d_max - d_min) } else { 0.0 };
+    let x_r = rho / h;
+    (texcoord_from_unit(x_mu, nu_), texcoord_from_unit(x_r, nr))
+}
+
+/// Inverse of [`transmittance_uv`].
+#[inline]
+pub fn transmittance_r_mu(g: &Radii, u: f64, v: f64, nmu: usize, nr: usize) -> (f64, f64) {
+    let h = g.h();
+    let x_mu = unit_from_texcoord(u, nmu);
+    let x_r = unit_from_texcoord(v, nr);
+    let rho = h * x_r;
+    let r = (rho * rho + g.bottom * g.bottom).sqrt();
+    let d_min = g.top - r;
+    let d_max = rho + h;
+    let d = d_min + x_mu * (d_max - d_min);
+    let mu = if d == 0.0 { 1.0 } else { clamp_cosine((h * h - rho * rho - d * d) / (2.0 * r * d)) };
+    (r, mu)
+}
+
+/// (u, v) of the irradiance table for (r, μ_s): linear in both.
+#[inline]
+pub fn irradiance_uv(g: &Radii, r: f64, mu_s: f64, nmu_s: usize, nr: usize) -> (f64, f64) {
+    let x_r = (r - g.bottom) / (g.top - g.bottom);
+    let x_mu_s = mu_s * 0.5 + 0.5;
+    (texcoord_from_unit(x_mu_s, nmu_s), texcoord_from_unit(x_r, nr))
+}
+
+/// Inverse of [`irradiance_uv`].
+#[inline]
+pub fn irradiance_r_mu_s(g: &Radii, u: f64, v: f64, nmu_s: usize, nr: usize) -> (f64, f64) {
+    let x_mu_s = unit_from_texcoord(u, nmu_s);
+    let x_r = unit_from_texcoord(v, nr);
+    (g.bottom + x_r * (g.top - g.bottom), clamp_cosine(2.0 * x_mu_s - 1.0))
+}
+
+/// The four coordinates (u_ν, u_μs, u_μ, u_r) ∈ [0,1]⁴ of the scattering table.
+#[inline]
+pub fn scattering_uvwz(
+    g: &Radii,
+    s: &TableSizes,
+    r: f64,
+    mu: f64,
+    mu_s: f64,
+    nu: f64,
+    ray_r_mu_intersects_ground: bool,
+) -> [f64; 4] {
+    let h = g.h();
+    let rho = safe_sqrt(r * r - g.bottom * g.bottom);
+    let u_r = texcoord_from_unit(rho / h, s.scattering_r);
+    let r_mu = r * mu;
+    let discriminant = r_mu * r_mu - r * r + g.bottom * g.bottom;
+    let half = s.scattering_mu / 2;
+    let u_mu = if ray_r_mu_intersects_ground {
+        // Distance to the ground, mapped to the lower half [0, 0.5].
+        let d = -r_mu - safe_sqrt(discriminant);
+        let d_min = r - g.bottom;
+        let d_max = rho;
+        let x = if d_max == d_min { 0.0 } else { ((d - d_min) / (d_max - d_min)).clamp(0.0, 1.0) };
+        0.5 - 0.5 * texcoord_from_unit(x, half)
+    } else {
+        // Distance to the top, mapped to the upper half [0.5, 1].
+        let d = -r_mu + safe_sqrt(discriminant + h * h);
+        let d_min = g.top - r;
+        let d_max = rho + h;
+        let x = if d_max > d_min { ((d - d_min) / (d_max - d_min)).clamp(0.0, 1.0) } else { 0.0 };
+        0.5 + 0.5 * texcoord_from_unit(x, half)
+    };
+    let u_mu_s = texcoord_from_unit(x_mu_s(g, mu_s), s.scattering_mu_s);
+    let u_nu = (nu + 1.0) / 2.0;
+    [u_nu.clamp(0.0, 1.0), u_mu_s, u_mu, u_r]
+}
+
+/// The non-linear μ_s coordinate in [0,1] (Bruneton 2017): from the distance to the top
+/// along the sun ray from the ground, with the configurable minimum sun elevation.
+#[inline]
+pub fn x_mu_s(g: &Radii, mu_s: f64) -> f64 {
+    let h = g.h();
+    let d_min = g.top - g.bottom;
+    let d_max = h;
+    let d = distance_to_top_atmosphere_boundary(g.bottom, mu_s, g.top);
+    let a = (d - d_min) / (d_max - d_min);
+    let big_d = distance_to_top_atmosphere_boundary(g.bottom, g.mu_s_min, g.top);
+    let big_a = (big_d - d_min) / (d_max - d_min);
+    ((1.0 - a / big_a).max(0.0) / (1.0 + a)).clamp(0.0, 1.0)
+}
+
+/// Inverse of [`x_mu_s`].
+#[inline]
+pub fn mu_s_from_x(g: &Radii, x: f64) -> f64 {
+    let h = g.h();
+    let d_min = g.top - g.bottom;
+    let d_max = h;
+    let big_d = distance_to_top_atmosphere_boundary(g.bottom, g.mu_s_min, g.top);
+    let big_a = (big_d - d_min) / (d_max - d_min);
+    let a = (big_a - x * big_a) / (1.0 + x * big_a);
+    let d = d_min + a.min(big_a) * (d_max - d_min);
+    if d == 0.0 {
+        1.0
+    } else {
+        clamp_cosine((h * h - d * d) / (2.0 * g.bottom * d))
+    }
+}
+
+/// Inverse of [`scattering_uvwz`]: (r, μ, μ_s, ν, ray hits ground).
+#[inline]
+pub fn scattering_r_mu_mu_s_nu(g: &Radii, s: &TableSizes, uvwz: [f64; 4]) -> (f64, f64, f64, f64, bool) {
+    let [u_nu, u_mu_s, u_mu, u_r] = uvwz;
+    let h = g.h();
+    let rho = h * unit_from_texcoord(u_r, s.scattering_r);
+    let r = (rho * rho + g.bottom * g.bottom).sqrt();
+    let half = s.scattering_mu / 2;
+    let (mu, ground) = if u_mu < 0.5 {
+        let d_min = r - g.bottom;
+        let d_max = rho;
+        let d = d_min + (d_max - d_min) * unit_from_texcoord(1.0 - 2.0 * u_mu, half);
+        let mu = if d == 0.0 { -1.0 } else { clamp_cosine(-(rho * rho + d * d) / (2.0 * r * d)) };
+        (mu, true)
+    } else {
+        let d_min = g.top - r;
+        let d_max = rho + h;
+        let d = d_min + (d_max - d_min) * unit_from_texcoord(2.0 * u_mu - 1.0, half);
+        let mu = if d == 0.0 { 1.0 } else { clamp_cosine((h * h - rho * rho - d * d) / (2.0 * r * d)) };
+        (mu, false)
+    };
+    let mu_s = mu_s_from_x(g, unit_from_texcoord(u_mu_s, s.scattering_mu_s));
+    let nu = clamp_cosine(u_nu * 2.0 - 1.0);
+    (r, mu, mu_s, nu, ground)
+}
+
+/// (r, μ, μ_s, ν, ground) at the centre of scattering texel (x = ν·N_μs + μ_s, y = μ,
+/// z = r); ν is clamped to the range allowed by μ and μ_s (Bruneton 2017
+/// `GetRMuMuSNuFromScatteringTextureFragCoord`; the ν grid includes −1 and 1).
+pub fn scattering_texel(g: &Radii, s: &TableSizes, x: usize, y: usize, z: usize) -> (f64, f64, f64, f64, bool) {
+    let i_nu = x / s.scattering_mu_s;
+    let i_mu_s = x % s.scattering_mu_s;
+    let uvwz = [
+        i_nu as f64 / (s.scattering_nu - 1) as f64,
+        (i_mu_s as f64 + 0.5) / s.scattering_mu_s as f64,
+        (y as f64 + 0.5) / s.scattering_mu as f64,
+        (z as f64 + 0.5) / s.scattering_r as f64,
+    ];
+    let (r, mu, mu_s, nu, ground) = scattering_r_mu_mu_s_nu(g, s, uvwz);
+    let spread = ((1.0 - mu * mu) * (1.0 - mu_s * mu_s)).max(0.0).sqrt();
+    let nu = nu.clamp(mu * mu_s - spread, mu * mu_s + spread);
+    (r, mu, mu_s, nu, ground)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const G: Radii = Radii { bottom: 6_360_000.0, top: 6_420_000.0, mu_s_min: -0.2079116908177593 };
+
+    #[test]
+    fn transmittance_mapping_round_trips() {
+        for &(r, mu) in &[(6_360_000.0, 0.0), (6_365_000.0, 0.3), (6_400_000.0, -0.1), (6_419_000.0, 0.99), (6_370_000.0, -0.05)] {
+            let (u, v) = transmittance_uv(&G, r, mu, 256, 64);
+            let (r2, mu2) = transmittance_r_mu(&G, u, v, 256, 64);
+            assert!((r2 - r).abs() / r < 1e-9, "r {r} {r2}");
+            assert!((mu2 - mu).abs() < 1e-6, "mu {mu} {mu2}");
+        }
+    }
+
+    #[test]
+    fn scattering_mapping_round_trips_and_splits_at_the_horizon() {
+        let s = TableSizes::default();
+        for &r in &[6_360_100.0, 6_362_000.0, 6_380_000.0, 6_419_000.0] {
+            let mu_h = crate::geometry::horizon_mu(r, G.bottom);
+            for &mu in &[-0.9, mu_h - 1e-3, mu_h + 1e-3, 0.2, 0.95] {
+                for &mu_s in &[-0.15, 0.0, 0.3, 0.9] {
+                    let ground = crate::geometry::ray_intersects_ground(r, mu, G.bottom);
+                    let uvwz = scattering_uvwz(&G, &s, r, mu, mu_s, 0.1, ground);
+                    // Horizon discontinuity: ground rays in the lower half, sky rays in the upper.
+                    assert_eq!(uvwz[2] < 0.5, ground);
+                    let (r2, mu2, mu_s2, nu2, g2) = scattering_r_mu_mu_s_nu(&G, &s, uvwz);
+                    assert_eq!(g2, ground);
+                    assert!((r2 - r).abs() / r < 1e-9);
+                    assert!((mu2 - mu).abs() < 1e-6, "mu {mu} -> {mu2} at r {r}");
+                    assert!((mu_s2 - mu_s).abs() < 1e-6, "mu_s {mu_s} -> {mu_s2}");
+                    assert!((nu2 - 0.1).abs() < 1e-12);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn irradiance_mapping_round_trips() {
+        let (u, v) = irradiance_uv(&G, 6_390_000.0, -0.2, 64, 16);
+        let (r, mu_s) = irradiance_r_mu_s(&G, u, v, 64, 16);
+        assert!((r - 6_390_000.0).abs() < 1e-6 && (mu_s + 0.2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn texel_centres_map_exactly() {
+        assert!((texcoord_from_unit(0.0, 32) - 0.5 / 32.0).abs() < 1e-15);
+        assert!((texcoord_from_unit(1.0, 32) - (1.0 - 0.5 / 32.0)).abs() < 1e-15);
+        assert!((unit_from_texcoord(texcoord_from_unit(0.37, 7), 7) - 0.37).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,694 @@
+//! The precomputation of Bruneton & Neyret 2008 Algorithm 4.1 (as in Bruneton 2017):
+//! transmittance, direct irradiance, single scattering (Rayleigh and Mie apart), then for
+//! each order n ≥ 2 the scattering density ΔJ, the indirect irradiance ΔE and the multiple
+//! scattering ΔS.
+//!
+//! The scattering density, which dominates Bruneton's cost (512 incident directions per
+//! texel), is computed as a spherical convolution (SPEC §8): for a fixed (r, μ_s) the
+//! incident radiance field is the same for every view direction, so it is sampled once on a
+//! (θ, φ) grid in the sun's frame, expanded as a cosine series in azimuth, and convolved
+//! with the phase functions' azimuthal harmonics (exact for the band-limited field), which
+//! are independent of the order and computed once.
+
+use std::f64::consts::PI;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use rayon::prelude::*;
+
+use super::context::Lookup;
+use super::params::{self, Radii, TableSizes};
+use super::table::{lerp_weights, Table2, Table4};
+use super::{MieStorage, TableConfig, Tables};
+use crate::atmosphere::Model;
+use crate::geometry::{distance_to_bottom_atmosphere_boundary, distance_to_nearest_atmosphere_boundary, ray_intersects_ground};
+use crate::medium::{ConstituentKind, PhaseFunction};
+use crate::{Error, Result};
+
+/// Segments of the 4-point Gauss–Legendre rule for the transmittance table.
+const TRANSMITTANCE_SEGMENTS: usize = 128;
+/// Trapezoid intervals along view rays for single and multiple scattering (Bruneton 2017).
+const RAY_INTERVALS: usize = 50;
+/// Incident zenith angles for the scattering density (midpoint rule).
+const DENSITY_THETA: usize = 32;
+/// Incident azimuths over 2π for the scattering density (Bruneton 2017 uses 32).
+const DENSITY_PHI: usize = 32;
+/// Azimuthal harmonics kept (the band limit of DENSITY_PHI samples).
+const HARMONICS: usize = DENSITY_PHI / 2;
+/// Azimuth steps over [0, π] to compute the phase functions' harmonics.
+const KERNEL_STEPS: usize = 96;
+/// Hemisphere sampling of the indirect irradiance (Bruneton 2017: 16 × 64).
+const IRRADIANCE_THETA: usize = 16;
+const IRRADIANCE_PHI: usize = 64;
+
+/// Progress callback: (stage description, fraction done of the whole precomputation).
+pub type Progress<'a> = &'a (dyn Fn(&str, f64) + Sync);
+
+/// Scattering constituents grouped as the tables store them.
+pub(crate) struct Groups {
+    /// Per group (0 = molecules, 1 = aerosols): indices of constituents.
+    pub members: [Vec<usize>; 2],
+    /// The phase function applied to each group at render time.
+    pub phase: [PhaseFunction; 2],
+    /// Group scattering coefficient at the ground per wavelength (for the red-only Mie rule).
+    pub ground_scattering: [Vec<f64>; 2],
+}
+
+impl Groups {
+    pub(crate) fn new(model: &Model) -> Groups {
+        let mut members: [Vec<usize>; 2] = [Vec::new(), Vec::new()];
+        let mut phase = [PhaseFunction::Rayleigh { depolarization: 0.0 }, PhaseFunction::HenyeyGreenstein { g: 0.0 }];
+        let mut seen = [false, false];
+        for (i, c) in model.constituents.iter().enumerate() {
+            if c.scattering.iter().all(|&s| s == 0.0) {
+                continue;
+            }
+            // Absorbers cannot scatter (validated); anything that scatters and is not
+            // molecular is stored with the aerosols.
+            let g = if c.kind == ConstituentKind::Molecules { 0 } else { 1 };
+            members[g].push(i);
+            if !seen[g] {
+                phase[g] = c.phase.clone();
+                seen[g] = true;
+            }
+        }
+        let n = model.channels();
+        let ground_scattering = [0, 1].map(|g| {
+            let mut s = vec![0.0; n];
+            for &i in &members[g] {
+                let c = &model.constituents[i];
+                let rho = c.density.density(0.0);
+                for k in 0..n {
+                    s[k] += rho * c.scattering[k];
+                }
+            }
+            s
+        });
+        Groups { members, phase, ground_scattering }
+    }
+
+    /// Scattering coefficient (m⁻¹) of group `g` at `altitude_m`, into `out`.
+    #[inline]
+    pub(crate) fn scattering_into(&self, model: &Model, g: usize, altitude_m: f64, out: &mut [f64]) {
+        out.iter_mut().for_each(|o| *o = 0.0);
+        for &i in &self.members[g] {
+            let c = &model.constituents[i];
+            let rho = c.density.density(altitude_m);
+            if rho > 0.0 {
+                for (o, s) in out.iter_mut().zip(&c.scattering) {
+                    *o += rho * s;
+                }
+            }
+        }
+    }
+}
+
+fn check_cancel(cancel: Option<&AtomicBool>) -> Result<()> {
+    match cancel {
+        Some(c) if c.load(Ordering::Relaxed) => Err(Error::Interrupted),
+        _ => Ok(()),
+    }
+}
+
+/// Run the whole precomputation.
+pub fn precompute(model: &Model, config: &TableConfig, progress: Progress, cancel: Option<&AtomicBool>) -> Result<Tables> {
+    config.validate()?;
+    let n = model.channels();
+    if n > 64 {
+        return Err(Error::invalid("wavelengths", n, "at most 64 wavelengths for the precomputed tables"));
+    }
+    let s = config.sizes;
+    let orders = config.orders;
+    let total_steps = 3.0 + 3.0 * (orders.saturating_sub(1)) as f64;
+    let mut step = 0.0;
+    let mut report = |what: &str| {
+        progress(what, step / total_steps);
+        step += 1.0;
+    };
+
+    report("transmittance");
+    let transmittance = compute_transmittance(model, &s);
+    check_cancel(cancel)?;
+    let lookup = Lookup::new(model, s, &transmittance);
+    let groups = Groups::new(model);
+
+    report("direct irradiance");
+    let mut delta_irradiance = compute_direct_irradiance(model, &lookup);
+    let mut irradiance = Table2::new(s.irradiance_mu_s, s.irradiance_r, n);
+
+    report("single scattering");
+    let (delta_rayleigh, delta_mie) = compute_single_scattering(model, &lookup, &groups);
+    check_cancel(cancel)?;
+    let mut order_means = vec![table_mean_radiance(&delta_rayleigh, &delta_mie, &groups, &lookup)];
+    let mut scattering = delta_rayleigh.clone();
+
+    if orders >= 2 {
+        let kernels = PhaseKernels::new(model, &lookup, &groups);
+        let mut delta_multiple = Table4::new(s.scattering_r, s.scattering_mu, s.scattering_mu_s, s.scattering_nu, n);
+        for order in 2..=orders {
+            report(&format!("scattering density, order {order}"));
+            let density = {
+                let previous = if order == 2 {
+                    Previous::Single { rayleigh: &delta_rayleigh, mie: &delta_mie, groups: &groups }
+                } else {
+                    Previous::Multiple(&delta_multiple)
+                };
+                compute_scattering_density(model, &lookup, &groups, &kernels, &previous, &delta_irradiance)
+            };
+            check_cancel(cancel)?;
+            report(&format!("indirect irradiance, order {}", order - 1));
+            delta_irradiance = {
+                let previous = if order == 2 {
+                    Previous::Single { rayleigh: &delta_rayleigh, mie: &delta_mie, groups: &groups }
+                } else {
+                    Previous::Multiple(&delta_multiple)
+                };
+                compute_indirect_irradiance(model, &lookup, &previous)
+            };
+            irradiance.add_assign(&delta_irradiance);
+            report(&format!("multiple scattering, order {order}"));
+            delta_multiple = compute_multiple_scattering(model, &lookup, &density);
+            check_cancel(cancel)?;
+            order_means.push(table_mean(&delta_multiple));
+            accumulate_multiple(&mut scattering, &delta_multiple, &groups, &lookup);
+        }
+    }
+    progress("done", 1.0);
+
+    let single_mie = match config.mie {
+        MieStorage::Separate => delta_mie,
+        MieStorage::RedOnly => {
+            let mut red = Table4::new(s.scattering_r, s.scattering_mu, s.scattering_mu_s, s.scattering_nu, 1);
+            for (i, v) in red.data.iter_mut().enumerate() {
+                *v = delta_mie.data[i * n];
+            }
+            red
+        }
+    };
+    Ok(Tables {
+        config: *config,
+        wavelengths_nm: model.wavelengths.nm().to_vec(),
+        atmosphere_hash: model.hash,
+        transmittance,
+        irradiance,
+        scattering,
+        single_mie,
+        order_means,
+        mie_ratio: mie_ratio(&groups, n),
+    })
+}
+
+/// β_M/β_R scaled to channel 0 (Bruneton 2017 `GetExtrapolatedSingleMieScattering`).
+fn mie_ratio(groups: &Groups, n: usize) -> Vec<f64> {
+    let [r, m] = &groups.ground_scattering;
+    (0..n)
+        .map(|k| if r[k] > 0.0 && m[0] > 0.0 && r[0] > 0.0 { (r[0] / m[0]) * (m[k] / r[k]) } else { 0.0 })
+        .collect()
+}
+
+/// Mean radiance of the single-scattering tables with phase functions at ν (per channel,
+/// over texels): used to check that orders decrease.
+fn table_mean_radiance(rayleigh: &Table4, mie: &Table4, groups: &Groups, lookup: &Lookup) -> Vec<f64> {
+    let n = rayleigh.channels;
+    let mut sum = vec![0.0; n];
+    let s = &lookup.sizes;
+    for z in 0..s.scattering_r {
+        for y in 0..s.scattering_mu {
+            for x in 0..rayleigh.width() {
+                let (_, _, _, nu, _) = params::scattering_texel(&lookup.radii, s, x, y, z);
+                let (pr, pm) = (groups.phase[0].eval(nu), groups.phase[1].eval(nu));
+                let i = rayleigh.index(x, y, z);
+                for k in 0..n {
+                    sum[k] += rayleigh.data[i + k] as f64 * pr + mie.data[i + k] as f64 * pm;
+                }
+            }
+        }
+    }
+    let count = (rayleigh.data.len() / n) as f64;
+    sum.iter().map(|v| v / count).collect()
+}
+
+fn table_mean(t: &Table4) -> Vec<f64> {
+    let n = t.channels;
+    let mut sum = vec![0.0; n];
+    for chunk in t.data.chunks(n) {
+        for k in 0..n {
+            sum[k] += chunk[k] as f64;
+        }
+    }
+    let count = (t.data.len() / n) as f64;
+    sum.iter().map(|v| v / count).collect()
+}
+
+/// T(r, μ) to the top: 4-point Gauss–Legendre on the constituents' columns (exact optical
+/// depths per constituent, then the per-wavelength sum).
+pub fn compute_transmittance(model: &Model, s: &TableSizes) -> Table2 {
+    let n = model.channels();
+    let radii = Radii { bottom: model.bottom_radius_m, top: model.top_radius_m, mu_s_min: model.mu_s_min };
+    let mut t = Table2::new(s.transmittance_mu, s.transmittance_r, n);
+    let width = s.transmittance_mu;
+    t.data.par_chunks_mut(width * n).enumerate().for_each(|(y, row)| {
+        let mut columns = vec![0.0; model.constituents.len()];
+        let mut tau = vec![0.0; n];
+        for x in 0..width {
+            let u = (x as f64 + 0.5) / width as f64;
+            let v = (y as f64 + 0.5) / s.transmittance_r as f64;
+            let (r, mu) = params::transmittance_r_mu(&radii, u, v, s.transmittance_mu, s.transmittance_r);
+            let d = crate::geometry::distance_to_top_atmosphere_boundary(r, mu, radii.top);
+            model.columns_along_ray(r, mu, d, TRANSMITTANCE_SEGMENTS, &mut columns);
+            model.optical_depth_from_columns(&columns, &mut tau);
+            for k in 0..n {
+                row[x * n + k] = (-tau[k]).exp() as f32;
+            }
+        }
+    });
+    t
+}
+
+/// Direct sun irradiance on a horizontal surface, E = E_sun·T·(average cosine over the
+/// partially visible disk) (Bruneton 2017 `ComputeDirectIrradiance`).
+fn compute_direct_irradiance(model: &Model, lookup: &Lookup) -> Table2 {
+    let s = &lookup.sizes;
+    let n = model.channels();
+    let mut e = Table2::new(s.irradiance_mu_s, s.irradiance_r, n);
+    let alpha_s = model.sun_angular_radius_rad;
+    let mut tr = vec![0.0; n];
+    for y in 0..s.irradiance_r {
+        for x in 0..s.irradiance_mu_s {
+            let (r, mu_s) = params::irradiance_r_mu_s(
+                &lookup.radii,
+                (x as f64 + 0.5) / s.irradiance_mu_s as f64,
+                (y as f64 + 0.5) / s.irradiance_r as f64,
+                s.irradiance_mu_s,
+                s.irradiance_r,
+            );
+            let cos_factor = if mu_s < -alpha_s {
+                0.0
+            } else if mu_s > alpha_s {
+                mu_s
+            } else {
+                (mu_s + alpha_s) * (mu_s + alpha_s) / (4.0 * alpha_s)
+            };
+            lookup.transmittance_to_top(r, mu_s, &mut tr);
+            let i = (y * s.irradiance_mu_s + x) * n;
+            for k in 0..n {
+                e.data[i + k] = (model.solar_irradiance[k] * tr[k] * cos_factor) as f32;
+            }
+        }
+    }
+    e
+}
+
+/// Geometry of one view ray shared by every (μ_s, ν) texel of a table row.
+struct RaySamples {
+    dx: f64,
+    d: Vec<f64>,
+    r: Vec<f64>,
+    mu: Vec<f64>,
+    /// Transmittance from the ray origin to each sample, `n` per sample.
+    t: Vec<f64>,
+    /// Trapezoid weights.
+    w: Vec<f64>,
+}
+
+impl RaySamples {
+    fn new(lookup: &Lookup, r: f64, mu: f64, ground: bool, n: usize) -> RaySamples {
+        let g = &lookup.radii;
+        let length = distance_to_nearest_atmosphere_boundary(r, mu, g.bottom, g.top, ground);
+        let dx = length / RAY_INTERVALS as f64;
+        let count = RAY_INTERVALS + 1;
+        let mut rs = RaySamples {
+            dx,
+            d: Vec::with_capacity(count),
+            r: Vec::with_capacity(count),
+            mu: Vec::with_capacity(count),
+            t: vec![0.0; count * n],
+            w: Vec::with_capacity(count),
+        };
+        for i in 0..count {
+            let d = i as f64 * dx;
+            let (r_d, mu_d) = crate::geometry::advance(r, mu, d, g.bottom, g.top);
+            rs.d.push(d);
+            rs.r.push(r_d);
+            rs.mu.push(mu_d);
+            rs.w.push(if i == 0 || i == RAY_INTERVALS { 0.5 } else { 1.0 });
+            lookup.transmittance(r, mu, d, ground, &mut rs.t[i * n..(i + 1) * n]);
+        }
+        rs
+    }
+}
+
+/// Single scattering (paper eq. 7; Bruneton 2017 `ComputeSingleScattering`): Rayleigh and
+/// Mie integrated separately without phase functions.
+fn compute_single_scattering(model: &Model, lookup: &Lookup, groups: &Groups) -> (Table4, Table4) {
+    let s = lookup.sizes;
+    let n = model.channels();
+    let mut rayleigh = Table4::new(s.scattering_r, s.scattering_mu, s.scattering_mu_s, s.scattering_nu, n);
+    let mut mie = rayleigh.clone();
+    let row_len = rayleigh.row_len();
+    let width = rayleigh.width();
+    rayleigh.data.par_chunks_mut(row_len).zip(mie.data.par_chunks_mut(row_len)).enumerate().for_each(|(row, (out_r, out_m))| {
+        let (z, y) = (row / s.scattering_mu, row % s.scattering_mu);
+        let (r, mu, _, _, ground) = params::scattering_texel(&lookup.radii, &s, 0, y, z);
+        let rays = RaySamples::new(lookup, r, mu, ground, n);
+        // Group scattering coefficients at each sample.
+        let count = rays.d.len();
+        let mut beta = [vec![0.0; count * n], vec![0.0; count * n]];
+        for i in 0..count {
+            let alt = rays.r[i] - lookup.radii.bottom;
+            for g in 0..2 {
+                groups.scattering_into(model, g, alt, &mut beta[g][i * n..(i + 1) * n]);
+            }
+        }
+        let mut t_sun = vec![0.0; n];
+        let mut acc = [vec![0.0; n], vec![0.0; n]];
+        for x in 0..width {
+            let (_, _, mu_s, nu, _) = params::scattering_texel(&lookup.radii, &s, x, y, z);
+            acc.iter_mut().for_each(|a| a.iter_mut().for_each(|v| *v = 0.0));
+            for i in 0..count {
+                let r_d = rays.r[i];
+                let mu_s_d = ((r * mu_s + rays.d[i] * nu) / r_d).clamp(-1.0, 1.0);
+                lookup.transmittance_to_sun(r_d, mu_s_d, &mut t_sun);
+                for k in 0..n {
+                    let t = rays.w[i] * rays.t[i * n + k] * t_sun[k];
+                    acc[0][k] += t * beta[0][i * n + k];
+                    acc[1][k] += t * beta[1][i * n + k];
+                }
+            }
+            for k in 0..n {
+                let e = model.solar_irradiance[k] * rays.dx;
+                out_r[x * n + k] = (acc[0][k] * e) as f32;
+                out_m[x * n + k] = (acc[1][k] * e) as f32;
+            }
+        }
+    });
+    (rayleigh, mie)
+}
+
+/// The radiance field of the previous scattering order.
+enum Previous<'a> {
+    /// Order 1: the single-scattering tables, phase functions applied at lookup.
+    Single { rayleigh: &'a Table4, mie: &'a Table4, groups: &'a Groups },
+    /// Order ≥ 2: ΔS, radiance as it is.
+    Multiple(&'a Table4),
+}
+
+impl Previous<'_> {
+    #[inline]
+    fn radiance(&self, lookup: &Lookup, r: f64, mu: f64, mu_s: f64, nu: f64, ground: bool, out: &mut [f64], tmp: &mut [f64]) {
+        let uvwz = params::scattering_uvwz(&lookup.radii, &lookup.sizes, r, mu, mu_s, nu, ground);
+        match self {
+            Previous::Single { rayleigh, mie, groups } => {
+                rayleigh.sample_into(uvwz, out);
+                mie.sample_into(uvwz, tmp);
+                let (pr, pm) = (groups.phase[0].eval(nu), groups.phase[1].eval(nu));
+                for k in 0..out.len() {
+                    out[k] = out[k] * pr + tmp[k] * pm;
+                }
+            }
+            Previous::Multiple(t) => t.sample_into(uvwz, out),
+        }
+    }
+}
+
+/// Azimuthal harmonics of each scattering group's phase function, for every table radius,
+/// view zenith (table μ) and incident zenith: b_m with P(Δφ) = Σ b_m cos(mΔφ).
+struct PhaseKernels {
+    /// `[((z·nmu + y)·THETA + l)·2 + g]·HARMONICS + m`.
+    b: Vec<f64>,
+}
+
+impl PhaseKernels {
+    fn new(model: &Model, lookup: &Lookup, groups: &Groups) -> PhaseKernels {
+        let s = &lookup.sizes;
+        let per_row = DENSITY_THETA * 2 * HARMONICS;
+        let mut b = vec![0.0; s.scattering_r * s.scattering_mu * per_row];
+        let _ = model;
+        b.par_chunks_mut(per_row).enumerate().for_each(|(row, out)| {
+            let (z, y) = (row / s.scattering_mu, row % s.scattering_mu);
+            let (_, mu_v, _, _, _) = params::scattering_texel(&lookup.radii, s, 0, y, z);
+            let sin_v = (1.0 - mu_v * mu_v).max(0.0).sqrt();
+            let mut cos_m = vec![0.0; (KERNEL_STEPS + 1) * HARMONICS];
+            for t in 0..=KERNEL_STEPS {
+                let dphi = PI * t as f64 / KERNEL_STEPS as f64;
+                for m in 0..HARMONICS {
+                    cos_m[t * HARMONICS + m] = (m as f64 * dphi).cos();
+                }
+            }
+            for l in 0..DENSITY_THETA {
+                let theta = (l as f64 + 0.5) * PI / DENSITY_THETA as f64;
+                let (sin_i, cos_i) = theta.sin_cos();
+                for g in 0..2 {
+                    if groups.members[g].is_empty() {
+                        continue;
+                    }
+                    let o = &mut out[(l * 2 + g) * HARMONICS..(l * 2 + g + 1) * HARMONICS];
+                    for t in 0..=KERNEL_STEPS {
+                        let dphi = PI * t as f64 / KERNEL_STEPS as f64;
+                        let p = groups.phase[g].eval((mu_v * cos_i + sin_v * sin_i * dphi.cos()).clamp(-1.0, 1.0));
+                        let w = if t == 0 || t == KERNEL_STEPS { 0.5 } else { 1.0 };
+                        for m in 0..HARMONICS {
+                            o[m] += w * p * cos_m[t * HARMONICS + m];
+                        }
+                    }
+                    // Trapezoid over [0, π]: b_0 = (1/π)∫P, b_m = (2/π)∫P cos(mΔ).
+                    let h = PI / KERNEL_STEPS as f64;
+                    for m in 0..HARMONICS {
+                        o[m] *= h / PI * if m == 0 { 1.0 } else { 2.0 };
+                    }
+                }
+            }
+        });
+        PhaseKernels { b }
+    }
+}
+
+/// Scattering density ΔJ of order n (paper eq. 11 / Bruneton 2017
+/// `ComputeScatteringDensity`), by spherical convolution per (r, μ_s).
+fn compute_scattering_density(
+    model: &Model,
+    lookup: &Lookup,
+    groups: &Groups,
+    kernels: &PhaseKernels,
+    previous: &Previous,
+    delta_irradiance: &Table2,
+) -> Table4 {
+    let s = lookup.sizes;
+    let n = model.channels();
+    let mut out = Table4::new(s.scattering_r, s.scattering_mu, s.scattering_mu_s, s.scattering_nu, n);
+    let slab = s.scattering_mu * out.row_len();
+    let width = out.width();
+    let g = lookup.radii;
+    let dtheta = PI / DENSITY_THETA as f64;
+    let dphi = 2.0 * PI / DENSITY_PHI as f64;
+    let half_phi = DENSITY_PHI / 2;
+    out.data.par_chunks_mut(slab).enumerate().for_each(|(z, slab_out)| {
+        let (r, _, _, _, _) = params::scattering_texel(&g, &s, 0, 0, z);
+        let alt = r - g.bottom;
+        let mut beta = [vec![0.0; n], vec![0.0; n]];
+        for gi in 0..2 {
+            groups.scattering_into(model, gi, alt, &mut beta[gi]);
+        }
+        let mut radiance = vec![0.0; n];
+        let mut tmp = vec![0.0; n];
+        let mut e_ground = vec![0.0; n];
+        let mut t_ground = vec![0.0; n];
+        // coefficients[l][m][k]
+        let mut coeff = vec![0.0; DENSITY_THETA * HARMONICS * n];
+        let mut field = vec![0.0; half_phi * n];
+        let mut k_acc = vec![0.0; 2 * HARMONICS * n];
+        for i_mu_s in 0..s.scattering_mu_s {
+            let (_, _, mu_s, _, _) = params::scattering_texel(&g, &s, i_mu_s, 0, z);
+            let sin_s = (1.0 - mu_s * mu_s).max(0.0).sqrt();
+            coeff.iter_mut().for_each(|v| *v = 0.0);
+            for l in 0..DENSITY_THETA {
+                let theta = (l as f64 + 0.5) * dtheta;
+                let (sin_i, cos_i) = theta.sin_cos();
+                let ground = ray_intersects_ground(r, cos_i, g.bottom);
+                let d_ground = if ground { distance_to_bottom_atmosphere_boundary(r, cos_i, g.bottom) } else { 0.0 };
+                if ground {
+                    lookup.transmittance(r, cos_i, d_ground, true, &mut t_ground);
+                }
+                for j in 0..half_phi {
+                    let phi = (j as f64 + 0.5) * dphi;
+                    let (sin_p, cos_p) = phi.sin_cos();
+                    let w_i = [cos_p * sin_i, sin_p * sin_i, cos_i];
+                    let nu_i = (w_i[0] * sin_s + w_i[2] * mu_s).clamp(-1.0, 1.0);
+                    previous.radiance(lookup, r, cos_i, mu_s, nu_i, ground, &mut radiance, &mut tmp);
+                    if ground {
+                        // Light reflected by the Lambertian ground: T·(α/π)·ΔE(n·ω_s).
+                        let p = [d_ground * w_i[0], d_ground * w_i[1], r + d_ground * w_i[2]];
+                        let len = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+                        let mu_g = (p[0] * sin_s + p[2] * mu_s) / len;
+                        lookup.irradiance(delta_irradiance, g.bottom, mu_g.clamp(-1.0, 1.0), &mut e_ground);
+                        for k in 0..n {
+                            radiance[k] += t_ground[k] * model.ground_albedo[k] / PI * e_ground[k];
+                        }
+                    }
+                    field[j * n..(j + 1) * n].copy_from_slice(&radiance);
+                }
+                // Cosine series of the even field: c_0 = (2/N)Σ_half, c_m = (4/N)Σ_half cos(mφ_j).
+                for m in 0..HARMONICS {
+                    let scale = if m == 0 { 2.0 } else { 4.0 } / DENSITY_PHI as f64;
+                    let c = &mut coeff[(l * HARMONICS + m) * n..(l * HARMONICS + m + 1) * n];
+                    for j in 0..half_phi {
+                        let w = scale * (m as f64 * (j as f64 + 0.5) * dphi).cos();
+                        for k in 0..n {
+                            c[k] += w * field[j * n + k];
+                        }
+                    }
+                }
+            }
+            // Convolve with the phase harmonics for every view zenith, then evaluate at ν.
+            for y in 0..s.scattering_mu {
+                k_acc.iter_mut().for_each(|v| *v = 0.0);
+                let kb = &kernels.b[(z * s.scattering_mu + y) * DENSITY_THETA * 2 * HARMONICS..];
+                for l in 0..DENSITY_THETA {
+                    let solid = dtheta * ((l as f64 + 0.5) * dtheta).sin();
+                    for gi in 0..2 {
+                        if groups.members[gi].is_empty() {
+                            continue;
+                        }
+                        for m in 0..HARMONICS {
+                            let b = kb[(l * 2 + gi) * HARMONICS + m] * solid;
+                            let c = &coeff[(l * HARMONICS + m) * n..(l * HARMONICS + m + 1) * n];
+                            let acc = &mut k_acc[(gi * HARMONICS + m) * n..(gi * HARMONICS + m + 1) * n];
+                            for k in 0..n {
+                                acc[k] += b * c[k];
+                            }
+                        }
+                    }
+                }
+                for i_nu in 0..s.scattering_nu {
+                    let x = i_nu * s.scattering_mu_s + i_mu_s;
+                    let (_, mu_v, _, nu, _) = params::scattering_texel(&g, &s, x, y, z);
+                    let sin_v = (1.0 - mu_v * mu_v).max(0.0).sqrt();
+                    let denom = sin_v * sin_s;
+                    let cos_phi_v = if denom > 1e-12 { ((nu - mu_v * mu_s) / denom).clamp(-1.0, 1.0) } else { 1.0 };
+                    let phi_v = cos_phi_v.acos();
+                    let o = &mut slab_out[(y * width + x) * n..(y * width + x + 1) * n];
+                    for gi in 0..2 {
+                        if groups.members[gi].is_empty() {
+                            continue;
+                        }
+                        for m in 0..HARMONICS {
+                            let w = if m == 0 { 2.0 * PI } else { PI * (m as f64 * phi_v).cos() };
+                            let acc = &k_acc[(gi * HARMONICS + m) * n..(gi * HARMONICS + m + 1) * n];
+                            for k in 0..n {
+                                o[k] += (w * acc[k] * beta[gi][k]) as f32;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    });
+    out
+}
+
+/// Indirect ground irradiance ΔE from the previous order (paper eq. 15 / Bruneton 2017
+/// `ComputeIndirectIrradiance`), by midpoint quadrature over the upper hemisphere.
+fn compute_indirect_irradiance(model: &Model, lookup: &Lookup, previous: &Previous) -> Table2 {
+    let s = lookup.sizes;
+    let n = model.channels();
+    let mut e = Table2::new(s.irradiance_mu_s, s.irradiance_r, n);
+    let dtheta = PI / 2.0 / IRRADIANCE_THETA as f64;
+    let dphi = 2.0 * PI / IRRADIANCE_PHI as f64;
+    e.data.par_chunks_mut(n).enumerate().for_each(|(i, out)| {
+        let (x, y) = (i % s.irradiance_mu_s, i / s.irradiance_mu_s);
+        let (r, mu_s) = params::irradiance_r_mu_s(
+            &lookup.radii,
+            (x as f64 + 0.5) / s.irradiance_mu_s as f64,
+            (y as f64 + 0.5) / s.irradiance_r as f64,
+            s.irradiance_mu_s,
+            s.irradiance_r,
+        );
+        let sin_s = (1.0 - mu_s * mu_s).max(0.0).sqrt();
+        let mut radiance = vec![0.0; n];
+        let mut tmp = vec![0.0; n];
+        let mut acc = vec![0.0; n];
+        for j in 0..IRRADIANCE_THETA {
+            let theta = (j as f64 + 0.5) * dtheta;
+            let (sin_t, cos_t) = theta.sin_cos();
+            let domega = dtheta * dphi * sin_t;
+            // Azimuth symmetry about the sun: sample half the circle, count twice.
+            for i_phi in 0..IRRADIANCE_PHI / 2 {
+                let phi = (i_phi as f64 + 0.5) * dphi;
+                let nu = (phi.cos() * sin_t * sin_s + cos_t * mu_s).clamp(-1.0, 1.0);
+                previous.radiance(lookup, r, cos_t, mu_s, nu, false, &mut radiance, &mut tmp);
+                for k in 0..n {
+                    acc[k] += 2.0 * radiance[k] * cos_t * domega;
+                }
+            }
+        }
+        for k in 0..n {
+            out[k] = acc[k] as f32;
+        }
+    });
+    e
+}
+
+/// Multiple scattering ΔS of order n from ΔJ (paper eq. 12 / Bruneton 2017
+/// `ComputeMultipleScattering`), per (r, μ) row: ray samples, their (μ, r) filter weights and
+/// transmittances are shared by every (μ_s, ν) texel.
+fn compute_multiple_scattering(model: &Model, lookup: &Lookup, density: &Table4) -> Table4 {
+    let s = lookup.sizes;
+    let n = model.channels();
+    let mut out = Table4::new(s.scattering_r, s.scattering_mu, s.scattering_mu_s, s.scattering_nu, n);
+    let row_len = out.row_len();
+    let width = out.width();
+    let g = lookup.radii;
+    out.data.par_chunks_mut(row_len).enumerate().for_each(|(row, o)| {
+        let (z, y) = (row / s.scattering_mu, row % s.scattering_mu);
+        let (r, mu, _, _, ground) = params::scattering_texel(&g, &s, 0, y, z);
+        let rays = RaySamples::new(lookup, r, mu, ground, n);
+        let count = rays.d.len();
+        // (μ, r) filter weights of each sample.
+        let weights: Vec<([usize; 2], f64, [usize; 2], f64)> = (0..count)
+            .map(|i| {
+                let uvwz = params::scattering_uvwz(&g, &s, rays.r[i], rays.mu[i], 0.0, 0.0, ground);
+                let (y0, y1, ty) = lerp_weights(uvwz[2], s.scattering_mu);
+                let (z0, z1, tz) = lerp_weights(uvwz[3], s.scattering_r);
+                ([y0, y1], ty, [z0, z1], tz)
+            })
+            .collect();
+        let mut j = vec![0.0; n];
+        let mut acc = vec![0.0; n];
+        for x in 0..width {
+            let (_, _, mu_s, nu, _) = params::scattering_texel(&g, &s, x, y, z);
+            let u_nu = ((nu + 1.0) / 2.0).clamp(0.0, 1.0);
+            acc.iter_mut().for_each(|v| *v = 0.0);
+            for i in 0..count {
+                let mu_s_i = ((r * mu_s + rays.d[i] * nu) / rays.r[i]).clamp(-1.0, 1.0);
+                let u_mu_s = params::texcoord_from_unit(params::x_mu_s(&g, mu_s_i), s.scattering_mu_s);
+                let (yy, ty, zz, tz) = weights[i];
+                density.sample_rows_into(u_nu, u_mu_s, yy, ty, zz, tz, &mut j);
+                for k in 0..n {
+                    acc[k] += rays.w[i] * rays.t[i * n + k] * j[k];
+                }
+            }
+            for k in 0..n {
+                o[x * n + k] = (acc[k] * rays.dx) as f32;
+            }
+        }
+    });
+    out
+}
+
+/// scattering += ΔS / P_molecules(ν) (Bruneton 2017: the table stores Rayleigh-like
+/// radiance divided by the phase function applied at render time).
+fn accumulate_multiple(scattering: &mut Table4, delta: &Table4, groups: &Groups, lookup: &Lookup) {
+    let s = lookup.sizes;
+    let n = scattering.channels;
+    let width = scattering.width();
+    let row_len = scattering.row_len();
+    scattering.data.par_chunks_mut(row_len).zip(delta.data.par_chunks(row_len)).enumerate().for_each(|(row, (o, d))| {
+        let (z, y) = (row / s.scattering_mu, row % s.scattering_mu);
+        for x in 0..width {
+            let (_, _, _, nu, _) = params::scattering_texel(&lookup.radii, &s, x, y, z);
+            let p = groups.phase[0].eval(nu).max(1e-6);
+            for k in 0..n {
+                o[x * n + k] += (d[x * n + k] as f64 / p) as f32;
+            }
+        }
+    });
+}

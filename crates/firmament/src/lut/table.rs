@@ -1,0 +1,161 @@
+//! Table storage (f32, channels innermost) and sampling with GPU semantics: texel i's centre
+//! at (i + 0.5)/n, bilinear/trilinear filtering with clamp-to-edge, and for the 4D scattering
+//! table the packing of Bruneton 2017 (ν and μ_s share the x axis; two 3D fetches and a
+//! manual lerp along ν), so CPU and GPU tables compare texel by texel.
+
+/// Linear-filter weights for texture coordinate `u` over `n` texels: (i0, i1, t).
+#[inline]
+pub fn lerp_weights(u: f64, n: usize) -> (usize, usize, f64) {
+    let x = (u * n as f64 - 0.5).clamp(0.0, (n - 1) as f64);
+    let i0 = (x.floor() as usize).min(n - 1);
+    let i1 = (i0 + 1).min(n - 1);
+    (i0, i1, x - i0 as f64)
+}
+
+/// A 2D table of `channels` f32 per texel, rows of `width` texels.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Table2 {
+    /// Texels along u.
+    pub width: usize,
+    /// Texels along v.
+    pub height: usize,
+    /// Values per texel.
+    pub channels: usize,
+    /// `data[(y·width + x)·channels + c]`.
+    pub data: Vec<f32>,
+}
+
+impl Table2 {
+    /// Zero-filled table.
+    pub fn new(width: usize, height: usize, channels: usize) -> Self {
+        Table2 { width, height, channels, data: vec![0.0; width * height * channels] }
+    }
+
+    /// The texel (x, y).
+    #[inline]
+    pub fn texel(&self, x: usize, y: usize) -> &[f32] {
+        let i = (y * self.width + x) * self.channels;
+        &self.data[i..i + self.channels]
+    }
+
+    /// Bilinear sample at (u, v) into `out` (overwritten).
+    #[inline]
+    pub fn sample_into(&self, u: f64, v: f64, out: &mut [f64]) {
+        let (x0, x1, tx) = lerp_weights(u, self.width);
+        let (y0, y1, ty) = lerp_weights(v, self.height);
+        let c = self.channels;
+        let w = self.width;
+        let d = &self.data;
+        let (i00, i10, i01, i11) = ((y0 * w + x0) * c, (y0 * w + x1) * c, (y1 * w + x0) * c, (y1 * w + x1) * c);
+        let (w00, w10, w01, w11) = ((1.0 - tx) * (1.0 - ty), tx * (1.0 - ty), (1.0 - tx) * ty, tx * ty);
+        for k in 0..c {
+            out[k] = w00 * d[i00 + k] as f64 + w10 * d[i10 + k] as f64 + w01 * d[i01 + k] as f64 + w11 * d[i11 + k] as f64;
+        }
+    }
+
+    /// Element-wise a += b.
+    pub fn add_assign(&mut self, other: &Table2) {
+        for (a, b) in self.data.iter_mut().zip(&other.data) {
+            *a += *b;
+        }
+    }
+}
+
+/// The 4D scattering table packed as a 3D texture: x = ν·N_μs + μ_s, y = μ, z = r.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Table4 {
+    /// r size.
+    pub nr: usize,
+    /// μ size.
+    pub nmu: usize,
+    /// μ_s size.
+    pub nmu_s: usize,
+    /// ν size.
+    pub nnu: usize,
+    /// Values per texel.
+    pub channels: usize,
+    /// `data[((z·nmu + y)·(nnu·nmu_s) + x)·channels + c]`.
+    pub data: Vec<f32>,
+}
+
+impl Table4 {
+    /// Zero-filled table.
+    pub fn new(nr: usize, nmu: usize, nmu_s: usize, nnu: usize, channels: usize) -> Self {
+        Table4 { nr, nmu, nmu_s, nnu, channels, data: vec![0.0; nr * nmu * nmu_s * nnu * channels] }
+    }
+
+    /// Width of the packed x axis.
+    #[inline]
+    pub fn width(&self) -> usize {
+        self.nnu * self.nmu_s
+    }
+
+    /// Floats in one (r, μ) row.
+    #[inline]
+    pub fn row_len(&self) -> usize {
+        self.width() * self.channels
+    }
+
+    /// Index of texel (x, y, z).
+    #[inline]
+    pub fn index(&self, x: usize, y: usize, z: usize) -> usize {
+        ((z * self.nmu + y) * self.width() + x) * self.channels
+    }
+
+    /// Sample at (u_ν, u_μs, u_μ, u_r) into `out` (overwritten), Bruneton 2017's
+    /// `GetScattering`: trilinear in (μ_s, μ, r) at the two nearest ν slices, then a lerp.
+    #[inline]
+    pub fn sample_into(&self, uvwz: [f64; 4], out: &mut [f64]) {
+        let (y0, y1, ty) = lerp_weights(uvwz[2], self.nmu);
+        let (z0, z1, tz) = lerp_weights(uvwz[3], self.nr);
+        self.sample_rows_into(uvwz[0], uvwz[1], [y0, y1], ty, [z0, z1], tz, out);
+    }
+
+    /// As [`Table4::sample_into`] with the (μ, r) filter weights already known (rays whose
+    /// samples share them).
+    #[inline]
+    pub fn sample_rows_into(&self, u_nu: f64, u_mu_s: f64, y: [usize; 2], ty: f64, z: [usize; 2], tz: f64, out: &mut [f64]) {
+        let tex_x = u_nu * (self.nnu - 1) as f64;
+        let nu0 = (tex_x.floor() as usize).min(self.nnu - 1);
+        let nu1 = (nu0 + 1).min(self.nnu - 1);
+        let tnu = tex_x - nu0 as f64;
+        let (s0, s1, ts) = lerp_weights(u_mu_s, self.nmu_s);
+        let c = self.channels;
+        out[..c].iter_mut().for_each(|o| *o = 0.0);
+        let wy = [1.0 - ty, ty];
+        let wz = [1.0 - tz, tz];
+        let wn = [1.0 - tnu, tnu];
+        let ws = [1.0 - ts, ts];
+        for (a, &zz) in z.iter().enumerate() {
+            if wz[a] == 0.0 {
+                continue;
+            }
+            for (b, &yy) in y.iter().enumerate() {
+                let wzy = wz[a] * wy[b];
+                if wzy == 0.0 {
+                    continue;
+                }
+                let row = (zz * self.nmu + yy) * self.width();
+                for (e, &nn) in [nu0, nu1].iter().enumerate() {
+                    for (f, &ss) in [s0, s1].iter().enumerate() {
+                        let w = wzy * wn[e] * ws[f];
+                        if w == 0.0 {
+                            continue;
+                        }
+                        let i = (row + nn * self.nmu_s + ss) * c;
+                        for k in 0..c {
+                            out[k] += w * self.data[i + k] as f64;
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Element-wise a += b.
+    pub fn add_assign(&mut self, other: &Table4) {
+        for (a, b) in self.data.iter_mut().zip(&other.data) {
+            *a += *b;
+        }
+    }
+}
