@@ -1,1 +1,104 @@
-fn main() {}
+//! `firmament`: physically based sky and atmosphere rendering from the command line.
+
+mod bench;
+mod common;
+mod query;
+mod render_bench;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Result;
+use clap::{Parser, Subcommand};
+use firmament::atmosphere::{presets, Atmosphere};
+
+use common::AtmosphereArgs;
+
+#[derive(Parser, Debug)]
+#[command(name = "firmament", version, about = "Physically based sky, atmosphere and cloud renderer")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Radiometric answers as JSON: radiance, luminance, transmittance, optical depths, irradiance.
+    Query(query::QueryArgs),
+    /// Print or check atmosphere definitions.
+    Atmosphere {
+        #[command(subcommand)]
+        action: AtmosphereAction,
+    },
+    /// Precompute the tables and write them to a file for `--tables`.
+    Bake {
+        #[command(flatten)]
+        atmosphere: AtmosphereArgs,
+        /// Output table file.
+        #[arg(long, value_name = "FILE")]
+        out: PathBuf,
+    },
+    /// Benchmarks: medians of the precomputation and frame costs.
+    Bench(bench::BenchArgs),
+}
+
+#[derive(Subcommand, Debug)]
+enum AtmosphereAction {
+    /// Print a preset as a complete, commented TOML file.
+    Show {
+        /// Preset name.
+        name: String,
+    },
+    /// List the presets.
+    List,
+    /// Check an atmosphere file and print it back, complete.
+    Check {
+        /// TOML file.
+        file: PathBuf,
+    },
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Query(args) => {
+            let value = query::run(&args)?;
+            println!("{}", serde_json::to_string_pretty(&value)?);
+        }
+        Command::Atmosphere { action } => match action {
+            AtmosphereAction::Show { name } => print!("{}", presets::toml_text(&name)?),
+            AtmosphereAction::List => {
+                for name in presets::NAMES {
+                    let a = Atmosphere::preset(name)?;
+                    println!("{name:14} {}", a.description);
+                }
+            }
+            AtmosphereAction::Check { file } => {
+                let a = Atmosphere::from_file(&file)?;
+                print!("{}", a.to_toml());
+            }
+        },
+        Command::Bake { atmosphere, out } => {
+            common::check_output_dir(&out, "--out")?;
+            if atmosphere.tables.is_some() {
+                anyhow::bail!("`bake` computes tables: --tables makes no sense here");
+            }
+            let model = atmosphere.model()?;
+            let tables = common::compute_tables(&model, &atmosphere.table_config()?, false)?;
+            firmament::lut::file::write(&tables, &out)?;
+            eprintln!("wrote {}", out.display());
+        }
+        Command::Bench(args) => bench::run(&args)?,
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -198,6 +198,34 @@ pub fn scattering_uvwz(
     [u_nu.clamp(0.0, 1.0), u_mu_s, u_mu, u_r]
 }
 
+/// [`x_mu_s`] with its constants computed once (hot loops).
+#[derive(Clone, Copy, Debug)]
+pub struct MuSMap {
+    top: f64,
+    bottom: f64,
+    d_min: f64,
+    inv_range: f64,
+    big_a: f64,
+}
+
+impl MuSMap {
+    /// Constants for these radii.
+    pub fn new(g: &Radii) -> MuSMap {
+        let d_min = g.top - g.bottom;
+        let d_max = g.h();
+        let big_d = distance_to_top_atmosphere_boundary(g.bottom, g.mu_s_min, g.top);
+        MuSMap { top: g.top, bottom: g.bottom, d_min, inv_range: 1.0 / (d_max - d_min), big_a: (big_d - d_min) / (d_max - d_min) }
+    }
+
+    /// Same as [`x_mu_s`].
+    #[inline]
+    pub fn x(&self, mu_s: f64) -> f64 {
+        let d = distance_to_top_atmosphere_boundary(self.bottom, mu_s, self.top);
+        let a = (d - self.d_min) * self.inv_range;
+        ((1.0 - a / self.big_a).max(0.0) / (1.0 + a)).clamp(0.0, 1.0)
+    }
+}
+
 /// The non-linear μ_s coordinate in [0,1] (Bruneton 2017): from the distance to the top
 /// along the sun ray from the ground, with the configurable minimum sun elevation.
 #[inline]

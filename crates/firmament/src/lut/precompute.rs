@@ -337,6 +337,53 @@ impl RaySamples {
     }
 }
 
+/// The transmittance table filtered to one radius, for lookups towards the sun from one
+/// ray sample at many μ_s.
+struct SunRow {
+    r: f64,
+    rho: f64,
+    cos_h: f64,
+    eps: f64,
+    row: Vec<f64>,
+}
+
+impl SunRow {
+    fn new(lookup: &Lookup, r: f64) -> SunRow {
+        let g = &lookup.radii;
+        let s = &lookup.sizes;
+        let t = lookup.transmittance;
+        let rho = crate::geometry::safe_sqrt(r * r - g.bottom * g.bottom);
+        let v = params::texcoord_from_unit(rho / g.h(), s.transmittance_r);
+        let (y0, y1, ty) = lerp_weights(v, s.transmittance_r);
+        let n = t.channels;
+        let w = t.width * n;
+        let row = (0..w).map(|i| (1.0 - ty) * t.data[y0 * w + i] as f64 + ty * t.data[y1 * w + i] as f64).collect();
+        let sin_h = g.bottom / r;
+        SunRow { r, rho, cos_h: -crate::geometry::safe_sqrt(1.0 - sin_h * sin_h), eps: sin_h * lookup.sun_angular_radius, row }
+    }
+
+    /// Same as [`Lookup::transmittance_to_sun`] at this radius; false when zero.
+    #[inline]
+    fn transmittance_to_sun(&self, lookup: &Lookup, mu_s: f64, out: &mut [f64]) -> bool {
+        let fraction = super::context::smoothstep(-self.eps, self.eps, mu_s - self.cos_h);
+        if fraction <= 0.0 {
+            return false;
+        }
+        let g = &lookup.radii;
+        let d = crate::geometry::distance_to_top_atmosphere_boundary(self.r, mu_s, g.top);
+        let d_min = g.top - self.r;
+        let d_max = self.rho + g.h();
+        let x_mu = if d_max > d_min { (d - d_min) / (d_max - d_min) } else { 0.0 };
+        let width = lookup.sizes.transmittance_mu;
+        let (x0, x1, tx) = lerp_weights(params::texcoord_from_unit(x_mu, width), width);
+        let n = out.len();
+        for k in 0..n {
+            out[k] = fraction * ((1.0 - tx) * self.row[x0 * n + k] + tx * self.row[x1 * n + k]);
+        }
+        true
+    }
+}
+
 /// Single scattering (paper eq. 7; Bruneton 2017 `ComputeSingleScattering`): Rayleigh and
 /// Mie integrated separately without phase functions.
 fn compute_single_scattering(model: &Model, lookup: &Lookup, groups: &Groups) -> (Table4, Table4) {
@@ -359,6 +406,7 @@ fn compute_single_scattering(model: &Model, lookup: &Lookup, groups: &Groups) ->
                 groups.scattering_into(model, g, alt, &mut beta[g][i * n..(i + 1) * n]);
             }
         }
+        let sun_rows: Vec<SunRow> = (0..count).map(|i| SunRow::new(lookup, rays.r[i])).collect();
         let mut t_sun = vec![0.0; n];
         let mut acc = [vec![0.0; n], vec![0.0; n]];
         for x in 0..width {
@@ -367,7 +415,9 @@ fn compute_single_scattering(model: &Model, lookup: &Lookup, groups: &Groups) ->
             for i in 0..count {
                 let r_d = rays.r[i];
                 let mu_s_d = ((r * mu_s + rays.d[i] * nu) / r_d).clamp(-1.0, 1.0);
-                lookup.transmittance_to_sun(r_d, mu_s_d, &mut t_sun);
+                if !sun_rows[i].transmittance_to_sun(lookup, mu_s_d, &mut t_sun) {
+                    continue;
+                }
                 for k in 0..n {
                     let t = rays.w[i] * rays.t[i * n + k] * t_sun[k];
                     acc[0][k] += t * beta[0][i * n + k];
@@ -496,6 +546,14 @@ fn compute_scattering_density(
         let mut coeff = vec![0.0; DENSITY_THETA * HARMONICS * n];
         let mut field = vec![0.0; half_phi * n];
         let mut k_acc = vec![0.0; 2 * HARMONICS * n];
+        // cos(m·φ_j) for the half-circle azimuths, with the series' scale folded in.
+        let cos_table: Vec<f64> = (0..HARMONICS)
+            .flat_map(|m| {
+                let scale = if m == 0 { 2.0 } else { 4.0 } / DENSITY_PHI as f64;
+                (0..half_phi).map(move |j| scale * (m as f64 * (j as f64 + 0.5) * dphi).cos())
+            })
+            .collect();
+        let mut harmonic = [0.0f64; HARMONICS];
         for i_mu_s in 0..s.scattering_mu_s {
             let (_, _, mu_s, _, _) = params::scattering_texel(&g, &s, i_mu_s, 0, z);
             let sin_s = (1.0 - mu_s * mu_s).max(0.0).sqrt();
@@ -528,10 +586,9 @@ fn compute_scattering_density(
                 }
                 // Cosine series of the even field: c_0 = (2/N)Σ_half, c_m = (4/N)Σ_half cos(mφ_j).
                 for m in 0..HARMONICS {
-                    let scale = if m == 0 { 2.0 } else { 4.0 } / DENSITY_PHI as f64;
                     let c = &mut coeff[(l * HARMONICS + m) * n..(l * HARMONICS + m + 1) * n];
                     for j in 0..half_phi {
-                        let w = scale * (m as f64 * (j as f64 + 0.5) * dphi).cos();
+                        let w = cos_table[m * half_phi + j];
                         for k in 0..n {
                             c[k] += w * field[j * n + k];
                         }
@@ -564,19 +621,31 @@ fn compute_scattering_density(
                     let sin_v = (1.0 - mu_v * mu_v).max(0.0).sqrt();
                     let denom = sin_v * sin_s;
                     let cos_phi_v = if denom > 1e-12 { ((nu - mu_v * mu_s) / denom).clamp(-1.0, 1.0) } else { 1.0 };
-                    let phi_v = cos_phi_v.acos();
-                    let o = &mut slab_out[(y * width + x) * n..(y * width + x + 1) * n];
+                    // 2π for m = 0, π·cos(mφ_v) otherwise (Chebyshev recurrence).
+                    harmonic[0] = 2.0 * PI;
+                    harmonic[1] = PI * cos_phi_v;
+                    let (mut c0, mut c1) = (1.0, cos_phi_v);
+                    for h in harmonic.iter_mut().skip(2) {
+                        let c2 = 2.0 * cos_phi_v * c1 - c0;
+                        *h = PI * c2;
+                        c0 = c1;
+                        c1 = c2;
+                    }
+                    let mut j_out = [0.0f64; 64];
                     for gi in 0..2 {
                         if groups.members[gi].is_empty() {
                             continue;
                         }
-                        for m in 0..HARMONICS {
-                            let w = if m == 0 { 2.0 * PI } else { PI * (m as f64 * phi_v).cos() };
+                        for (m, w) in harmonic.iter().enumerate() {
                             let acc = &k_acc[(gi * HARMONICS + m) * n..(gi * HARMONICS + m + 1) * n];
                             for k in 0..n {
-                                o[k] += (w * acc[k] * beta[gi][k]) as f32;
+                                j_out[k] += w * acc[k] * beta[gi][k];
                             }
                         }
+                    }
+                    let o = &mut slab_out[(y * width + x) * n..(y * width + x + 1) * n];
+                    for k in 0..n {
+                        o[k] = j_out[k] as f32;
                     }
                 }
             }
@@ -642,28 +711,46 @@ fn compute_multiple_scattering(model: &Model, lookup: &Lookup, density: &Table4)
         let (r, mu, _, _, ground) = params::scattering_texel(&g, &s, 0, y, z);
         let rays = RaySamples::new(lookup, r, mu, ground, n);
         let count = rays.d.len();
-        // (μ, r) filter weights of each sample.
-        let weights: Vec<([usize; 2], f64, [usize; 2], f64)> = (0..count)
-            .map(|i| {
-                let uvwz = params::scattering_uvwz(&g, &s, rays.r[i], rays.mu[i], 0.0, 0.0, ground);
-                let (y0, y1, ty) = lerp_weights(uvwz[2], s.scattering_mu);
-                let (z0, z1, tz) = lerp_weights(uvwz[3], s.scattering_r);
-                ([y0, y1], ty, [z0, z1], tz)
-            })
-            .collect();
-        let mut j = vec![0.0; n];
+        // Each sample's (μ, r)-filtered row of ΔJ, so a texel's lookup is a bilinear
+        // filter in (ν, μ_s) only.
+        let row_len = density.row_len();
+        let mut blended = vec![0.0f64; count * row_len];
+        for i in 0..count {
+            let uvwz = params::scattering_uvwz(&g, &s, rays.r[i], rays.mu[i], 0.0, 0.0, ground);
+            let (y0, y1, ty) = lerp_weights(uvwz[2], s.scattering_mu);
+            let (z0, z1, tz) = lerp_weights(uvwz[3], s.scattering_r);
+            let b = &mut blended[i * row_len..(i + 1) * row_len];
+            for (yy, zz, w) in [(y0, z0, (1.0 - ty) * (1.0 - tz)), (y1, z0, ty * (1.0 - tz)), (y0, z1, (1.0 - ty) * tz), (y1, z1, ty * tz)] {
+                if w == 0.0 {
+                    continue;
+                }
+                let start = density.index(0, yy, zz);
+                for (o, v) in b.iter_mut().zip(&density.data[start..start + row_len]) {
+                    *o += w * *v as f64;
+                }
+            }
+        }
+        let nmu_s = s.scattering_mu_s;
+        let mu_s_map = params::MuSMap::new(&g);
         let mut acc = vec![0.0; n];
         for x in 0..width {
             let (_, _, mu_s, nu, _) = params::scattering_texel(&g, &s, x, y, z);
-            let u_nu = ((nu + 1.0) / 2.0).clamp(0.0, 1.0);
+            let tex_x = ((nu + 1.0) / 2.0).clamp(0.0, 1.0) * (s.scattering_nu - 1) as f64;
+            let nu0 = (tex_x as usize).min(s.scattering_nu - 1);
+            let nu1 = (nu0 + 1).min(s.scattering_nu - 1);
+            let tnu = tex_x - nu0 as f64;
             acc.iter_mut().for_each(|v| *v = 0.0);
             for i in 0..count {
                 let mu_s_i = ((r * mu_s + rays.d[i] * nu) / rays.r[i]).clamp(-1.0, 1.0);
-                let u_mu_s = params::texcoord_from_unit(params::x_mu_s(&g, mu_s_i), s.scattering_mu_s);
-                let (yy, ty, zz, tz) = weights[i];
-                density.sample_rows_into(u_nu, u_mu_s, yy, ty, zz, tz, &mut j);
+                let u_mu_s = params::texcoord_from_unit(mu_s_map.x(mu_s_i), nmu_s);
+                let (s0, s1, ts) = lerp_weights(u_mu_s, nmu_s);
+                let b = &blended[i * row_len..(i + 1) * row_len];
+                let (a0, a1, a2, a3) = ((nu0 * nmu_s + s0) * n, (nu0 * nmu_s + s1) * n, (nu1 * nmu_s + s0) * n, (nu1 * nmu_s + s1) * n);
+                let (w0, w1, w2, w3) = ((1.0 - tnu) * (1.0 - ts), (1.0 - tnu) * ts, tnu * (1.0 - ts), tnu * ts);
+                let wt = rays.w[i];
                 for k in 0..n {
-                    acc[k] += rays.w[i] * rays.t[i * n + k] * j[k];
+                    let j = w0 * b[a0 + k] + w1 * b[a1 + k] + w2 * b[a2 + k] + w3 * b[a3 + k];
+                    acc[k] += wt * rays.t[i * n + k] * j;
                 }
             }
             for k in 0..n {

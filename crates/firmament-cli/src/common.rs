@@ -1,0 +1,158 @@
+//! What several subcommands share: choosing the atmosphere and wavelengths, getting the
+//! tables (from a file or computed with a progress bar), Ctrl-C.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::OnceLock;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+use clap::Args;
+use firmament::atmosphere::{Atmosphere, Model};
+use firmament::lut::{self, MieStorage, TableConfig, TableSizes, Tables};
+use firmament::sky::Sky;
+use firmament::spectrum::Wavelengths;
+use indicatif::{ProgressBar, ProgressStyle};
+
+/// Set by Ctrl-C; long work checks it and stops cleanly.
+pub fn cancel_flag() -> &'static AtomicBool {
+    static FLAG: OnceLock<AtomicBool> = OnceLock::new();
+    FLAG.get_or_init(|| {
+        let _ = ctrlc::set_handler(|| {
+            if cancel_flag().swap(true, Ordering::SeqCst) {
+                // Second Ctrl-C: leave at once.
+                std::process::exit(130);
+            }
+            eprintln!("\ninterrupted: stopping (Ctrl-C again to quit at once)");
+        });
+        AtomicBool::new(false)
+    })
+}
+
+/// Which atmosphere, which wavelengths, which tables.
+#[derive(Args, Debug, Clone)]
+pub struct AtmosphereArgs {
+    /// Embedded preset: earth (default), bruneton2008, frostbite2016, hazy, mars.
+    #[arg(long, conflicts_with = "atmosphere")]
+    pub preset: Option<String>,
+    /// Atmosphere TOML file (see `firmament atmosphere show earth` for the schema).
+    #[arg(long, value_name = "FILE")]
+    pub atmosphere: Option<PathBuf>,
+    /// Wavelengths: `rgb` (680, 550, 440 nm), `spectral` (16 samples 365–815 nm) or a list `NM,NM,...`.
+    #[arg(long, default_value = "rgb")]
+    pub wavelengths: String,
+    /// Precomputed tables from `firmament bake` (must match the atmosphere and wavelengths).
+    #[arg(long, value_name = "FILE")]
+    pub tables: Option<PathBuf>,
+    /// Scattering orders to precompute when no --tables are given.
+    #[arg(long, default_value_t = 4)]
+    pub orders: usize,
+    /// Table sizes when no --tables are given: `default` (SPEC sizes) or `small` (fast, coarse).
+    #[arg(long, default_value = "default", value_name = "default|small")]
+    pub table_size: String,
+    /// Store single Mie scattering for every wavelength (`separate`) or only the first (`red-only`, ratio rule).
+    #[arg(long, default_value = "separate", value_name = "separate|red-only")]
+    pub mie: String,
+}
+
+impl AtmosphereArgs {
+    /// The chosen atmosphere.
+    pub fn atmosphere(&self) -> Result<Atmosphere> {
+        Ok(match (&self.atmosphere, &self.preset) {
+            (Some(path), _) => Atmosphere::from_file(path)?,
+            (None, Some(name)) => Atmosphere::preset(name)?,
+            (None, None) => Atmosphere::preset("earth")?,
+        })
+    }
+
+    /// The resolved model.
+    pub fn model(&self) -> Result<Model> {
+        let wavelengths = Wavelengths::parse(&self.wavelengths)?;
+        Ok(self.atmosphere()?.resolve(&wavelengths)?)
+    }
+
+    /// The table configuration for a fresh precomputation.
+    pub fn table_config(&self) -> Result<TableConfig> {
+        let sizes = match self.table_size.as_str() {
+            "default" => TableSizes::default(),
+            "small" => TableSizes::small(),
+            other => anyhow::bail!("invalid value for `--table-size`: {other} (accepted: default, small)"),
+        };
+        let mie = match self.mie.as_str() {
+            "separate" => MieStorage::Separate,
+            "red-only" => MieStorage::RedOnly,
+            other => anyhow::bail!("invalid value for `--mie`: {other} (accepted: separate, red-only)"),
+        };
+        let config = TableConfig { sizes, orders: self.orders, mie };
+        config.validate()?;
+        Ok(config)
+    }
+
+    /// Model and tables (read from --tables, or computed), paired.
+    pub fn sky(&self, quiet: bool) -> Result<Sky> {
+        let model = self.model()?;
+        let tables = match &self.tables {
+            Some(path) => {
+                let t = lut::file::read(path)?;
+                t.check_matches(&model, &path.display().to_string())?;
+                t
+            }
+            None => compute_tables(&model, &self.table_config()?, quiet)?,
+        };
+        Ok(Sky::new(model, tables)?)
+    }
+}
+
+/// Precompute with a progress bar on stderr (hidden when `quiet` or not a terminal).
+pub fn compute_tables(model: &Model, config: &TableConfig, quiet: bool) -> Result<Tables> {
+    let bar = progress_bar(1000, quiet);
+    bar.set_message("precomputing tables");
+    let started = Instant::now();
+    let tables = lut::precompute::precompute(
+        model,
+        config,
+        &|stage, fraction| {
+            bar.set_position((fraction * 1000.0) as u64);
+            bar.set_message(stage.to_string());
+        },
+        Some(cancel_flag()),
+    );
+    bar.finish_and_clear();
+    let tables = tables.context("precomputing the tables")?;
+    if !quiet {
+        eprintln!("tables: {:.2} s ({} wavelengths, {} orders)", started.elapsed().as_secs_f64(), model.channels(), config.orders);
+    }
+    Ok(tables)
+}
+
+/// A progress bar drawn on stderr only for work long enough to need one.
+pub fn progress_bar(len: u64, quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(len);
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {wide_bar} {percent:>3}% {msg}")
+            .expect("valid template"),
+    );
+    bar.enable_steady_tick(Duration::from_millis(200));
+    bar
+}
+
+/// Check a finite number is within [lo, hi]; the message names the flag.
+pub fn check_range(flag: &str, v: f64, lo: f64, hi: f64, unit: &str) -> Result<()> {
+    if v.is_finite() && v >= lo && v <= hi {
+        Ok(())
+    } else {
+        anyhow::bail!("invalid value for `{flag}`: {v} (accepted: a number in [{lo}, {hi}] {unit})")
+    }
+}
+
+/// The directory of a path exists (for clear errors before long work).
+pub fn check_output_dir(path: &Path, flag: &str) -> Result<()> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if !dir.is_dir() {
+        anyhow::bail!("invalid value for `{flag}`: {} (directory {} does not exist)", path.display(), dir.display());
+    }
+    Ok(())
+}

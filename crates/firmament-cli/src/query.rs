@@ -1,0 +1,116 @@
+//! `firmament query`: radiometric answers as one JSON object.
+
+use anyhow::Result;
+use clap::Args;
+use firmament::geometry::direction_from_zenith_azimuth;
+use firmament::spectrum::{spectrum_to_xyz, xyz_to_linear_srgb};
+use serde_json::json;
+
+use crate::common::{check_range, AtmosphereArgs};
+
+/// Arguments of `firmament query`.
+#[derive(Args, Debug)]
+pub struct QueryArgs {
+    #[command(flatten)]
+    pub atmosphere: AtmosphereArgs,
+    /// Observer altitude above the ground (m); above the atmosphere top is space.
+    #[arg(long, allow_hyphen_values = true)]
+    pub altitude_m: f64,
+    /// Sun zenith angle (degrees, 0–180; above 90 the sun is below the horizon).
+    #[arg(long, allow_hyphen_values = true)]
+    pub sun_zenith_deg: f64,
+    /// Sun azimuth (degrees clockwise from north).
+    #[arg(long, default_value_t = 180.0, allow_hyphen_values = true)]
+    pub sun_azimuth_deg: f64,
+    /// A view direction `ZENITH_DEG,AZIMUTH_DEG` (azimuth clockwise from north); repeatable.
+    #[arg(long = "view", value_name = "ZENITH_DEG,AZIMUTH_DEG", allow_hyphen_values = true)]
+    pub views: Vec<String>,
+    /// Method: `lut` (precomputed tables).
+    #[arg(long, default_value = "lut")]
+    pub method: String,
+}
+
+fn parse_view(s: &str) -> Result<(f64, f64)> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let parsed: Vec<f64> = parts.iter().filter_map(|p| p.parse().ok()).collect();
+    if parts.len() != 2 || parsed.len() != 2 {
+        anyhow::bail!("invalid value for `--view`: {s:?} (accepted: ZENITH_DEG,AZIMUTH_DEG, e.g. 45,180)");
+    }
+    check_range("--view (zenith)", parsed[0], 0.0, 180.0, "degrees")?;
+    check_range("--view (azimuth)", parsed[1], -360.0, 360.0, "degrees")?;
+    Ok((parsed[0], parsed[1]))
+}
+
+/// Run the query and return the JSON.
+pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
+    check_range("--altitude-m", args.altitude_m, 0.0, 1e12, "m")?;
+    check_range("--sun-zenith-deg", args.sun_zenith_deg, 0.0, 180.0, "degrees")?;
+    check_range("--sun-azimuth-deg", args.sun_azimuth_deg, -360.0, 360.0, "degrees")?;
+    if args.method != "lut" {
+        anyhow::bail!("invalid value for `--method`: {} (accepted: lut)", args.method);
+    }
+    let views: Vec<(f64, f64)> = args.views.iter().map(|v| parse_view(v)).collect::<Result<_>>()?;
+    let sky = args.atmosphere.sky(true)?;
+    let model = &sky.model;
+    let nm = model.wavelengths.nm().to_vec();
+    let n = nm.len();
+
+    let camera = [0.0, 0.0, model.bottom_radius_m + args.altitude_m];
+    let up = [0.0, 0.0, 1.0];
+    let sun = direction_from_zenith_azimuth(args.sun_zenith_deg.to_radians(), args.sun_azimuth_deg.to_radians());
+
+    let depths = model.optical_depths_vertical(args.altitude_m);
+    let e_toa = model.solar_irradiance.clone();
+    let mut sun_t = vec![0.0; n];
+    sky.transmittance_to_sun(camera, sun, &mut sun_t);
+    let (mut e_sun, mut e_sky) = (vec![0.0; n], vec![0.0; n]);
+    if args.altitude_m <= model.height_m() {
+        sky.sun_and_sky_irradiance(camera, up, sun, &mut e_sun, &mut e_sky);
+    } else {
+        // In space: the direct beam only (no sky below a horizontal surface facing up).
+        let cos = sun[2].max(0.0);
+        for k in 0..n {
+            e_sun[k] = e_toa[k] * sun_t[k] * cos;
+        }
+    }
+    let lux = |v: &[f64]| spectrum_to_xyz(&nm, v)[1];
+
+    let mut view_json = Vec::new();
+    for &(z, a) in &views {
+        let dir = direction_from_zenith_azimuth(z.to_radians(), a.to_radians());
+        let (mut radiance, mut t) = (vec![0.0; n], vec![0.0; n]);
+        sky.sky_radiance(camera, dir, 0.0, sun, &mut radiance, &mut t);
+        let xyz = spectrum_to_xyz(&nm, &radiance);
+        view_json.push(json!({
+            "zenith_deg": z,
+            "azimuth_deg": a,
+            "radiance": radiance,
+            "luminance_cd_m2": xyz[1],
+            "xyz": xyz,
+            "srgb_linear": xyz_to_linear_srgb(xyz),
+            "transmittance": t,
+        }));
+    }
+    Ok(json!({
+        "method": args.method,
+        "wavelengths_nm": nm,
+        "units": {
+            "radiance": "W m-2 sr-1 nm-1",
+            "irradiance": "W m-2 nm-1",
+            "luminance": "cd m-2 (CIE 1931 2 deg, 683 lm/W; spectrum linearly interpolated between samples)",
+        },
+        "altitude_m": args.altitude_m,
+        "sun": { "zenith_deg": args.sun_zenith_deg, "azimuth_deg": args.sun_azimuth_deg },
+        "optical_depth_zenith": depths,
+        "solar_irradiance_toa": e_toa,
+        "solar_illuminance_toa_lux": lux(&model.solar_irradiance),
+        "sun_transmittance": sun_t,
+        "irradiance": {
+            "sun": e_sun,
+            "sky": e_sky,
+            "sun_lux": lux(&e_sun),
+            "sky_lux": lux(&e_sky),
+        },
+        "views": view_json,
+    }))
+}
