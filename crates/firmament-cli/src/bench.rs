@@ -52,7 +52,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let cpu = cpu_name();
     let threads = rayon::current_num_threads();
     if !args.json {
-        eprintln!("machine: {cpu}, {threads} threads; {} runs per measurement", args.runs);
+        eprintln!(
+            "machine: {cpu}, {threads} threads; {} runs per measurement",
+            args.runs
+        );
     }
     let mut stages: Vec<(String, f64)> = Vec::new();
     let precompute = time_runs(args.runs, || {
@@ -96,7 +99,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         spectral_args.wavelengths = "spectral".into();
         let spectral_model = spectral_args.model()?;
         let times = time_runs(args.runs.min(3), || {
-            let _ = firmament::lut::precompute::precompute(&spectral_model, &config, &|_, _| {}, None)?;
+            let _ =
+                firmament::lut::precompute::precompute(&spectral_model, &config, &|_, _| {}, None)?;
             Ok(())
         })?;
         result["cpu_precompute_spectral_s"] = json!(median(times));
@@ -117,6 +121,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
 pub fn cpu_name() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()
-        .and_then(|s| s.lines().find(|l| l.starts_with("model name")).map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string()))
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
         .unwrap_or_else(|| "unknown".into())
 }

@@ -76,14 +76,22 @@ impl AtmosphereArgs {
         let sizes = match self.table_size.as_str() {
             "default" => TableSizes::default(),
             "small" => TableSizes::small(),
-            other => anyhow::bail!("invalid value for `--table-size`: {other} (accepted: default, small)"),
+            other => anyhow::bail!(
+                "invalid value for `--table-size`: {other} (accepted: default, small)"
+            ),
         };
         let mie = match self.mie.as_str() {
             "separate" => MieStorage::Separate,
             "red-only" => MieStorage::RedOnly,
-            other => anyhow::bail!("invalid value for `--mie`: {other} (accepted: separate, red-only)"),
+            other => {
+                anyhow::bail!("invalid value for `--mie`: {other} (accepted: separate, red-only)")
+            }
         };
-        let config = TableConfig { sizes, orders: self.orders, mie };
+        let config = TableConfig {
+            sizes,
+            orders: self.orders,
+            mie,
+        };
         config.validate()?;
         Ok(config)
     }
@@ -120,7 +128,12 @@ pub fn compute_tables(model: &Model, config: &TableConfig, quiet: bool) -> Resul
     bar.finish_and_clear();
     let tables = tables.context("precomputing the tables")?;
     if !quiet {
-        eprintln!("tables: {:.2} s ({} wavelengths, {} orders)", started.elapsed().as_secs_f64(), model.channels(), config.orders);
+        eprintln!(
+            "tables: {:.2} s ({} wavelengths, {} orders)",
+            started.elapsed().as_secs_f64(),
+            model.channels(),
+            config.orders
+        );
     }
     Ok(tables)
 }
@@ -132,8 +145,10 @@ pub fn progress_bar(len: u64, quiet: bool) -> ProgressBar {
     }
     let bar = ProgressBar::new(len);
     bar.set_style(
-        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {wide_bar} {percent:>3}% {msg}")
-            .expect("valid template"),
+        ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {wide_bar} {percent:>3}% {msg}",
+        )
+        .expect("valid template"),
     );
     bar.enable_steady_tick(Duration::from_millis(200));
     bar
@@ -150,9 +165,16 @@ pub fn check_range(flag: &str, v: f64, lo: f64, hi: f64, unit: &str) -> Result<(
 
 /// The directory of a path exists (for clear errors before long work).
 pub fn check_output_dir(path: &Path, flag: &str) -> Result<()> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     if !dir.is_dir() {
-        anyhow::bail!("invalid value for `{flag}`: {} (directory {} does not exist)", path.display(), dir.display());
+        anyhow::bail!(
+            "invalid value for `{flag}`: {} (directory {} does not exist)",
+            path.display(),
+            dir.display()
+        );
     }
     Ok(())
 }

@@ -2,7 +2,9 @@
 
 mod bench;
 mod common;
+mod gallery;
 mod query;
+mod render;
 mod render_bench;
 
 use std::path::PathBuf;
@@ -15,7 +17,11 @@ use firmament::atmosphere::{presets, Atmosphere};
 use common::AtmosphereArgs;
 
 #[derive(Parser, Debug)]
-#[command(name = "firmament", version, about = "Physically based sky, atmosphere and cloud renderer")]
+#[command(
+    name = "firmament",
+    version,
+    about = "Physically based sky, atmosphere and cloud renderer"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -38,6 +44,10 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         out: PathBuf,
     },
+    /// Render a picture of the sky (with no arguments: a default scene to firmament.png and firmament.exr).
+    Render(render::RenderArgs),
+    /// The canonical views as PNGs with an index.html contact sheet.
+    Gallery(gallery::GalleryArgs),
     /// Benchmarks: medians of the precomputation and frame costs.
     Bench(bench::BenchArgs),
 }
@@ -88,6 +98,8 @@ fn run(cli: Cli) -> Result<()> {
             eprintln!("wrote {}", out.display());
         }
         Command::Bench(args) => bench::run(&args)?,
+        Command::Render(args) => render::run(&args)?,
+        Command::Gallery(args) => gallery::run(&args)?,
     }
     Ok(())
 }

@@ -23,7 +23,11 @@ pub struct QueryArgs {
     #[arg(long, default_value_t = 180.0, allow_hyphen_values = true)]
     pub sun_azimuth_deg: f64,
     /// A view direction `ZENITH_DEG,AZIMUTH_DEG` (azimuth clockwise from north); repeatable.
-    #[arg(long = "view", value_name = "ZENITH_DEG,AZIMUTH_DEG", allow_hyphen_values = true)]
+    #[arg(
+        long = "view",
+        value_name = "ZENITH_DEG,AZIMUTH_DEG",
+        allow_hyphen_values = true
+    )]
     pub views: Vec<String>,
     /// Method: `lut` (precomputed tables).
     #[arg(long, default_value = "lut")]
@@ -34,7 +38,9 @@ fn parse_view(s: &str) -> Result<(f64, f64)> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     let parsed: Vec<f64> = parts.iter().filter_map(|p| p.parse().ok()).collect();
     if parts.len() != 2 || parsed.len() != 2 {
-        anyhow::bail!("invalid value for `--view`: {s:?} (accepted: ZENITH_DEG,AZIMUTH_DEG, e.g. 45,180)");
+        anyhow::bail!(
+            "invalid value for `--view`: {s:?} (accepted: ZENITH_DEG,AZIMUTH_DEG, e.g. 45,180)"
+        );
     }
     check_range("--view (zenith)", parsed[0], 0.0, 180.0, "degrees")?;
     check_range("--view (azimuth)", parsed[1], -360.0, 360.0, "degrees")?;
@@ -44,12 +50,31 @@ fn parse_view(s: &str) -> Result<(f64, f64)> {
 /// Run the query and return the JSON.
 pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
     check_range("--altitude-m", args.altitude_m, 0.0, 1e12, "m")?;
-    check_range("--sun-zenith-deg", args.sun_zenith_deg, 0.0, 180.0, "degrees")?;
-    check_range("--sun-azimuth-deg", args.sun_azimuth_deg, -360.0, 360.0, "degrees")?;
+    check_range(
+        "--sun-zenith-deg",
+        args.sun_zenith_deg,
+        0.0,
+        180.0,
+        "degrees",
+    )?;
+    check_range(
+        "--sun-azimuth-deg",
+        args.sun_azimuth_deg,
+        -360.0,
+        360.0,
+        "degrees",
+    )?;
     if args.method != "lut" {
-        anyhow::bail!("invalid value for `--method`: {} (accepted: lut)", args.method);
+        anyhow::bail!(
+            "invalid value for `--method`: {} (accepted: lut)",
+            args.method
+        );
     }
-    let views: Vec<(f64, f64)> = args.views.iter().map(|v| parse_view(v)).collect::<Result<_>>()?;
+    let views: Vec<(f64, f64)> = args
+        .views
+        .iter()
+        .map(|v| parse_view(v))
+        .collect::<Result<_>>()?;
     let sky = args.atmosphere.sky(true)?;
     let model = &sky.model;
     let nm = model.wavelengths.nm().to_vec();
@@ -57,7 +82,10 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
 
     let camera = [0.0, 0.0, model.bottom_radius_m + args.altitude_m];
     let up = [0.0, 0.0, 1.0];
-    let sun = direction_from_zenith_azimuth(args.sun_zenith_deg.to_radians(), args.sun_azimuth_deg.to_radians());
+    let sun = direction_from_zenith_azimuth(
+        args.sun_zenith_deg.to_radians(),
+        args.sun_azimuth_deg.to_radians(),
+    );
 
     let depths = model.optical_depths_vertical(args.altitude_m);
     let e_toa = model.solar_irradiance.clone();

@@ -50,7 +50,15 @@ pub type Result<T> = std::result::Result<T, Error>;
 
 impl Error {
     /// A parameter error; `value` is formatted with `{:?}`-free display.
-    pub fn invalid(field: impl Into<String>, value: impl ToString, expected: impl Into<String>) -> Self {
-        Error::InvalidParameter { field: field.into(), value: value.to_string(), expected: expected.into() }
+    pub fn invalid(
+        field: impl Into<String>,
+        value: impl ToString,
+        expected: impl Into<String>,
+    ) -> Self {
+        Error::InvalidParameter {
+            field: field.into(),
+            value: value.to_string(),
+            expected: expected.into(),
+        }
     }
 }

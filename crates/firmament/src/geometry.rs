@@ -104,7 +104,11 @@ pub fn normalize(a: Vec3) -> Vec3 {
 /// Cross product.
 #[inline]
 pub fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 /// Distances (near, far) along unit `dir` from `origin` to a sphere of `radius` centred at
@@ -124,7 +128,11 @@ pub fn ray_sphere(origin: Vec3, dir: Vec3, radius: f64) -> Option<(f64, f64)> {
 /// x = east, y = north, z = up, azimuth clockwise from north (towards east).
 pub fn direction_from_zenith_azimuth(zenith_rad: f64, azimuth_rad: f64) -> Vec3 {
     let s = zenith_rad.sin();
-    [s * azimuth_rad.sin(), s * azimuth_rad.cos(), zenith_rad.cos()]
+    [
+        s * azimuth_rad.sin(),
+        s * azimuth_rad.cos(),
+        zenith_rad.cos(),
+    ]
 }
 
 #[cfg(test)]

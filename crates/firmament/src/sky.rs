@@ -25,7 +25,11 @@ impl Sky {
     pub fn new(model: Model, tables: Tables) -> Result<Sky> {
         tables.check_matches(&model, "(in memory)")?;
         let groups = Groups::new(&model);
-        Ok(Sky { model, tables, groups })
+        Ok(Sky {
+            model,
+            tables,
+            groups,
+        })
     }
 
     /// Number of wavelengths.
@@ -35,7 +39,11 @@ impl Sky {
 
     /// Table lookups.
     pub fn lookup(&self) -> Lookup<'_> {
-        Lookup::new(&self.model, self.tables.config.sizes, &self.tables.transmittance)
+        Lookup::new(
+            &self.model,
+            self.tables.config.sizes,
+            &self.tables.transmittance,
+        )
     }
 
     /// Molecular phase function value.
@@ -52,8 +60,19 @@ impl Sky {
 
     /// Rayleigh+multiple and single Mie scattering at (r, μ, μ_s, ν), without phase functions
     /// (Bruneton 2017 `GetCombinedScattering`; the ratio rule for red-only Mie).
-    fn combined_scattering(&self, lk: &Lookup, r: f64, mu: f64, mu_s: f64, nu: f64, ground: bool, scat: &mut [f64], mie: &mut [f64]) {
-        let uvwz = crate::lut::params::scattering_uvwz(&lk.radii, &lk.sizes, r, mu, mu_s, nu, ground);
+    fn combined_scattering(
+        &self,
+        lk: &Lookup,
+        r: f64,
+        mu: f64,
+        mu_s: f64,
+        nu: f64,
+        ground: bool,
+        scat: &mut [f64],
+        mie: &mut [f64],
+    ) {
+        let uvwz =
+            crate::lut::params::scattering_uvwz(&lk.radii, &lk.sizes, r, mu, mu_s, nu, ground);
         self.tables.scattering.sample_into(uvwz, scat);
         match self.tables.config.mie {
             MieStorage::Separate => self.tables.single_mie.sample_into(uvwz, mie),
@@ -62,7 +81,11 @@ impl Sky {
                 self.tables.single_mie.sample_into(uvwz, &mut red);
                 let n = scat.len();
                 for k in 0..n {
-                    mie[k] = if scat[0] > 0.0 { scat[k] * red[0] / scat[0] * self.tables.mie_ratio[k] } else { 0.0 };
+                    mie[k] = if scat[0] > 0.0 {
+                        scat[k] * red[0] / scat[0] * self.tables.mie_ratio[k]
+                    } else {
+                        0.0
+                    };
                 }
             }
         }
@@ -85,7 +108,11 @@ impl Sky {
         if d <= 0.0 {
             return None;
         }
-        let c = [camera[0] + view[0] * d, camera[1] + view[1] * d, camera[2] + view[2] * d];
+        let c = [
+            camera[0] + view[0] * d,
+            camera[1] + view[1] * d,
+            camera[2] + view[2] * d,
+        ];
         Some((c, top, rmu + d))
     }
 
@@ -93,7 +120,15 @@ impl Sky {
     /// boundary or the ground (ground radiance itself excluded), and the transmittance along
     /// the ray (0 where it hits the ground). `shadow_length_m` ignores in-scattering over the
     /// first metres of the ray (light shafts, paper eq. 17–18).
-    pub fn sky_radiance(&self, camera: Vec3, view: Vec3, shadow_length_m: f64, sun: Vec3, radiance: &mut [f64], transmittance: &mut [f64]) {
+    pub fn sky_radiance(
+        &self,
+        camera: Vec3,
+        view: Vec3,
+        shadow_length_m: f64,
+        sun: Vec3,
+        radiance: &mut [f64],
+        transmittance: &mut [f64],
+    ) {
         let n = self.channels();
         let Some((camera, r, rmu)) = self.enter_atmosphere(camera, view) else {
             radiance[..n].iter_mut().for_each(|v| *v = 0.0);
@@ -117,7 +152,13 @@ impl Sky {
             self.combined_scattering(&lk, r, mu, mu_s, nu, ground, scat, mie);
         } else {
             let d = shadow_length_m;
-            let (r_p, mu_p) = crate::geometry::advance(r, mu, d, self.model.bottom_radius_m, self.model.top_radius_m);
+            let (r_p, mu_p) = crate::geometry::advance(
+                r,
+                mu,
+                d,
+                self.model.bottom_radius_m,
+                self.model.top_radius_m,
+            );
             let mu_s_p = ((r * mu_s + d * nu) / r_p).clamp(-1.0, 1.0);
             self.combined_scattering(&lk, r_p, mu_p, mu_s_p, nu, ground, scat, mie);
             let mut t = [0.0f64; 64];
@@ -135,9 +176,21 @@ impl Sky {
 
     /// In-scattered radiance between `camera` and `point` (aerial perspective) and the
     /// transmittance between them (paper eq. 16's S|x − T(x,x_s)·S|x_s).
-    pub fn sky_radiance_to_point(&self, camera: Vec3, point: Vec3, shadow_length_m: f64, sun: Vec3, radiance: &mut [f64], transmittance: &mut [f64]) {
+    pub fn sky_radiance_to_point(
+        &self,
+        camera: Vec3,
+        point: Vec3,
+        shadow_length_m: f64,
+        sun: Vec3,
+        radiance: &mut [f64],
+        transmittance: &mut [f64],
+    ) {
         let n = self.channels();
-        let dir = crate::geometry::normalize([point[0] - camera[0], point[1] - camera[1], point[2] - camera[2]]);
+        let dir = crate::geometry::normalize([
+            point[0] - camera[0],
+            point[1] - camera[1],
+            point[2] - camera[2],
+        ]);
         let Some((camera, r, rmu)) = self.enter_atmosphere(camera, dir) else {
             radiance[..n].iter_mut().for_each(|v| *v = 0.0);
             transmittance[..n].iter_mut().for_each(|v| *v = 1.0);
@@ -148,12 +201,21 @@ impl Sky {
         let mu = (rmu / r).clamp(-1.0, 1.0);
         let mu_s = (dot(camera, sun) / r).clamp(-1.0, 1.0);
         let nu = dot(dir, sun).clamp(-1.0, 1.0);
-        let d_total = length([point[0] - camera[0], point[1] - camera[1], point[2] - camera[2]]);
+        let d_total = length([
+            point[0] - camera[0],
+            point[1] - camera[1],
+            point[2] - camera[2],
+        ]);
         let ground = ray_intersects_ground(r, mu, bottom);
         lk.transmittance(r, mu, d_total, ground, transmittance);
         let mut buf = [[0.0f64; 64]; 4];
         let [scat, mie, scat_p, mie_p] = &mut buf;
-        let (scat, mie, scat_p, mie_p) = (&mut scat[..n], &mut mie[..n], &mut scat_p[..n], &mut mie_p[..n]);
+        let (scat, mie, scat_p, mie_p) = (
+            &mut scat[..n],
+            &mut mie[..n],
+            &mut scat_p[..n],
+            &mut mie_p[..n],
+        );
         self.combined_scattering(&lk, r, mu, mu_s, nu, ground, scat, mie);
         let d = (d_total - shadow_length_m.max(0.0)).max(0.0);
         let (r_p, mu_p) = crate::geometry::advance(r, mu, d, bottom, top);
@@ -207,7 +269,14 @@ impl Sky {
     /// Sun and sky irradiance (W·m⁻²·nm⁻¹) on a surface at `point` with unit `normal`
     /// (Bruneton 2017 `GetSunAndSkyIrradiance`; the sky term with the (1 + n·n̄)/2
     /// occlusion factor of paper eq. 16).
-    pub fn sun_and_sky_irradiance(&self, point: Vec3, normal: Vec3, sun: Vec3, sun_out: &mut [f64], sky_out: &mut [f64]) {
+    pub fn sun_and_sky_irradiance(
+        &self,
+        point: Vec3,
+        normal: Vec3,
+        sun: Vec3,
+        sun_out: &mut [f64],
+        sky_out: &mut [f64],
+    ) {
         let n = self.channels();
         let lk = self.lookup();
         let r = length(point).clamp(self.model.bottom_radius_m, self.model.top_radius_m);
@@ -227,7 +296,12 @@ impl Sky {
     pub fn solar_radiance_centre(&self, out: &mut [f64]) {
         for (k, o) in out.iter_mut().enumerate().take(self.channels()) {
             let l = self.model.wavelengths.nm()[k];
-            *o = self.model.solar_irradiance[k] / disk_solid_angle_weighted(self.model.sun_angular_radius_rad, self.model.limb_darkening, l);
+            *o = self.model.solar_irradiance[k]
+                / disk_solid_angle_weighted(
+                    self.model.sun_angular_radius_rad,
+                    self.model.limb_darkening,
+                    l,
+                );
         }
     }
 }

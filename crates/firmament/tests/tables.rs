@@ -34,25 +34,55 @@ phase = {phase}
 }
 
 fn small(orders: usize) -> TableConfig {
-    TableConfig { sizes: TableSizes::small(), orders, mie: MieStorage::Separate }
+    TableConfig {
+        sizes: TableSizes::small(),
+        orders,
+        mie: MieStorage::Separate,
+    }
 }
 
 /// Coarse tables for tests that only need the structure of the result.
 fn tiny(orders: usize) -> TableConfig {
-    TableConfig { sizes: TableSizes { scattering_r: 8, scattering_mu: 32, scattering_mu_s: 16, ..TableSizes::small() }, orders, mie: MieStorage::Separate }
+    TableConfig {
+        sizes: TableSizes {
+            scattering_r: 8,
+            scattering_mu: 32,
+            scattering_mu_s: 16,
+            ..TableSizes::small()
+        },
+        orders,
+        mie: MieStorage::Separate,
+    }
 }
 
 #[test]
 fn homogeneous_transmittance_is_exp_of_beta_times_distance() {
     let beta = 2e-5;
-    let model = toy("[{ constant_term = 1.0 }]", beta, 0.0, r#"{ type = "isotropic" }"#).resolve(&Wavelengths::rgb()).unwrap();
+    let model = toy(
+        "[{ constant_term = 1.0 }]",
+        beta,
+        0.0,
+        r#"{ type = "isotropic" }"#,
+    )
+    .resolve(&Wavelengths::rgb())
+    .unwrap();
     let s = TableSizes::default();
     let t = lut::precompute::compute_transmittance(&model, &s);
-    let radii = params::Radii { bottom: RG, top: RT, mu_s_min: model.mu_s_min };
+    let radii = params::Radii {
+        bottom: RG,
+        top: RT,
+        mu_s_min: model.mu_s_min,
+    };
     let mut worst: f64 = 0.0;
     for y in 0..s.transmittance_r {
         for x in 0..s.transmittance_mu {
-            let (r, mu) = params::transmittance_r_mu(&radii, (x as f64 + 0.5) / 256.0, (y as f64 + 0.5) / 64.0, 256, 64);
+            let (r, mu) = params::transmittance_r_mu(
+                &radii,
+                (x as f64 + 0.5) / 256.0,
+                (y as f64 + 0.5) / 64.0,
+                256,
+                64,
+            );
             let exact = (-beta * distance_to_top_atmosphere_boundary(r, mu, RT)).exp();
             worst = worst.max((t.texel(x, y)[1] as f64 - exact).abs() / exact);
         }
@@ -61,12 +91,19 @@ fn homogeneous_transmittance_is_exp_of_beta_times_distance() {
     // Between texels, bilinear filtering stays close too.
     let lookup = lut::Lookup::new(&model, s, &t);
     let mut out = [0.0; 3];
-    for &(r, mu) in &[(RG + 1234.0, 0.4321), (RG + 30_000.0, 0.02), (RG + 100.0, 0.05)] {
+    for &(r, mu) in &[
+        (RG + 1234.0, 0.4321),
+        (RG + 30_000.0, 0.02),
+        (RG + 100.0, 0.05),
+    ] {
         lookup.transmittance_to_top(r, mu, &mut out);
         let exact = (-beta * distance_to_top_atmosphere_boundary(r, mu, RT)).exp();
         // Compare optical depths: T spans many decades.
         let (tau, tau_exact) = (-out[0].ln(), -exact.ln());
-        assert!((tau - tau_exact).abs() < 1e-3 * tau_exact, "({r}, {mu}): τ {tau} vs {tau_exact}");
+        assert!(
+            (tau - tau_exact).abs() < 1e-3 * tau_exact,
+            "({r}, {mu}): τ {tau} vs {tau_exact}"
+        );
     }
 }
 
@@ -74,20 +111,33 @@ fn homogeneous_transmittance_is_exp_of_beta_times_distance() {
 fn exponential_vertical_optical_depth_matches_closed_form() {
     // Vertical optical depth from altitude h: H·β·(e^{−h/H} − e^{−Δ/H}).
     let (beta, h_scale) = (1.2e-5, 8000.0);
-    let model = toy(r#"[{ exp_term = 1.0, scale_height_m = 8000.0 }]"#, beta, 0.0, r#"{ type = "rayleigh" }"#)
-        .resolve(&Wavelengths::rgb())
-        .unwrap();
+    let model = toy(
+        r#"[{ exp_term = 1.0, scale_height_m = 8000.0 }]"#,
+        beta,
+        0.0,
+        r#"{ type = "rayleigh" }"#,
+    )
+    .resolve(&Wavelengths::rgb())
+    .unwrap();
     let s = TableSizes::default();
     let t = lut::precompute::compute_transmittance(&model, &s);
-    let radii = params::Radii { bottom: RG, top: RT, mu_s_min: model.mu_s_min };
+    let radii = params::Radii {
+        bottom: RG,
+        top: RT,
+        mu_s_min: model.mu_s_min,
+    };
     for y in 0..s.transmittance_r {
         // Texel column x = 0 is exactly μ = 1.
-        let (r, mu) = params::transmittance_r_mu(&radii, 0.5 / 256.0, (y as f64 + 0.5) / 64.0, 256, 64);
+        let (r, mu) =
+            params::transmittance_r_mu(&radii, 0.5 / 256.0, (y as f64 + 0.5) / 64.0, 256, 64);
         assert!((mu - 1.0).abs() < 1e-12);
         let h = r - RG;
         let tau = h_scale * beta * ((-h / h_scale).exp() - (-(RT - RG) / h_scale).exp());
         let got = -(t.texel(0, y)[0] as f64).ln();
-        assert!((got - tau).abs() < 1e-6 + 1e-5 * tau, "h = {h}: {got} vs {tau}");
+        assert!(
+            (got - tau).abs() < 1e-6 + 1e-5 * tau,
+            "h = {h}: {got} vs {tau}"
+        );
     }
     // The model's analytic vertical depth agrees too.
     let d = model.optical_depths_vertical(1000.0);
@@ -104,12 +154,29 @@ fn sun_path(r: f64, mu_s: f64) -> f64 {
 fn single_scattering_matches_direct_quadrature_in_a_thin_homogeneous_atmosphere() {
     let (beta_s, beta_a) = (1e-6, 2e-7);
     let beta_e = beta_s + beta_a;
-    let model = toy("[{ constant_term = 1.0 }]", beta_s, beta_a, r#"{ type = "isotropic" }"#).resolve(&Wavelengths::rgb()).unwrap();
+    let model = toy(
+        "[{ constant_term = 1.0 }]",
+        beta_s,
+        beta_a,
+        r#"{ type = "isotropic" }"#,
+    )
+    .resolve(&Wavelengths::rgb())
+    .unwrap();
     let tables = Tables::compute(&model, &small(1)).unwrap();
     let s = tables.config.sizes;
-    let radii = params::Radii { bottom: RG, top: RT, mu_s_min: model.mu_s_min };
+    let radii = params::Radii {
+        bottom: RG,
+        top: RT,
+        mu_s_min: model.mu_s_min,
+    };
     let mut checked = 0;
-    for &(x, y, z) in &[(5 * 16 + 12, 50, 3), (7 * 16 + 14, 40, 8), (3 * 16 + 10, 60, 1), (6 * 16 + 15, 20, 5), (2 * 16 + 13, 33, 12)] {
+    for &(x, y, z) in &[
+        (5 * 16 + 12, 50, 3),
+        (7 * 16 + 14, 40, 8),
+        (3 * 16 + 10, 60, 1),
+        (6 * 16 + 15, 20, 5),
+        (2 * 16 + 13, 33, 12),
+    ] {
         let (r, mu, mu_s, nu, ground) = params::scattering_texel(&radii, &s, x, y, z);
         if mu_s < 0.2 {
             continue;
@@ -134,7 +201,10 @@ fn single_scattering_matches_direct_quadrature_in_a_thin_homogeneous_atmosphere(
         }
         let exact = sum * h / 3.0 * model.solar_irradiance[0];
         let got = tables.scattering.data[tables.scattering.index(x, y, z)] as f64;
-        assert!((got - exact).abs() / exact < 0.01, "texel ({x},{y},{z}) mu {mu} mu_s {mu_s}: {got} vs {exact}");
+        assert!(
+            (got - exact).abs() / exact < 0.01,
+            "texel ({x},{y},{z}) mu {mu} mu_s {mu_s}: {got} vs {exact}"
+        );
         checked += 1;
     }
     assert!(checked >= 3);
@@ -143,7 +213,11 @@ fn single_scattering_matches_direct_quadrature_in_a_thin_homogeneous_atmosphere(
 #[test]
 fn ozone_column_in_dobson_units_is_recovered_from_the_profile() {
     let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
-    let ozone = model.constituents.iter().find(|c| c.name == "ozone").unwrap();
+    let ozone = model
+        .constituents
+        .iter()
+        .find(|c| c.name == "ozone")
+        .unwrap();
     // Number density at density 1 = absorption / σ; integrate the profile with an
     // independent trapezoid at 1 m steps.
     let k = 1; // 550 nm
@@ -163,9 +237,19 @@ fn ozone_column_in_dobson_units_is_recovered_from_the_profile() {
 fn earth_rayleigh_optical_depth_matches_bodhaine_1999_table_3() {
     // Bodhaine, Wood, Dutton & Slusser 1999, J. Atmos. Oceanic Technol. 16, Table 3:
     // sea level, 1013.25 hPa, 45° latitude, 360 ppm CO2.
-    let published = [(400.0, 0.36022), (450.0, 0.22111), (500.0, 0.14336), (550.0, 0.09707), (600.0, 0.06809), (650.0, 0.04919), (700.0, 0.03642)];
+    let published = [
+        (400.0, 0.36022),
+        (450.0, 0.22111),
+        (500.0, 0.14336),
+        (550.0, 0.09707),
+        (600.0, 0.06809),
+        (650.0, 0.04919),
+        (700.0, 0.03642),
+    ];
     let nm: Vec<f64> = published.iter().map(|p| p.0).collect();
-    let model = Atmosphere::earth().resolve(&Wavelengths::from_list(&nm).unwrap()).unwrap();
+    let model = Atmosphere::earth()
+        .resolve(&Wavelengths::from_list(&nm).unwrap())
+        .unwrap();
     let tau = model.optical_depths_vertical(0.0).rayleigh;
     for (i, (l, t)) in published.iter().enumerate() {
         assert!((tau[i] - t).abs() / t < 0.01, "{l} nm: {} vs {t}", tau[i]);
@@ -181,9 +265,18 @@ fn scattering_orders_decrease_and_converge() {
     for k in 0..3 {
         let total: f64 = m.iter().map(|o| o[k]).sum();
         for o in 1..m.len() {
-            assert!(m[o][k] < 0.7 * m[o - 1][k], "channel {k}: order {} not below order {}", o + 1, o);
+            assert!(
+                m[o][k] < 0.7 * m[o - 1][k],
+                "channel {k}: order {} not below order {}",
+                o + 1,
+                o
+            );
         }
-        assert!(m[5][k] / total < 0.01, "channel {k}: order 6 is {} of the sum", m[5][k] / total);
+        assert!(
+            m[5][k] / total < 0.01,
+            "channel {k}: order 6 is {} of the sum",
+            m[5][k] / total
+        );
     }
     // More orders add light: the summed table grows.
     let three = Tables::compute(&model, &tiny(3)).unwrap();
@@ -194,20 +287,44 @@ fn scattering_orders_decrease_and_converge() {
 #[test]
 fn every_preset_precomputes_finite_non_negative_tables() {
     for name in firmament::atmosphere::presets::NAMES {
-        let model = Atmosphere::preset(name).unwrap().resolve(&Wavelengths::rgb()).unwrap();
+        let model = Atmosphere::preset(name)
+            .unwrap()
+            .resolve(&Wavelengths::rgb())
+            .unwrap();
         let t = Tables::compute(&model, &tiny(2)).unwrap();
-        for table in [&t.scattering.data, &t.single_mie.data, &t.irradiance.data, &t.transmittance.data] {
-            assert!(table.iter().all(|v| v.is_finite() && *v >= 0.0), "{name}: bad values");
+        for table in [
+            &t.scattering.data,
+            &t.single_mie.data,
+            &t.irradiance.data,
+            &t.transmittance.data,
+        ] {
+            assert!(
+                table.iter().all(|v| v.is_finite() && *v >= 0.0),
+                "{name}: bad values"
+            );
         }
-        assert!(t.scattering.data.iter().any(|&v| v > 0.0), "{name}: empty scattering");
+        assert!(
+            t.scattering.data.iter().any(|&v| v > 0.0),
+            "{name}: empty scattering"
+        );
     }
 }
 
 #[test]
 fn red_only_mie_follows_the_ratio_rule() {
-    let model = Atmosphere::preset("bruneton2008").unwrap().resolve(&Wavelengths::rgb()).unwrap();
+    let model = Atmosphere::preset("bruneton2008")
+        .unwrap()
+        .resolve(&Wavelengths::rgb())
+        .unwrap();
     let full = Tables::compute(&model, &small(1)).unwrap();
-    let red = Tables::compute(&model, &TableConfig { mie: MieStorage::RedOnly, ..small(1) }).unwrap();
+    let red = Tables::compute(
+        &model,
+        &TableConfig {
+            mie: MieStorage::RedOnly,
+            ..small(1)
+        },
+    )
+    .unwrap();
     assert_eq!(red.single_mie.channels, 1);
     let sky_full = firmament::sky::Sky::new(model.clone(), full).unwrap();
     let sky_red = firmament::sky::Sky::new(model, red).unwrap();
@@ -219,14 +336,29 @@ fn red_only_mie_follows_the_ratio_rule() {
     sky_red.sky_radiance(cam, view, 0.0, sun, &mut b, &mut t);
     for k in 0..3 {
         // The rule is an approximation (paper §4): a few per cent.
-        assert!((a[k] - b[k]).abs() / a[k] < 0.05, "channel {k}: {} vs {}", a[k], b[k]);
+        assert!(
+            (a[k] - b[k]).abs() / a[k] < 0.05,
+            "channel {k}: {} vs {}",
+            a[k],
+            b[k]
+        );
     }
 }
 
 #[test]
 fn table_files_round_trip_and_bad_files_are_refused() {
     let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
-    let cfg = TableConfig { sizes: TableSizes { scattering_mu: 16, scattering_r: 4, scattering_mu_s: 8, scattering_nu: 4, ..TableSizes::small() }, orders: 2, mie: MieStorage::Separate };
+    let cfg = TableConfig {
+        sizes: TableSizes {
+            scattering_mu: 16,
+            scattering_r: 4,
+            scattering_mu_s: 8,
+            scattering_nu: 4,
+            ..TableSizes::small()
+        },
+        orders: 2,
+        mie: MieStorage::Separate,
+    };
     let t = Tables::compute(&model, &cfg).unwrap();
     let bytes = lut::file::to_bytes(&t);
     let back = lut::file::from_bytes(&bytes, "x").unwrap();
@@ -234,18 +366,41 @@ fn table_files_round_trip_and_bad_files_are_refused() {
     assert_eq!(back.transmittance, t.transmittance);
     back.check_matches(&model, "x").unwrap();
     // Truncated.
-    let err = lut::file::from_bytes(&bytes[..bytes.len() - 100], "x").unwrap_err().to_string();
+    let err = lut::file::from_bytes(&bytes[..bytes.len() - 100], "x")
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("truncated or corrupt"), "{err}");
     // Corrupt.
     let mut bad = bytes.clone();
     bad[bytes.len() / 2] ^= 0xff;
-    assert!(lut::file::from_bytes(&bad, "x").unwrap_err().to_string().contains("checksum"));
+    assert!(lut::file::from_bytes(&bad, "x")
+        .unwrap_err()
+        .to_string()
+        .contains("checksum"));
     // Not a table file.
-    assert!(lut::file::from_bytes(b"hello world, this is not a table file", "x").unwrap_err().to_string().contains("magic"));
+    assert!(
+        lut::file::from_bytes(b"hello world, this is not a table file", "x")
+            .unwrap_err()
+            .to_string()
+            .contains("magic")
+    );
     // Another atmosphere.
-    let other = Atmosphere::preset("hazy").unwrap().resolve(&Wavelengths::rgb()).unwrap();
-    assert!(back.check_matches(&other, "x").unwrap_err().to_string().contains("another atmosphere"));
+    let other = Atmosphere::preset("hazy")
+        .unwrap()
+        .resolve(&Wavelengths::rgb())
+        .unwrap();
+    assert!(back
+        .check_matches(&other, "x")
+        .unwrap_err()
+        .to_string()
+        .contains("another atmosphere"));
     // Other wavelengths.
-    let spectral = Atmosphere::earth().resolve(&Wavelengths::spectral()).unwrap();
-    assert!(back.check_matches(&spectral, "x").unwrap_err().to_string().contains("wavelengths"));
+    let spectral = Atmosphere::earth()
+        .resolve(&Wavelengths::spectral())
+        .unwrap();
+    assert!(back
+        .check_matches(&spectral, "x")
+        .unwrap_err()
+        .to_string()
+        .contains("wavelengths"));
 }

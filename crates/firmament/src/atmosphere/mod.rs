@@ -102,7 +102,8 @@ impl Atmosphere {
     /// Parse and validate a TOML document. `base_dir` resolves relative file paths
     /// (tabulated phase functions).
     pub fn from_toml_str(text: &str, base_dir: Option<&Path>) -> Result<Self> {
-        let mut atmosphere: Atmosphere = toml::from_str(text).map_err(|e| Error::Toml(format!("atmosphere TOML: {e}")))?;
+        let mut atmosphere: Atmosphere =
+            toml::from_str(text).map_err(|e| Error::Toml(format!("atmosphere TOML: {e}")))?;
         atmosphere.prepare(base_dir.unwrap_or(Path::new(".")))?;
         atmosphere.validate()?;
         Ok(atmosphere)
@@ -110,8 +111,10 @@ impl Atmosphere {
 
     /// Read, parse and validate a TOML file.
     pub fn from_file(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Error::File { path: path.display().to_string(), reason: e.to_string() })?;
+        let text = std::fs::read_to_string(path).map_err(|e| Error::File {
+            path: path.display().to_string(),
+            reason: e.to_string(),
+        })?;
         Self::from_toml_str(&text, path.parent()).map_err(|e| match e {
             Error::Toml(m) => Error::Toml(format!("{}: {m}", path.display())),
             other => other,
@@ -163,34 +166,58 @@ impl Atmosphere {
         }
         match &self.ground_albedo {
             Albedo::Grey(a) => check_unit("ground_albedo", *a)?,
-            Albedo::Table { wavelengths_nm, values } => {
+            Albedo::Table {
+                wavelengths_nm,
+                values,
+            } => {
                 check_table("ground_albedo", wavelengths_nm, values)?;
                 for (i, v) in values.iter().enumerate() {
                     check_unit(&format!("ground_albedo.values[{i}]"), *v)?;
                 }
             }
         }
-        if !(self.min_sun_elevation_deg.is_finite() && (-90.0..=0.0).contains(&self.min_sun_elevation_deg)) {
-            return Err(Error::invalid("min_sun_elevation_deg", self.min_sun_elevation_deg, "a number in [-90, 0] degrees"));
+        if !(self.min_sun_elevation_deg.is_finite()
+            && (-90.0..=0.0).contains(&self.min_sun_elevation_deg))
+        {
+            return Err(Error::invalid(
+                "min_sun_elevation_deg",
+                self.min_sun_elevation_deg,
+                "a number in [-90, 0] degrees",
+            ));
         }
         let r = self.sun.angular_radius_deg;
         if !(r.is_finite() && r > 0.0 && r < 10.0) {
-            return Err(Error::invalid("sun.angular_radius_deg", r, "a number in (0, 10) degrees"));
+            return Err(Error::invalid(
+                "sun.angular_radius_deg",
+                r,
+                "a number in (0, 10) degrees",
+            ));
         }
         match &self.sun.spectrum {
             SolarSpectrum::AstmG173 => {}
-            SolarSpectrum::Table { wavelengths_nm, values } => {
+            SolarSpectrum::Table {
+                wavelengths_nm,
+                values,
+            } => {
                 check_table("sun.spectrum", wavelengths_nm, values)?;
                 for (i, v) in values.iter().enumerate() {
                     if !(v.is_finite() && *v >= 0.0) {
-                        return Err(Error::invalid(format!("sun.spectrum.values[{i}]"), v, "a finite irradiance ≥ 0 W/m²/nm"));
+                        return Err(Error::invalid(
+                            format!("sun.spectrum.values[{i}]"),
+                            v,
+                            "a finite irradiance ≥ 0 W/m²/nm",
+                        ));
                     }
                 }
             }
             SolarSpectrum::ZenithIlluminance { lux } => finite_positive("sun.spectrum.lux", *lux)?,
         }
         if self.constituents.is_empty() {
-            return Err(Error::invalid("constituents", "[]", "at least one constituent"));
+            return Err(Error::invalid(
+                "constituents",
+                "[]",
+                "at least one constituent",
+            ));
         }
         for (i, c) in self.constituents.iter().enumerate() {
             c.validate(&format!("constituents[{i}]"))?;
@@ -220,7 +247,11 @@ fn check_unit(field: &str, v: f64) -> Result<()> {
 
 fn check_table(field: &str, wavelengths_nm: &[f64], values: &[f64]) -> Result<()> {
     if wavelengths_nm.is_empty() {
-        return Err(Error::invalid(format!("{field}.wavelengths_nm"), "[]", "at least one wavelength"));
+        return Err(Error::invalid(
+            format!("{field}.wavelengths_nm"),
+            "[]",
+            "at least one wavelength",
+        ));
     }
     if wavelengths_nm.len() != values.len() {
         return Err(Error::invalid(
@@ -231,7 +262,11 @@ fn check_table(field: &str, wavelengths_nm: &[f64], values: &[f64]) -> Result<()
     }
     for (i, w) in wavelengths_nm.iter().enumerate() {
         if !(w.is_finite() && *w > 0.0) || (i > 0 && *w <= wavelengths_nm[i - 1]) {
-            return Err(Error::invalid(format!("{field}.wavelengths_nm[{i}]"), w, "positive wavelengths in increasing order"));
+            return Err(Error::invalid(
+                format!("{field}.wavelengths_nm[{i}]"),
+                w,
+                "positive wavelengths in increasing order",
+            ));
         }
     }
     Ok(())

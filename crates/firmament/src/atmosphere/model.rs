@@ -57,7 +57,11 @@ impl Model {
                 let column = c.density.column_m(0.0, height);
                 let scattering = c.scattering.resolve(nm, column);
                 let absorption = c.absorption.resolve(nm, column);
-                let extinction = scattering.iter().zip(&absorption).map(|(s, a)| s + a).collect();
+                let extinction = scattering
+                    .iter()
+                    .zip(&absorption)
+                    .map(|(s, a)| s + a)
+                    .collect();
                 ResolvedConstituent {
                     name: c.name.clone(),
                     kind: c.kind,
@@ -73,7 +77,10 @@ impl Model {
             .iter()
             .map(|&l| match &atmosphere.ground_albedo {
                 Albedo::Grey(a) => *a,
-                Albedo::Table { wavelengths_nm, values } => interpolate_linear(wavelengths_nm, values, l),
+                Albedo::Table {
+                    wavelengths_nm,
+                    values,
+                } => interpolate_linear(wavelengths_nm, values, l),
             })
             .collect();
         let mut model = Model {
@@ -90,15 +97,29 @@ impl Model {
             hash: 0,
         };
         model.solar_irradiance = match &atmosphere.sun.spectrum {
-            SolarSpectrum::AstmG173 => nm.iter().map(|&l| spectrum::solar_irradiance_band_mean(l, 10.0)).collect(),
-            SolarSpectrum::Table { wavelengths_nm, values } => {
-                nm.iter().map(|&l| interpolate_linear(wavelengths_nm, values, l)).collect()
-            }
+            SolarSpectrum::AstmG173 => nm
+                .iter()
+                .map(|&l| spectrum::solar_irradiance_band_mean(l, 10.0))
+                .collect(),
+            SolarSpectrum::Table {
+                wavelengths_nm,
+                values,
+            } => nm
+                .iter()
+                .map(|&l| interpolate_linear(wavelengths_nm, values, l))
+                .collect(),
             SolarSpectrum::ZenithIlluminance { lux } => {
                 // Scale the standard shape so that E_toa·T_zenith integrates to `lux`.
-                let shape: Vec<f64> = nm.iter().map(|&l| spectrum::solar_irradiance_band_mean(l, 10.0)).collect();
+                let shape: Vec<f64> = nm
+                    .iter()
+                    .map(|&l| spectrum::solar_irradiance_band_mean(l, 10.0))
+                    .collect();
                 let t = model.optical_depths_vertical(0.0).total;
-                let ground: Vec<f64> = shape.iter().zip(&t).map(|(e, tau)| e * (-tau).exp()).collect();
+                let ground: Vec<f64> = shape
+                    .iter()
+                    .zip(&t)
+                    .map(|(e, tau)| e * (-tau).exp())
+                    .collect();
                 let y = spectrum::spectrum_to_xyz(nm, &ground)[1];
                 let scale = if y > 0.0 { lux / y } else { 0.0 };
                 shape.iter().map(|e| e * scale).collect()
@@ -158,13 +179,30 @@ impl Model {
     /// `mu` over `length_m` metres, into `out` (one entry per constituent). Composite
     /// 4-point Gauss–Legendre with `segments` sub-intervals (Bruneton 2017 uses 500
     /// trapezoids; 128 Gauss segments are more accurate for the same cost).
-    pub fn columns_along_ray(&self, r: f64, mu: f64, length_m: f64, segments: usize, out: &mut [f64]) {
+    pub fn columns_along_ray(
+        &self,
+        r: f64,
+        mu: f64,
+        length_m: f64,
+        segments: usize,
+        out: &mut [f64],
+    ) {
         out.iter_mut().for_each(|o| *o = 0.0);
         if length_m <= 0.0 {
             return;
         }
-        const X: [f64; 4] = [-0.861_136_311_594_052_6, -0.339_981_043_584_856_3, 0.339_981_043_584_856_3, 0.861_136_311_594_052_6];
-        const W: [f64; 4] = [0.347_854_845_137_453_9, 0.652_145_154_862_546_1, 0.652_145_154_862_546_1, 0.347_854_845_137_453_9];
+        const X: [f64; 4] = [
+            -0.861_136_311_594_052_6,
+            -0.339_981_043_584_856_3,
+            0.339_981_043_584_856_3,
+            0.861_136_311_594_052_6,
+        ];
+        const W: [f64; 4] = [
+            0.347_854_845_137_453_9,
+            0.652_145_154_862_546_1,
+            0.652_145_154_862_546_1,
+            0.347_854_845_137_453_9,
+        ];
         let h = length_m / segments as f64;
         for i in 0..segments {
             let c = (i as f64 + 0.5) * h;
@@ -206,7 +244,12 @@ impl Model {
     /// (exact columns of the layered profiles).
     pub fn optical_depths_vertical(&self, altitude_m: f64) -> OpticalDepths {
         let n = self.channels();
-        let mut d = OpticalDepths { rayleigh: vec![0.0; n], mie: vec![0.0; n], ozone: vec![0.0; n], total: vec![0.0; n] };
+        let mut d = OpticalDepths {
+            rayleigh: vec![0.0; n],
+            mie: vec![0.0; n],
+            ozone: vec![0.0; n],
+            total: vec![0.0; n],
+        };
         let top = self.height_m();
         for c in &self.constituents {
             let column = c.density.column_m(altitude_m.clamp(0.0, top), top);

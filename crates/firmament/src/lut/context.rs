@@ -5,7 +5,7 @@
 use super::params::{self, Radii, TableSizes};
 use super::table::{Table2, Table4};
 use crate::atmosphere::Model;
-use crate::geometry::{safe_sqrt, distance_to_top_atmosphere_boundary};
+use crate::geometry::{distance_to_top_atmosphere_boundary, safe_sqrt};
 
 /// What a lookup needs: the model's radii, the sizes and the transmittance table.
 pub struct Lookup<'a> {
@@ -23,7 +23,11 @@ impl<'a> Lookup<'a> {
     /// Lookup context for a model.
     pub fn new(model: &Model, sizes: TableSizes, transmittance: &'a Table2) -> Self {
         Lookup {
-            radii: Radii { bottom: model.bottom_radius_m, top: model.top_radius_m, mu_s_min: model.mu_s_min },
+            radii: Radii {
+                bottom: model.bottom_radius_m,
+                top: model.top_radius_m,
+                mu_s_min: model.mu_s_min,
+            },
             sizes,
             transmittance,
             sun_angular_radius: model.sun_angular_radius_rad,
@@ -33,7 +37,13 @@ impl<'a> Lookup<'a> {
     /// T(r, μ) to the top of the atmosphere (ray assumed not to hit the ground).
     #[inline]
     pub fn transmittance_to_top(&self, r: f64, mu: f64, out: &mut [f64]) {
-        let (u, v) = params::transmittance_uv(&self.radii, r, mu, self.sizes.transmittance_mu, self.sizes.transmittance_r);
+        let (u, v) = params::transmittance_uv(
+            &self.radii,
+            r,
+            mu,
+            self.sizes.transmittance_mu,
+            self.sizes.transmittance_r,
+        );
         self.transmittance.sample_into(u, v, out);
     }
 
@@ -47,7 +57,11 @@ impl<'a> Lookup<'a> {
         let n = out.len();
         let mut a = [0.0f64; 64];
         let mut b = [0.0f64; 64];
-        let (a, b) = if n <= 64 { (&mut a[..n], &mut b[..n]) } else { unreachable!("at most 64 wavelengths") };
+        let (a, b) = if n <= 64 {
+            (&mut a[..n], &mut b[..n])
+        } else {
+            unreachable!("at most 64 wavelengths")
+        };
         if ground {
             self.transmittance_to_top(r_d, -mu_d, a);
             self.transmittance_to_top(r, -mu, b);
@@ -56,7 +70,11 @@ impl<'a> Lookup<'a> {
             self.transmittance_to_top(r_d, mu_d, b);
         }
         for k in 0..n {
-            out[k] = if b[k] > 0.0 { (a[k] / b[k]).min(1.0) } else { 0.0 };
+            out[k] = if b[k] > 0.0 {
+                (a[k] / b[k]).min(1.0)
+            } else {
+                0.0
+            };
         }
     }
 
@@ -86,13 +104,28 @@ impl<'a> Lookup<'a> {
     /// Irradiance-table lookup at (r, μ_s).
     #[inline]
     pub fn irradiance(&self, table: &Table2, r: f64, mu_s: f64, out: &mut [f64]) {
-        let (u, v) = params::irradiance_uv(&self.radii, r, mu_s, self.sizes.irradiance_mu_s, self.sizes.irradiance_r);
+        let (u, v) = params::irradiance_uv(
+            &self.radii,
+            r,
+            mu_s,
+            self.sizes.irradiance_mu_s,
+            self.sizes.irradiance_r,
+        );
         table.sample_into(u, v, out);
     }
 
     /// Scattering-table lookup at (r, μ, μ_s, ν).
     #[inline]
-    pub fn scattering(&self, table: &Table4, r: f64, mu: f64, mu_s: f64, nu: f64, ground: bool, out: &mut [f64]) {
+    pub fn scattering(
+        &self,
+        table: &Table4,
+        r: f64,
+        mu: f64,
+        mu_s: f64,
+        nu: f64,
+        ground: bool,
+        out: &mut [f64],
+    ) {
         let uvwz = params::scattering_uvwz(&self.radii, &self.sizes, r, mu, mu_s, nu, ground);
         table.sample_into(uvwz, out);
     }

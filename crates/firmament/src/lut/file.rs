@@ -46,13 +46,21 @@ pub fn to_bytes(t: &Tables) -> Vec<u8> {
         mie_ratio: t.mie_ratio.clone(),
     };
     let json = serde_json::to_vec(&header).expect("header serialises");
-    let floats = t.transmittance.data.len() + t.irradiance.data.len() + t.scattering.data.len() + t.single_mie.data.len();
+    let floats = t.transmittance.data.len()
+        + t.irradiance.data.len()
+        + t.scattering.data.len()
+        + t.single_mie.data.len();
     let mut out = Vec::with_capacity(16 + json.len() + floats * 4 + 8);
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&VERSION.to_le_bytes());
     out.extend_from_slice(&(json.len() as u32).to_le_bytes());
     out.extend_from_slice(&json);
-    for data in [&t.transmittance.data, &t.irradiance.data, &t.scattering.data, &t.single_mie.data] {
+    for data in [
+        &t.transmittance.data,
+        &t.irradiance.data,
+        &t.scattering.data,
+        &t.single_mie.data,
+    ] {
         for v in data.iter() {
             out.extend_from_slice(&v.to_le_bytes());
         }
@@ -64,26 +72,38 @@ pub fn to_bytes(t: &Tables) -> Vec<u8> {
 
 /// Parse tables from bytes; `path` names the file in messages.
 pub fn from_bytes(bytes: &[u8], path: &str) -> Result<Tables> {
-    let bad = |reason: String| Error::TableFile { path: path.to_string(), reason };
+    let bad = |reason: String| Error::TableFile {
+        path: path.to_string(),
+        reason,
+    };
     if bytes.len() < 16 + 8 || &bytes[..8] != MAGIC {
-        return Err(bad("not a firmament table file (bad magic number or too short)".into()));
+        return Err(bad(
+            "not a firmament table file (bad magic number or too short)".into(),
+        ));
     }
     let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
     if version != VERSION {
-        return Err(bad(format!("format version {version}, this program reads version {VERSION}; bake the tables again")));
+        return Err(bad(format!(
+            "format version {version}, this program reads version {VERSION}; bake the tables again"
+        )));
     }
     let (body, tail) = bytes.split_at(bytes.len() - 8);
     let stored = u64::from_le_bytes(tail.try_into().unwrap());
     if fnv1a(body) != stored {
-        return Err(bad("checksum mismatch: the file is truncated or corrupt".into()));
+        return Err(bad(
+            "checksum mismatch: the file is truncated or corrupt".into()
+        ));
     }
     let hlen = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
     if 16 + hlen > body.len() {
         return Err(bad("header length beyond the end of the file".into()));
     }
-    let header: Header =
-        serde_json::from_slice(&body[16..16 + hlen]).map_err(|e| bad(format!("unreadable header: {e}")))?;
-    header.config.validate().map_err(|e| bad(format!("invalid sizes in header: {e}")))?;
+    let header: Header = serde_json::from_slice(&body[16..16 + hlen])
+        .map_err(|e| bad(format!("unreadable header: {e}")))?;
+    header
+        .config
+        .validate()
+        .map_err(|e| bad(format!("invalid sizes in header: {e}")))?;
     let n = header.channels;
     if n == 0 || n != header.wavelengths_nm.len() {
         return Err(bad("channel count does not match the wavelengths".into()));
@@ -110,17 +130,43 @@ pub fn from_bytes(bytes: &[u8], path: &str) -> Result<Tables> {
     }
     let mut offset = 0;
     let mut take = |count: usize| -> Vec<f32> {
-        let v = data[offset..offset + count * 4].chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+        let v = data[offset..offset + count * 4]
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+            .collect();
         offset += count * 4;
         v
     };
-    let transmittance = Table2 { width: s.transmittance_mu, height: s.transmittance_r, channels: n, data: take(counts[0]) };
-    let irradiance = Table2 { width: s.irradiance_mu_s, height: s.irradiance_r, channels: n, data: take(counts[1]) };
-    let mut scattering = Table4::new(s.scattering_r, s.scattering_mu, s.scattering_mu_s, s.scattering_nu, n);
+    let transmittance = Table2 {
+        width: s.transmittance_mu,
+        height: s.transmittance_r,
+        channels: n,
+        data: take(counts[0]),
+    };
+    let irradiance = Table2 {
+        width: s.irradiance_mu_s,
+        height: s.irradiance_r,
+        channels: n,
+        data: take(counts[1]),
+    };
+    let mut scattering = Table4::new(
+        s.scattering_r,
+        s.scattering_mu,
+        s.scattering_mu_s,
+        s.scattering_nu,
+        n,
+    );
     scattering.data = take(counts[2]);
-    let mut single_mie = Table4::new(s.scattering_r, s.scattering_mu, s.scattering_mu_s, s.scattering_nu, mie_channels);
+    let mut single_mie = Table4::new(
+        s.scattering_r,
+        s.scattering_mu,
+        s.scattering_mu_s,
+        s.scattering_nu,
+        mie_channels,
+    );
     single_mie.data = take(counts[3]);
-    let hash = u64::from_str_radix(&header.atmosphere_hash, 16).map_err(|_| bad("bad atmosphere hash".into()))?;
+    let hash = u64::from_str_radix(&header.atmosphere_hash, 16)
+        .map_err(|_| bad("bad atmosphere hash".into()))?;
     Ok(Tables {
         config: header.config,
         wavelengths_nm: header.wavelengths_nm,
@@ -137,10 +183,22 @@ pub fn from_bytes(bytes: &[u8], path: &str) -> Result<Tables> {
 /// Write tables atomically (temporary file, then rename).
 pub fn write(t: &Tables, path: &Path) -> Result<()> {
     let bytes = to_bytes(t);
-    let file_err = |e: std::io::Error| Error::File { path: path.display().to_string(), reason: e.to_string() };
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = path.file_name().ok_or_else(|| Error::invalid("out", path.display(), "a file path"))?;
-    let tmp = dir.join(format!(".{}.tmp-{}", name.to_string_lossy(), std::process::id()));
+    let file_err = |e: std::io::Error| Error::File {
+        path: path.display().to_string(),
+        reason: e.to_string(),
+    };
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .ok_or_else(|| Error::invalid("out", path.display(), "a file path"))?;
+    let tmp = dir.join(format!(
+        ".{}.tmp-{}",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(&bytes)?;
@@ -156,6 +214,9 @@ pub fn write(t: &Tables, path: &Path) -> Result<()> {
 
 /// Read tables from a file (format checks only; see [`Tables::check_matches`]).
 pub fn read(path: &Path) -> Result<Tables> {
-    let bytes = std::fs::read(path).map_err(|e| Error::File { path: path.display().to_string(), reason: e.to_string() })?;
+    let bytes = std::fs::read(path).map_err(|e| Error::File {
+        path: path.display().to_string(),
+        reason: e.to_string(),
+    })?;
     from_bytes(&bytes, &path.display().to_string())
 }

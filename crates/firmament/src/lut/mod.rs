@@ -43,7 +43,11 @@ pub struct TableConfig {
 
 impl Default for TableConfig {
     fn default() -> Self {
-        TableConfig { sizes: TableSizes::default(), orders: 4, mie: MieStorage::Separate }
+        TableConfig {
+            sizes: TableSizes::default(),
+            orders: 4,
+            mie: MieStorage::Separate,
+        }
     }
 }
 
@@ -52,7 +56,11 @@ impl TableConfig {
     pub fn validate(&self) -> Result<()> {
         self.sizes.validate()?;
         if !(1..=50).contains(&self.orders) {
-            return Err(Error::invalid("orders", self.orders, "an integer in [1, 50]"));
+            return Err(Error::invalid(
+                "orders",
+                self.orders,
+                "an integer in [1, 50]",
+            ));
         }
         Ok(())
     }
@@ -94,7 +102,11 @@ impl Tables {
         if self.wavelengths_nm != model.wavelengths.nm() {
             return Err(Error::TableFile {
                 path: path.to_string(),
-                reason: format!("computed for wavelengths {:?} nm, but {:?} nm are asked for", self.wavelengths_nm, model.wavelengths.nm()),
+                reason: format!(
+                    "computed for wavelengths {:?} nm, but {:?} nm are asked for",
+                    self.wavelengths_nm,
+                    model.wavelengths.nm()
+                ),
             });
         }
         if self.atmosphere_hash != model.hash {

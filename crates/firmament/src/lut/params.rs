@@ -71,15 +71,28 @@ impl TableSizes {
         ];
         for (name, v) in dims {
             if !(2..=4096).contains(&v) {
-                return Err(crate::Error::invalid(format!("tables.{name}"), v, "an integer in [2, 4096]"));
+                return Err(crate::Error::invalid(
+                    format!("tables.{name}"),
+                    v,
+                    "an integer in [2, 4096]",
+                ));
             }
         }
         if self.scattering_mu % 2 != 0 || self.scattering_mu < 4 {
-            return Err(crate::Error::invalid("tables.scattering_mu", self.scattering_mu, "an even integer ≥ 4 (two halves split at the horizon)"));
+            return Err(crate::Error::invalid(
+                "tables.scattering_mu",
+                self.scattering_mu,
+                "an even integer ≥ 4 (two halves split at the horizon)",
+            ));
         }
-        let texels = self.scattering_r * self.scattering_mu * self.scattering_mu_s * self.scattering_nu;
+        let texels =
+            self.scattering_r * self.scattering_mu * self.scattering_mu_s * self.scattering_nu;
         if texels > 64 << 20 {
-            return Err(crate::Error::invalid("tables", format!("{texels} scattering texels"), "at most 67108864 texels"));
+            return Err(crate::Error::invalid(
+                "tables",
+                format!("{texels} scattering texels"),
+                "at most 67108864 texels",
+            ));
         }
         Ok(())
     }
@@ -125,7 +138,11 @@ pub fn transmittance_uv(g: &Radii, r: f64, mu: f64, nu_: usize, nr: usize) -> (f
     let d = distance_to_top_atmosphere_boundary(r, mu, g.top);
     let d_min = g.top - r;
     let d_max = rho + h;
-    let x_mu = if d_max > d_min { (d - d_min) / (d_max - d_min) } else { 0.0 };
+    let x_mu = if d_max > d_min {
+        (d - d_min) / (d_max - d_min)
+    } else {
+        0.0
+    };
     let x_r = rho / h;
     (texcoord_from_unit(x_mu, nu_), texcoord_from_unit(x_r, nr))
 }
@@ -141,7 +158,11 @@ pub fn transmittance_r_mu(g: &Radii, u: f64, v: f64, nmu: usize, nr: usize) -> (
     let d_min = g.top - r;
     let d_max = rho + h;
     let d = d_min + x_mu * (d_max - d_min);
-    let mu = if d == 0.0 { 1.0 } else { clamp_cosine((h * h - rho * rho - d * d) / (2.0 * r * d)) };
+    let mu = if d == 0.0 {
+        1.0
+    } else {
+        clamp_cosine((h * h - rho * rho - d * d) / (2.0 * r * d))
+    };
     (r, mu)
 }
 
@@ -150,7 +171,10 @@ pub fn transmittance_r_mu(g: &Radii, u: f64, v: f64, nmu: usize, nr: usize) -> (
 pub fn irradiance_uv(g: &Radii, r: f64, mu_s: f64, nmu_s: usize, nr: usize) -> (f64, f64) {
     let x_r = (r - g.bottom) / (g.top - g.bottom);
     let x_mu_s = mu_s * 0.5 + 0.5;
-    (texcoord_from_unit(x_mu_s, nmu_s), texcoord_from_unit(x_r, nr))
+    (
+        texcoord_from_unit(x_mu_s, nmu_s),
+        texcoord_from_unit(x_r, nr),
+    )
 }
 
 /// Inverse of [`irradiance_uv`].
@@ -158,7 +182,10 @@ pub fn irradiance_uv(g: &Radii, r: f64, mu_s: f64, nmu_s: usize, nr: usize) -> (
 pub fn irradiance_r_mu_s(g: &Radii, u: f64, v: f64, nmu_s: usize, nr: usize) -> (f64, f64) {
     let x_mu_s = unit_from_texcoord(u, nmu_s);
     let x_r = unit_from_texcoord(v, nr);
-    (g.bottom + x_r * (g.top - g.bottom), clamp_cosine(2.0 * x_mu_s - 1.0))
+    (
+        g.bottom + x_r * (g.top - g.bottom),
+        clamp_cosine(2.0 * x_mu_s - 1.0),
+    )
 }
 
 /// The four coordinates (u_ν, u_μs, u_μ, u_r) ∈ [0,1]⁴ of the scattering table.
@@ -183,14 +210,22 @@ pub fn scattering_uvwz(
         let d = -r_mu - safe_sqrt(discriminant);
         let d_min = r - g.bottom;
         let d_max = rho;
-        let x = if d_max == d_min { 0.0 } else { ((d - d_min) / (d_max - d_min)).clamp(0.0, 1.0) };
+        let x = if d_max == d_min {
+            0.0
+        } else {
+            ((d - d_min) / (d_max - d_min)).clamp(0.0, 1.0)
+        };
         0.5 - 0.5 * texcoord_from_unit(x, half)
     } else {
         // Distance to the top, mapped to the upper half [0.5, 1].
         let d = -r_mu + safe_sqrt(discriminant + h * h);
         let d_min = g.top - r;
         let d_max = rho + h;
-        let x = if d_max > d_min { ((d - d_min) / (d_max - d_min)).clamp(0.0, 1.0) } else { 0.0 };
+        let x = if d_max > d_min {
+            ((d - d_min) / (d_max - d_min)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
         0.5 + 0.5 * texcoord_from_unit(x, half)
     };
     let u_mu_s = texcoord_from_unit(x_mu_s(g, mu_s), s.scattering_mu_s);
@@ -214,7 +249,13 @@ impl MuSMap {
         let d_min = g.top - g.bottom;
         let d_max = g.h();
         let big_d = distance_to_top_atmosphere_boundary(g.bottom, g.mu_s_min, g.top);
-        MuSMap { top: g.top, bottom: g.bottom, d_min, inv_range: 1.0 / (d_max - d_min), big_a: (big_d - d_min) / (d_max - d_min) }
+        MuSMap {
+            top: g.top,
+            bottom: g.bottom,
+            d_min,
+            inv_range: 1.0 / (d_max - d_min),
+            big_a: (big_d - d_min) / (d_max - d_min),
+        }
     }
 
     /// Same as [`x_mu_s`].
@@ -259,7 +300,11 @@ pub fn mu_s_from_x(g: &Radii, x: f64) -> f64 {
 
 /// Inverse of [`scattering_uvwz`]: (r, μ, μ_s, ν, ray hits ground).
 #[inline]
-pub fn scattering_r_mu_mu_s_nu(g: &Radii, s: &TableSizes, uvwz: [f64; 4]) -> (f64, f64, f64, f64, bool) {
+pub fn scattering_r_mu_mu_s_nu(
+    g: &Radii,
+    s: &TableSizes,
+    uvwz: [f64; 4],
+) -> (f64, f64, f64, f64, bool) {
     let [u_nu, u_mu_s, u_mu, u_r] = uvwz;
     let h = g.h();
     let rho = h * unit_from_texcoord(u_r, s.scattering_r);
@@ -269,13 +314,21 @@ pub fn scattering_r_mu_mu_s_nu(g: &Radii, s: &TableSizes, uvwz: [f64; 4]) -> (f6
         let d_min = r - g.bottom;
         let d_max = rho;
         let d = d_min + (d_max - d_min) * unit_from_texcoord(1.0 - 2.0 * u_mu, half);
-        let mu = if d == 0.0 { -1.0 } else { clamp_cosine(-(rho * rho + d * d) / (2.0 * r * d)) };
+        let mu = if d == 0.0 {
+            -1.0
+        } else {
+            clamp_cosine(-(rho * rho + d * d) / (2.0 * r * d))
+        };
         (mu, true)
     } else {
         let d_min = g.top - r;
         let d_max = rho + h;
         let d = d_min + (d_max - d_min) * unit_from_texcoord(2.0 * u_mu - 1.0, half);
-        let mu = if d == 0.0 { 1.0 } else { clamp_cosine((h * h - rho * rho - d * d) / (2.0 * r * d)) };
+        let mu = if d == 0.0 {
+            1.0
+        } else {
+            clamp_cosine((h * h - rho * rho - d * d) / (2.0 * r * d))
+        };
         (mu, false)
     };
     let mu_s = mu_s_from_x(g, unit_from_texcoord(u_mu_s, s.scattering_mu_s));
@@ -286,7 +339,13 @@ pub fn scattering_r_mu_mu_s_nu(g: &Radii, s: &TableSizes, uvwz: [f64; 4]) -> (f6
 /// (r, μ, μ_s, ν, ground) at the centre of scattering texel (x = ν·N_μs + μ_s, y = μ,
 /// z = r); ν is clamped to the range allowed by μ and μ_s (Bruneton 2017
 /// `GetRMuMuSNuFromScatteringTextureFragCoord`; the ν grid includes −1 and 1).
-pub fn scattering_texel(g: &Radii, s: &TableSizes, x: usize, y: usize, z: usize) -> (f64, f64, f64, f64, bool) {
+pub fn scattering_texel(
+    g: &Radii,
+    s: &TableSizes,
+    x: usize,
+    y: usize,
+    z: usize,
+) -> (f64, f64, f64, f64, bool) {
     let i_nu = x / s.scattering_mu_s;
     let i_mu_s = x % s.scattering_mu_s;
     let uvwz = [
@@ -305,11 +364,21 @@ pub fn scattering_texel(g: &Radii, s: &TableSizes, x: usize, y: usize, z: usize)
 mod tests {
     use super::*;
 
-    const G: Radii = Radii { bottom: 6_360_000.0, top: 6_420_000.0, mu_s_min: -0.2079116908177593 };
+    const G: Radii = Radii {
+        bottom: 6_360_000.0,
+        top: 6_420_000.0,
+        mu_s_min: -0.2079116908177593,
+    };
 
     #[test]
     fn transmittance_mapping_round_trips() {
-        for &(r, mu) in &[(6_360_000.0, 0.0), (6_365_000.0, 0.3), (6_400_000.0, -0.1), (6_419_000.0, 0.99), (6_370_000.0, -0.05)] {
+        for &(r, mu) in &[
+            (6_360_000.0, 0.0),
+            (6_365_000.0, 0.3),
+            (6_400_000.0, -0.1),
+            (6_419_000.0, 0.99),
+            (6_370_000.0, -0.05),
+        ] {
             let (u, v) = transmittance_uv(&G, r, mu, 256, 64);
             let (r2, mu2) = transmittance_r_mu(&G, u, v, 256, 64);
             assert!((r2 - r).abs() / r < 1e-9, "r {r} {r2}");

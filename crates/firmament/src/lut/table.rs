@@ -29,7 +29,12 @@ pub struct Table2 {
 impl Table2 {
     /// Zero-filled table.
     pub fn new(width: usize, height: usize, channels: usize) -> Self {
-        Table2 { width, height, channels, data: vec![0.0; width * height * channels] }
+        Table2 {
+            width,
+            height,
+            channels,
+            data: vec![0.0; width * height * channels],
+        }
     }
 
     /// The texel (x, y).
@@ -47,10 +52,23 @@ impl Table2 {
         let c = self.channels;
         let w = self.width;
         let d = &self.data;
-        let (i00, i10, i01, i11) = ((y0 * w + x0) * c, (y0 * w + x1) * c, (y1 * w + x0) * c, (y1 * w + x1) * c);
-        let (w00, w10, w01, w11) = ((1.0 - tx) * (1.0 - ty), tx * (1.0 - ty), (1.0 - tx) * ty, tx * ty);
+        let (i00, i10, i01, i11) = (
+            (y0 * w + x0) * c,
+            (y0 * w + x1) * c,
+            (y1 * w + x0) * c,
+            (y1 * w + x1) * c,
+        );
+        let (w00, w10, w01, w11) = (
+            (1.0 - tx) * (1.0 - ty),
+            tx * (1.0 - ty),
+            (1.0 - tx) * ty,
+            tx * ty,
+        );
         for k in 0..c {
-            out[k] = w00 * d[i00 + k] as f64 + w10 * d[i10 + k] as f64 + w01 * d[i01 + k] as f64 + w11 * d[i11 + k] as f64;
+            out[k] = w00 * d[i00 + k] as f64
+                + w10 * d[i10 + k] as f64
+                + w01 * d[i01 + k] as f64
+                + w11 * d[i11 + k] as f64;
         }
     }
 
@@ -82,7 +100,14 @@ pub struct Table4 {
 impl Table4 {
     /// Zero-filled table.
     pub fn new(nr: usize, nmu: usize, nmu_s: usize, nnu: usize, channels: usize) -> Self {
-        Table4 { nr, nmu, nmu_s, nnu, channels, data: vec![0.0; nr * nmu * nmu_s * nnu * channels] }
+        Table4 {
+            nr,
+            nmu,
+            nmu_s,
+            nnu,
+            channels,
+            data: vec![0.0; nr * nmu * nmu_s * nnu * channels],
+        }
     }
 
     /// Width of the packed x axis.
@@ -115,7 +140,16 @@ impl Table4 {
     /// As [`Table4::sample_into`] with the (μ, r) filter weights already known (rays whose
     /// samples share them).
     #[inline]
-    pub fn sample_rows_into(&self, u_nu: f64, u_mu_s: f64, y: [usize; 2], ty: f64, z: [usize; 2], tz: f64, out: &mut [f64]) {
+    pub fn sample_rows_into(
+        &self,
+        u_nu: f64,
+        u_mu_s: f64,
+        y: [usize; 2],
+        ty: f64,
+        z: [usize; 2],
+        tz: f64,
+        out: &mut [f64],
+    ) {
         let tex_x = u_nu * (self.nnu - 1) as f64;
         let nu0 = (tex_x.max(0.0) as usize).min(self.nnu - 1);
         let nu1 = (nu0 + 1).min(self.nnu - 1);

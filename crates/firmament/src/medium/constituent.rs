@@ -85,15 +85,26 @@ impl Coefficient {
             if v.is_finite() && v >= 0.0 {
                 Ok(())
             } else {
-                Err(Error::invalid(format!("{field}.{name}"), v, "a finite number ≥ 0"))
+                Err(Error::invalid(
+                    format!("{field}.{name}"),
+                    v,
+                    "a finite number ≥ 0",
+                ))
             }
         };
         match self {
             Coefficient::None => Ok(()),
             Coefficient::Constant { value_per_m } => nonneg("value_per_m", *value_per_m),
-            Coefficient::Table { wavelengths_nm, values_per_m } => {
+            Coefficient::Table {
+                wavelengths_nm,
+                values_per_m,
+            } => {
                 if wavelengths_nm.is_empty() {
-                    return Err(Error::invalid(format!("{field}.wavelengths_nm"), "[]", "at least one wavelength"));
+                    return Err(Error::invalid(
+                        format!("{field}.wavelengths_nm"),
+                        "[]",
+                        "at least one wavelength",
+                    ));
                 }
                 if wavelengths_nm.len() != values_per_m.len() {
                     return Err(Error::invalid(
@@ -104,7 +115,11 @@ impl Coefficient {
                 }
                 for (i, w) in wavelengths_nm.iter().enumerate() {
                     if !(w.is_finite() && *w > 0.0) || (i > 0 && *w <= wavelengths_nm[i - 1]) {
-                        return Err(Error::invalid(format!("{field}.wavelengths_nm[{i}]"), w, "positive wavelengths in increasing order"));
+                        return Err(Error::invalid(
+                            format!("{field}.wavelengths_nm[{i}]"),
+                            w,
+                            "positive wavelengths in increasing order",
+                        ));
                     }
                 }
                 for (i, v) in values_per_m.iter().enumerate() {
@@ -112,25 +127,49 @@ impl Coefficient {
                 }
                 Ok(())
             }
-            Coefficient::PowerLaw { reference_nm, value_per_m, exponent } => {
+            Coefficient::PowerLaw {
+                reference_nm,
+                value_per_m,
+                exponent,
+            } => {
                 if !(reference_nm.is_finite() && *reference_nm > 0.0) {
-                    return Err(Error::invalid(format!("{field}.reference_nm"), reference_nm, "a wavelength > 0 nm"));
+                    return Err(Error::invalid(
+                        format!("{field}.reference_nm"),
+                        reference_nm,
+                        "a wavelength > 0 nm",
+                    ));
                 }
                 nonneg("value_per_m", *value_per_m)?;
                 if !exponent.is_finite() {
-                    return Err(Error::invalid(format!("{field}.exponent"), exponent, "a finite number"));
+                    return Err(Error::invalid(
+                        format!("{field}.exponent"),
+                        exponent,
+                        "a finite number",
+                    ));
                 }
                 Ok(())
             }
             Coefficient::RayleighCrossSection { column_m2 } => nonneg("column_m2", *column_m2),
             Coefficient::OzoneColumn { column_du } => nonneg("column_du", *column_du),
-            Coefficient::Angstrom { alpha, beta, fraction } => {
+            Coefficient::Angstrom {
+                alpha,
+                beta,
+                fraction,
+            } => {
                 if !alpha.is_finite() {
-                    return Err(Error::invalid(format!("{field}.alpha"), alpha, "a finite number"));
+                    return Err(Error::invalid(
+                        format!("{field}.alpha"),
+                        alpha,
+                        "a finite number",
+                    ));
                 }
                 nonneg("beta", *beta)?;
                 if !(0.0..=1.0).contains(fraction) {
-                    return Err(Error::invalid(format!("{field}.fraction"), fraction, "a number in [0, 1]"));
+                    return Err(Error::invalid(
+                        format!("{field}.fraction"),
+                        fraction,
+                        "a number in [0, 1]",
+                    ));
                 }
                 Ok(())
             }
@@ -146,11 +185,26 @@ impl Coefficient {
             .map(|&l| match self {
                 Coefficient::None => 0.0,
                 Coefficient::Constant { value_per_m } => *value_per_m,
-                Coefficient::Table { wavelengths_nm, values_per_m } => interpolate_power_law(wavelengths_nm, values_per_m, l),
-                Coefficient::PowerLaw { reference_nm, value_per_m, exponent } => value_per_m * (l / reference_nm).powf(-exponent),
-                Coefficient::RayleighCrossSection { column_m2 } => per_column(spectrum::rayleigh_cross_section_m2(l) * column_m2),
-                Coefficient::OzoneColumn { column_du } => per_column(spectrum::ozone_cross_section_m2(l) * column_du * DOBSON_UNIT_M2),
-                Coefficient::Angstrom { alpha, beta, fraction } => per_column(fraction * beta * (l / 1000.0).powf(-alpha)),
+                Coefficient::Table {
+                    wavelengths_nm,
+                    values_per_m,
+                } => interpolate_power_law(wavelengths_nm, values_per_m, l),
+                Coefficient::PowerLaw {
+                    reference_nm,
+                    value_per_m,
+                    exponent,
+                } => value_per_m * (l / reference_nm).powf(-exponent),
+                Coefficient::RayleighCrossSection { column_m2 } => {
+                    per_column(spectrum::rayleigh_cross_section_m2(l) * column_m2)
+                }
+                Coefficient::OzoneColumn { column_du } => {
+                    per_column(spectrum::ozone_cross_section_m2(l) * column_du * DOBSON_UNIT_M2)
+                }
+                Coefficient::Angstrom {
+                    alpha,
+                    beta,
+                    fraction,
+                } => per_column(fraction * beta * (l / 1000.0).powf(-alpha)),
             })
             .collect()
     }
@@ -205,7 +259,11 @@ impl Constituent {
         self.absorption.validate(&format!("{field}.absorption"))?;
         self.phase.validate(&format!("{field}.phase"))?;
         if self.kind == ConstituentKind::Absorber && self.scattering != Coefficient::None {
-            return Err(Error::invalid(format!("{field}.scattering"), "a scattering coefficient", "type = \"none\" for an absorber"));
+            return Err(Error::invalid(
+                format!("{field}.scattering"),
+                "a scattering coefficient",
+                "type = \"none\" for an absorber",
+            ));
         }
         Ok(())
     }

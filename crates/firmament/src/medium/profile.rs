@@ -37,22 +37,44 @@ fn infinite() -> f64 {
 impl DensityLayer {
     /// An exponential layer e^{−h/H}, infinitely thick.
     pub fn exponential(scale_height_m: f64) -> Self {
-        DensityLayer { width_m: 0.0, exp_term: 1.0, scale_height_m, linear_term_per_m: 0.0, constant_term: 0.0 }
+        DensityLayer {
+            width_m: 0.0,
+            exp_term: 1.0,
+            scale_height_m,
+            linear_term_per_m: 0.0,
+            constant_term: 0.0,
+        }
     }
 
     /// A uniform layer of density `c`.
     pub fn constant(width_m: f64, c: f64) -> Self {
-        DensityLayer { width_m, exp_term: 0.0, scale_height_m: f64::INFINITY, linear_term_per_m: 0.0, constant_term: c }
+        DensityLayer {
+            width_m,
+            exp_term: 0.0,
+            scale_height_m: f64::INFINITY,
+            linear_term_per_m: 0.0,
+            constant_term: c,
+        }
     }
 
     /// A linear layer `a·h + c`.
     pub fn linear(width_m: f64, a: f64, c: f64) -> Self {
-        DensityLayer { width_m, exp_term: 0.0, scale_height_m: f64::INFINITY, linear_term_per_m: a, constant_term: c }
+        DensityLayer {
+            width_m,
+            exp_term: 0.0,
+            scale_height_m: f64::INFINITY,
+            linear_term_per_m: a,
+            constant_term: c,
+        }
     }
 
     #[inline]
     fn density(&self, altitude_m: f64) -> f64 {
-        let e = if self.exp_term != 0.0 { self.exp_term * (-altitude_m / self.scale_height_m).exp() } else { 0.0 };
+        let e = if self.exp_term != 0.0 {
+            self.exp_term * (-altitude_m / self.scale_height_m).exp()
+        } else {
+            0.0
+        };
         (e + self.linear_term_per_m * altitude_m + self.constant_term).max(0.0)
     }
 }
@@ -68,12 +90,16 @@ pub struct DensityProfile {
 impl DensityProfile {
     /// One exponential layer.
     pub fn exponential(scale_height_m: f64) -> Self {
-        DensityProfile { layers: vec![DensityLayer::exponential(scale_height_m)] }
+        DensityProfile {
+            layers: vec![DensityLayer::exponential(scale_height_m)],
+        }
     }
 
     /// Uniform density 1 everywhere.
     pub fn uniform() -> Self {
-        DensityProfile { layers: vec![DensityLayer::constant(0.0, 1.0)] }
+        DensityProfile {
+            layers: vec![DensityLayer::constant(0.0, 1.0)],
+        }
     }
 
     /// A tent: 0 below `bottom_m`, rising linearly to 1 at `peak_m`, back to 0 at `top_m`
@@ -131,7 +157,11 @@ impl DensityProfile {
     /// Gauss–Legendre between breakpoints; exact to ~1e-10 for these smooth pieces.
     pub fn column_m(&self, from_m: f64, to_m: f64) -> f64 {
         let mut edges = vec![from_m];
-        edges.extend(self.breakpoints(to_m).into_iter().filter(|&b| b > from_m && b < to_m));
+        edges.extend(
+            self.breakpoints(to_m)
+                .into_iter()
+                .filter(|&b| b > from_m && b < to_m),
+        );
         edges.push(to_m);
         let mut sum = 0.0;
         for w in edges.windows(2) {
@@ -148,12 +178,24 @@ impl DensityProfile {
         for (i, l) in self.layers.iter().enumerate() {
             let f = |name: &str| format!("{field}[{i}].{name}");
             if !(l.width_m.is_finite() && l.width_m >= 0.0) {
-                return Err(Error::invalid(f("width_m"), l.width_m, "a finite width ≥ 0 m"));
+                return Err(Error::invalid(
+                    f("width_m"),
+                    l.width_m,
+                    "a finite width ≥ 0 m",
+                ));
             }
             if !(l.scale_height_m > 0.0) || l.scale_height_m.is_nan() {
-                return Err(Error::invalid(f("scale_height_m"), l.scale_height_m, "a scale height > 0 m (inf for none)"));
+                return Err(Error::invalid(
+                    f("scale_height_m"),
+                    l.scale_height_m,
+                    "a scale height > 0 m (inf for none)",
+                ));
             }
-            for (name, v) in [("exp_term", l.exp_term), ("linear_term_per_m", l.linear_term_per_m), ("constant_term", l.constant_term)] {
+            for (name, v) in [
+                ("exp_term", l.exp_term),
+                ("linear_term_per_m", l.linear_term_per_m),
+                ("constant_term", l.constant_term),
+            ] {
                 if !v.is_finite() {
                     return Err(Error::invalid(f(name), v, "a finite number"));
                 }
@@ -166,8 +208,18 @@ impl DensityProfile {
 /// ∫_a^b f by `n`-point composite Gauss–Legendre (4 nodes per sub-interval).
 pub fn gauss_legendre(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
     // 4-point Gauss–Legendre nodes and weights (Abramowitz & Stegun 25.4.30).
-    const X: [f64; 4] = [-0.861_136_311_594_052_6, -0.339_981_043_584_856_3, 0.339_981_043_584_856_3, 0.861_136_311_594_052_6];
-    const W: [f64; 4] = [0.347_854_845_137_453_9, 0.652_145_154_862_546_1, 0.652_145_154_862_546_1, 0.347_854_845_137_453_9];
+    const X: [f64; 4] = [
+        -0.861_136_311_594_052_6,
+        -0.339_981_043_584_856_3,
+        0.339_981_043_584_856_3,
+        0.861_136_311_594_052_6,
+    ];
+    const W: [f64; 4] = [
+        0.347_854_845_137_453_9,
+        0.652_145_154_862_546_1,
+        0.652_145_154_862_546_1,
+        0.347_854_845_137_453_9,
+    ];
     if b <= a {
         return 0.0;
     }

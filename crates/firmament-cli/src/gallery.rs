@@ -1,0 +1,122 @@
+//! `firmament gallery`: the canonical views (Bruneton & Neyret 2008 figures 8–9 and more)
+//! as PNGs with an index.html contact sheet.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use firmament::render::{camera::orbit_fit_fov_deg, Camera, Projection, Scene};
+
+use crate::render::{atmosphere_args, render_scene, write_outputs};
+
+/// Arguments of `firmament gallery`.
+#[derive(Args, Debug)]
+pub struct GalleryArgs {
+    /// Output directory (created if missing).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Embedded preset.
+    #[arg(long, default_value = "earth")]
+    pub preset: String,
+    /// Precomputed tables (must match the preset, rgb).
+    #[arg(long, value_name = "FILE")]
+    pub tables: Option<PathBuf>,
+    /// Width of the perspective views (height is 9/16 of it).
+    #[arg(long, default_value_t = 960)]
+    pub width: usize,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+struct View {
+    name: &'static str,
+    title: &'static str,
+    camera: Camera,
+    sun: (f64, f64),
+    size: (usize, usize),
+}
+
+fn views(width: usize) -> Vec<View> {
+    let h = width * 9 / 16;
+    let cam = |projection, altitude_m, heading_deg, pitch_deg, fov_deg| Camera {
+        projection,
+        altitude_m,
+        heading_deg,
+        pitch_deg,
+        roll_deg: 0.0,
+        fov_deg,
+    };
+    use Projection::*;
+    vec![
+        View { name: "noon", title: "Noon from the ground, looking north (sun 60° high in the south)", camera: cam(Perspective, 2.0, 0.0, 12.0, 80.0), sun: (30.0, 180.0), size: (width, h) },
+        View { name: "afternoon", title: "Afternoon, facing the sun (30° high)", camera: cam(Perspective, 2.0, 240.0, 12.0, 80.0), sun: (60.0, 240.0), size: (width, h) },
+        View { name: "sunset", title: "Sunset (sun 1° high in the west)", camera: cam(Perspective, 2.0, 270.0, 6.0, 80.0), sun: (89.0, 270.0), size: (width, h) },
+        View { name: "twilight", title: "Twilight, facing east away from the sun 4° below the horizon: Earth's shadow and the Belt of Venus", camera: cam(Perspective, 2.0, 90.0, 8.0, 80.0), sun: (94.0, 270.0), size: (width, h) },
+        View { name: "altitude-10km", title: "From 10 km, looking down the aerial perspective", camera: cam(Perspective, 10_000.0, 200.0, -8.0, 80.0), sun: (50.0, 160.0), size: (width, h) },
+        View { name: "low-orbit", title: "From low orbit (400 km), the limb with the sun low", camera: cam(Perspective, 400_000.0, 90.0, -17.0, 60.0), sun: (75.0, 90.0), size: (width, h) },
+        View { name: "planet", title: "The whole planet from 30 000 km: limb, terminator, night side", camera: cam(Orbit, 30_000_000.0, 0.0, 0.0, orbit_fit_fov_deg(6_424_000.0, 36_360_000.0)), sun: (75.0, 90.0), size: (width * 2 / 3, width * 2 / 3) },
+        View { name: "fisheye", title: "All-sky fisheye (equidistant, north up, east left), sun 45° high in the south-east", camera: cam(Fisheye, 2.0, 0.0, 0.0, 60.0), sun: (45.0, 135.0), size: (width * 2 / 3, width * 2 / 3) },
+        View { name: "equirect", title: "Equirectangular environment map (north at the centre column), sun 20° high in the east-south-east", camera: cam(Equirect, 2.0, 0.0, 0.0, 60.0), sun: (70.0, 120.0), size: (width, width / 2) },
+    ]
+}
+
+/// Run the gallery.
+pub fn run(args: &GalleryArgs) -> Result<()> {
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let mut base = Scene::default();
+    base.atmosphere.preset = args.preset.clone();
+    let t = Instant::now();
+    let sky = atmosphere_args(&base, args.tables.clone(), "default").sky(args.quiet)?;
+    if !args.quiet {
+        eprintln!("tables ready in {:.2} s", t.elapsed().as_secs_f64());
+    }
+    let mut html = String::from(
+        "<!doctype html><meta charset=utf-8><title>firmament gallery</title>\n<style>body{background:#111;color:#ddd;font-family:sans-serif}figure{display:inline-block;margin:8px;vertical-align:top;max-width:480px}img{max-width:480px}figcaption{font-size:13px}</style>\n<h1>firmament gallery</h1>\n",
+    );
+    let _ = writeln!(
+        html,
+        "<p>Preset <code>{}</code>, RGB, default tables, automatic exposure, ACES tone curve.</p>",
+        args.preset
+    );
+    for v in views(args.width) {
+        let mut scene = base.clone();
+        scene.camera = v.camera.clone();
+        scene.sun.zenith_deg = v.sun.0;
+        scene.sun.azimuth_deg = v.sun.1;
+        (scene.image.width, scene.image.height) = v.size;
+        let file = format!("{}.png", v.name);
+        scene.output.files = vec![args.out.join(&file)];
+        scene.validate()?;
+        let t = Instant::now();
+        let (frame, ev100) = render_scene(&sky, &scene, true)?;
+        write_outputs(&frame, &scene, ev100, false, true)?;
+        if !args.quiet {
+            eprintln!(
+                "{:14} {}×{} in {:.2} s",
+                v.name,
+                v.size.0,
+                v.size.1,
+                t.elapsed().as_secs_f64()
+            );
+        }
+        let c = &v.camera;
+        let _ = writeln!(
+            html,
+            "<figure><img src=\"{file}\"><figcaption><b>{}</b><br>{:?}, altitude {} m, heading {}°, pitch {}°, fov {:.1}°; sun zenith {}°, azimuth {}°; EV100 {:.1}<br><code>firmament render --camera {} --altitude-m {} --heading-deg {} --pitch-deg {} --fov-deg {:.1} --sun-zenith-deg {} --sun-azimuth-deg {} --width {} --height {}</code></figcaption></figure>",
+            v.title, c.projection, c.altitude_m, c.heading_deg, c.pitch_deg, c.fov_deg, v.sun.0, v.sun.1, ev100,
+            format!("{:?}", c.projection).to_lowercase(), c.altitude_m, c.heading_deg, c.pitch_deg, c.fov_deg, v.sun.0, v.sun.1, v.size.0, v.size.1
+        );
+    }
+    let index = args.out.join("index.html");
+    let tmp = args.out.join(".index.html.tmp");
+    std::fs::write(&tmp, html)?;
+    std::fs::rename(&tmp, &index)?;
+    if !args.quiet {
+        eprintln!("wrote {}", index.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,306 @@
+//! `firmament render`: pictures of the sky from flags or a scene file.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use firmament::io::{self, ExrPrecision, OutputFormat};
+use firmament::render::{
+    self, tonemap, Projection, RenderSettings, Scene, ShadeOptions, ToneCurve,
+};
+use firmament::sky::Sky;
+
+use crate::common::{cancel_flag, check_output_dir, progress_bar, AtmosphereArgs};
+
+/// Arguments of `firmament render`; flags override the scene file, which overrides the
+/// built-in default scene.
+#[derive(Args, Debug, Default)]
+pub struct RenderArgs {
+    /// Scene file (TOML; see scenes/ for examples).
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
+    /// Camera: perspective, fisheye, equirect, cubemap, orbit.
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// Image width (pixels).
+    #[arg(long)]
+    pub width: Option<usize>,
+    /// Image height (pixels).
+    #[arg(long)]
+    pub height: Option<usize>,
+    /// Camera altitude above the ground (m).
+    #[arg(long, allow_hyphen_values = true)]
+    pub altitude_m: Option<f64>,
+    /// View heading (degrees clockwise from north).
+    #[arg(long, allow_hyphen_values = true)]
+    pub heading_deg: Option<f64>,
+    /// View pitch (degrees above the horizon).
+    #[arg(long, allow_hyphen_values = true)]
+    pub pitch_deg: Option<f64>,
+    /// Camera roll (degrees).
+    #[arg(long, allow_hyphen_values = true)]
+    pub roll_deg: Option<f64>,
+    /// Vertical field of view (degrees).
+    #[arg(long)]
+    pub fov_deg: Option<f64>,
+    /// Sun zenith angle (degrees; > 90 below the horizon).
+    #[arg(long, allow_hyphen_values = true)]
+    pub sun_zenith_deg: Option<f64>,
+    /// Sun azimuth (degrees clockwise from north).
+    #[arg(long, allow_hyphen_values = true)]
+    pub sun_azimuth_deg: Option<f64>,
+    /// Do not draw the solar disk.
+    #[arg(long)]
+    pub no_sun_disk: bool,
+    /// Embedded preset.
+    #[arg(long, conflicts_with = "atmosphere")]
+    pub preset: Option<String>,
+    /// Atmosphere TOML file.
+    #[arg(long, value_name = "FILE")]
+    pub atmosphere: Option<PathBuf>,
+    /// Wavelengths: rgb, spectral or NM,NM,...
+    #[arg(long)]
+    pub wavelengths: Option<String>,
+    /// Precomputed tables from `firmament bake`.
+    #[arg(long, value_name = "FILE")]
+    pub tables: Option<PathBuf>,
+    /// Table sizes when computing: default or small.
+    #[arg(long, default_value = "default")]
+    pub table_size: String,
+    /// Exposure value at ISO 100 (PNG only); automatic when absent.
+    #[arg(long, allow_hyphen_values = true)]
+    pub ev100: Option<f64>,
+    /// Automatic exposure from the log-average luminance (overrides the scene's ev100).
+    #[arg(long)]
+    pub auto_exposure: bool,
+    /// Tone curve for PNG: aces (default), filmic, clamp.
+    #[arg(long)]
+    pub tonemap: Option<String>,
+    /// White-balance to the sun's colour.
+    #[arg(long)]
+    pub white_balance: bool,
+    /// Write OpenEXR as 16-bit half floats instead of 32-bit.
+    #[arg(long)]
+    pub exr_half: bool,
+    /// Output file, repeatable; format from the extension (.png, .exr, .hdr).
+    #[arg(long = "out", value_name = "FILE")]
+    pub outputs: Vec<PathBuf>,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+fn parse_projection(s: &str) -> Result<Projection> {
+    Ok(match s {
+        "perspective" => Projection::Perspective,
+        "fisheye" => Projection::Fisheye,
+        "equirect" => Projection::Equirect,
+        "cubemap" => Projection::Cubemap,
+        "orbit" => Projection::Orbit,
+        _ => anyhow::bail!("invalid value for `--camera`: {s} (accepted: perspective, fisheye, equirect, cubemap, orbit)"),
+    })
+}
+
+/// The scene after applying flags.
+pub fn scene_from_args(args: &RenderArgs) -> Result<Scene> {
+    let mut scene = match &args.scene {
+        Some(path) => Scene::from_file(path)?,
+        None => Scene::default(),
+    };
+    if let Some(c) = &args.camera {
+        scene.camera.projection = parse_projection(c)?;
+        // Sensible shapes for the all-round projections unless sizes are given.
+        if args.scene.is_none() {
+            match scene.camera.projection {
+                Projection::Fisheye => (scene.image.width, scene.image.height) = (1024, 1024),
+                Projection::Equirect => (scene.image.width, scene.image.height) = (2048, 1024),
+                Projection::Cubemap => (scene.image.width, scene.image.height) = (3072, 512),
+                Projection::Orbit => {
+                    (scene.image.width, scene.image.height) = (1024, 1024);
+                    scene.camera.altitude_m = 20_000_000.0;
+                }
+                Projection::Perspective => {}
+            }
+        }
+    }
+    macro_rules! set {
+        ($flag:expr, $field:expr) => {
+            if let Some(v) = $flag {
+                $field = v;
+            }
+        };
+    }
+    set!(args.width, scene.image.width);
+    set!(args.height, scene.image.height);
+    if args.width.is_some()
+        && args.height.is_none()
+        && scene.camera.projection == Projection::Cubemap
+    {
+        scene.image.height = scene.image.width / 6;
+    }
+    set!(args.altitude_m, scene.camera.altitude_m);
+    set!(args.heading_deg, scene.camera.heading_deg);
+    set!(args.pitch_deg, scene.camera.pitch_deg);
+    set!(args.roll_deg, scene.camera.roll_deg);
+    set!(args.fov_deg, scene.camera.fov_deg);
+    if scene.camera.projection == Projection::Orbit
+        && args.fov_deg.is_none()
+        && args.scene.is_none()
+    {
+        scene.camera.fov_deg = render::camera::orbit_fit_fov_deg(
+            6_360_000.0 * 1.01,
+            6_360_000.0 + scene.camera.altitude_m,
+        );
+    }
+    set!(args.sun_zenith_deg, scene.sun.zenith_deg);
+    set!(args.sun_azimuth_deg, scene.sun.azimuth_deg);
+    if args.no_sun_disk {
+        scene.sun.disk = false;
+    }
+    if let Some(p) = &args.preset {
+        scene.atmosphere.preset = p.clone();
+        scene.atmosphere.file = None;
+    }
+    if let Some(f) = &args.atmosphere {
+        scene.atmosphere.file = Some(f.clone());
+    }
+    if let Some(w) = &args.wavelengths {
+        scene.atmosphere.wavelengths = w.clone();
+    }
+    if let Some(ev) = args.ev100 {
+        scene.output.ev100 = Some(ev);
+    }
+    if args.auto_exposure {
+        scene.output.ev100 = None;
+    }
+    if let Some(t) = &args.tonemap {
+        scene.output.tonemap = ToneCurve::parse(t).map_err(|_| {
+            anyhow::anyhow!("invalid value for `--tonemap`: {t} (accepted: aces, filmic, clamp)")
+        })?;
+    }
+    if args.white_balance {
+        scene.output.white_balance = true;
+    }
+    if !args.outputs.is_empty() {
+        scene.output.files = args.outputs.clone();
+    }
+    scene.validate()?;
+    Ok(scene)
+}
+
+/// Atmosphere arguments equivalent to the scene's.
+pub fn atmosphere_args(scene: &Scene, tables: Option<PathBuf>, table_size: &str) -> AtmosphereArgs {
+    AtmosphereArgs {
+        preset: if scene.atmosphere.file.is_none() {
+            Some(scene.atmosphere.preset.clone())
+        } else {
+            None
+        },
+        atmosphere: scene.atmosphere.file.clone(),
+        wavelengths: scene.atmosphere.wavelengths.clone(),
+        tables,
+        orders: 4,
+        table_size: table_size.to_string(),
+        mie: "separate".into(),
+    }
+}
+
+/// Render the scene with a sky; returns the frame and the EV100 used.
+pub fn render_scene(sky: &Sky, scene: &Scene, quiet: bool) -> Result<(render::Frame, f64)> {
+    let settings = RenderSettings {
+        camera: &scene.camera,
+        width: scene.image.width,
+        height: scene.image.height,
+        shade: ShadeOptions {
+            sun: render::sun_direction(scene.sun.zenith_deg, scene.sun.azimuth_deg),
+            sun_disk: scene.sun.disk,
+        },
+        white_balance: scene.output.white_balance,
+    };
+    let bar = progress_bar(1000, quiet);
+    bar.set_message("rendering");
+    let frame = render::render(
+        sky,
+        &settings,
+        &|f| bar.set_position((f * 1000.0) as u64),
+        Some(cancel_flag()),
+    );
+    bar.finish_and_clear();
+    let frame = frame.context("rendering")?;
+    let ev100 = scene
+        .output
+        .ev100
+        .unwrap_or_else(|| tonemap::auto_ev100(frame.log_average_luminance()));
+    Ok((frame, ev100))
+}
+
+/// Write the frame to every output (each atomically).
+pub fn write_outputs(
+    frame: &render::Frame,
+    scene: &Scene,
+    ev100: f64,
+    half: bool,
+    quiet: bool,
+) -> Result<()> {
+    for path in &scene.output.files {
+        let t = Instant::now();
+        match OutputFormat::from_path(path)? {
+            OutputFormat::Png => {
+                let rgb8 =
+                    frame.to_srgb8(tonemap::exposure_from_ev100(ev100), scene.output.tonemap);
+                io::write_png_srgb8(path, frame.image.width, frame.image.height, &rgb8)?;
+            }
+            OutputFormat::Exr => io::write_exr(
+                path,
+                &frame.image,
+                if half {
+                    ExrPrecision::F16
+                } else {
+                    ExrPrecision::F32
+                },
+            )?,
+            OutputFormat::Hdr => io::write_hdr(path, &frame.image)?,
+        }
+        if !quiet {
+            eprintln!(
+                "wrote {} ({:.2} s)",
+                path.display(),
+                t.elapsed().as_secs_f64()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Run `firmament render`.
+pub fn run(args: &RenderArgs) -> Result<()> {
+    let scene = scene_from_args(args)?;
+    for f in &scene.output.files {
+        check_output_dir(f, "--out")?;
+        OutputFormat::from_path(f)?;
+    }
+    let t = Instant::now();
+    let sky = atmosphere_args(&scene, args.tables.clone(), &args.table_size).sky(args.quiet)?;
+    if !args.quiet && args.tables.is_some() {
+        eprintln!("tables: loaded in {:.2} s", t.elapsed().as_secs_f64());
+    }
+    let t = Instant::now();
+    let (frame, ev100) = render_scene(&sky, &scene, args.quiet)?;
+    if !args.quiet {
+        eprintln!(
+            "render: {}×{} {:?} in {:.2} s (EV100 {:.1}{})",
+            scene.image.width,
+            scene.image.height,
+            scene.camera.projection,
+            t.elapsed().as_secs_f64(),
+            ev100,
+            if scene.output.ev100.is_none() {
+                ", automatic"
+            } else {
+                ""
+            }
+        );
+    }
+    write_outputs(&frame, &scene, ev100, args.exr_half, args.quiet)
+}

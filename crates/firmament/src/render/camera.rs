@@ -1,0 +1,223 @@
+//! Cameras. The world is planet-centred (metres). The observer stands above the point of the
+//! planet on the +z axis; its local frame there is x = east, y = north, z = up, and
+//! azimuths/headings are clockwise from north.
+
+use std::f64::consts::PI;
+
+use serde::{Deserialize, Serialize};
+
+use crate::geometry::{add_scaled, cross, normalize, Vec3};
+use crate::{Error, Result};
+
+/// The kind of projection.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Projection {
+    /// Pinhole camera with a vertical field of view.
+    Perspective,
+    /// Equidistant all-sky fisheye: zenith at the centre, horizon on the circle, north up,
+    /// east to the left (as seen looking up, the standard for sky cameras).
+    Fisheye,
+    /// Equirectangular 360×180 map: columns are azimuth clockwise from north, from −180°
+    /// (south) at the left edge through north (0°) at the centre column and east (90°) at
+    /// three quarters of the width; rows are elevation, +90° at the top row.
+    Equirect,
+    /// Six square faces side by side in the order +X (east), −X (west), +Y (north),
+    /// −Y (south), +Z (up), −Z (down); each is a 90° view as seen from the inside, side
+    /// faces with the zenith at the top, the up and down faces with north at the top.
+    Cubemap,
+    /// A perspective camera in space looking at the planet's centre from above the observer
+    /// point; the field of view fits the whole planet unless given.
+    Orbit,
+}
+
+/// Camera parameters.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Camera {
+    /// Projection.
+    pub projection: Projection,
+    /// Altitude above the ground (m).
+    pub altitude_m: f64,
+    /// Heading of the view (degrees clockwise from north).
+    #[serde(default)]
+    pub heading_deg: f64,
+    /// Pitch (degrees above the horizon).
+    #[serde(default)]
+    pub pitch_deg: f64,
+    /// Roll (degrees, clockwise).
+    #[serde(default)]
+    pub roll_deg: f64,
+    /// Vertical field of view (degrees), perspective and orbit.
+    #[serde(default = "default_fov")]
+    pub fov_deg: f64,
+}
+
+fn default_fov() -> f64 {
+    60.0
+}
+
+/// A primary ray.
+#[derive(Clone, Copy, Debug)]
+pub struct Ray {
+    /// Origin (m, planet-centred).
+    pub origin: Vec3,
+    /// Unit direction.
+    pub dir: Vec3,
+}
+
+impl Camera {
+    /// Check the values.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.altitude_m.is_finite() && self.altitude_m >= 0.0) {
+            return Err(Error::invalid(
+                "camera.altitude_m",
+                self.altitude_m,
+                "a finite altitude ≥ 0 m",
+            ));
+        }
+        for (name, v) in [
+            ("camera.heading_deg", self.heading_deg),
+            ("camera.roll_deg", self.roll_deg),
+        ] {
+            if !(v.is_finite() && v.abs() <= 360.0) {
+                return Err(Error::invalid(name, v, "a number in [-360, 360] degrees"));
+            }
+        }
+        if !(self.pitch_deg.is_finite() && self.pitch_deg.abs() <= 90.0) {
+            return Err(Error::invalid(
+                "camera.pitch_deg",
+                self.pitch_deg,
+                "a number in [-90, 90] degrees",
+            ));
+        }
+        if !(self.fov_deg.is_finite() && self.fov_deg > 0.0 && self.fov_deg < 180.0) {
+            return Err(Error::invalid(
+                "camera.fov_deg",
+                self.fov_deg,
+                "a number in (0, 180) degrees",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Rays for pixel centres of a `width`×`height` image (row 0 at the top); None for
+    /// pixels outside the projection (the corners of a fisheye).
+    pub fn ray(
+        &self,
+        bottom_radius_m: f64,
+        width: usize,
+        height: usize,
+        px: f64,
+        py: f64,
+    ) -> Option<Ray> {
+        let origin = [0.0, 0.0, bottom_radius_m + self.altitude_m];
+        // Normalised device coordinates, x right, y up, in [-1, 1].
+        let (u, v) = (
+            2.0 * px / width as f64 - 1.0,
+            1.0 - 2.0 * py / height as f64,
+        );
+        let local = match self.projection {
+            Projection::Perspective => {
+                self.perspective(u, v, width as f64 / height as f64, self.fov_deg)
+            }
+            Projection::Orbit => {
+                // Look straight down (towards the centre), `heading` at the top of the image.
+                let down = Camera {
+                    pitch_deg: -90.0,
+                    ..self.clone()
+                };
+                down.perspective(u, v, width as f64 / height as f64, self.fov_deg)
+            }
+            Projection::Fisheye => {
+                // Square inscribed circle; zenith angle proportional to radius (equidistant).
+                let aspect = width as f64 / height as f64;
+                let (x, y) = if aspect >= 1.0 {
+                    (u * aspect, v)
+                } else {
+                    (u, v / aspect)
+                };
+                let rho = (x * x + y * y).sqrt();
+                if rho > 1.0 {
+                    return None;
+                }
+                let zenith = rho * PI / 2.0;
+                // Looking up with north at the top of the image: east is on the left.
+                let azimuth = (-x).atan2(y);
+                crate::geometry::direction_from_zenith_azimuth(zenith, azimuth)
+            }
+            Projection::Equirect => {
+                // Column: azimuth from −180° (south, left edge) through 0° (north, centre)
+                // to 180°; row: elevation +90° (top) to −90° (bottom).
+                let azimuth = u * PI;
+                let elevation = v * PI / 2.0;
+                crate::geometry::direction_from_zenith_azimuth(PI / 2.0 - elevation, azimuth)
+            }
+            Projection::Cubemap => {
+                let face_w = width as f64 / 6.0;
+                let face = ((px / face_w) as usize).min(5);
+                let fu = 2.0 * (px - face as f64 * face_w) / face_w - 1.0;
+                let fv = 1.0 - 2.0 * py / height as f64;
+                cube_direction(face, fu, fv)
+            }
+        };
+        Some(Ray {
+            origin,
+            dir: normalize(local),
+        })
+    }
+
+    /// A perspective ray in the local frame for NDC (u, v).
+    fn perspective(&self, u: f64, v: f64, aspect: f64, fov_deg: f64) -> Vec3 {
+        let (forward, right, up) = self.basis();
+        let t = (fov_deg.to_radians() / 2.0).tan();
+        let d = add_scaled(add_scaled(forward, u * t * aspect, right), v * t, up);
+        normalize(d)
+    }
+
+    /// (forward, right, up) unit vectors of the view in the local frame.
+    pub fn basis(&self) -> (Vec3, Vec3, Vec3) {
+        let h = self.heading_deg.to_radians();
+        let p = self.pitch_deg.to_radians();
+        let forward = [h.sin() * p.cos(), h.cos() * p.cos(), p.sin()];
+        // Right is horizontal, clockwise from forward; degenerate at ±90° pitch, where the
+        // heading gives the image's up direction instead.
+        let right0 = [h.cos(), -h.sin(), 0.0];
+        let up0 = cross(right0, forward);
+        let r = self.roll_deg.to_radians();
+        let right = add_scaled(
+            [
+                right0[0] * r.cos(),
+                right0[1] * r.cos(),
+                right0[2] * r.cos(),
+            ],
+            -r.sin(),
+            up0,
+        );
+        let up = cross(right, forward);
+        (forward, normalize(right), normalize(up))
+    }
+}
+
+/// Vertical field of view (degrees) that frames a sphere of `radius_m` seen from
+/// `distance_m` from its centre with a 15 % margin (120° when the camera is too close).
+pub fn orbit_fit_fov_deg(radius_m: f64, distance_m: f64) -> f64 {
+    if radius_m >= distance_m * 0.99 {
+        return 120.0;
+    }
+    (2.0 * (radius_m / distance_m).asin().to_degrees() * 1.15).min(120.0)
+}
+
+/// Direction of cube face `face` (+X, −X, +Y, −Y, +Z, −Z) at face coordinates (u right,
+/// v up) in [-1, 1], as seen from the inside (x east, y north, z up): side faces have the
+/// zenith at the top; the +Z and −Z faces have north at the top.
+pub fn cube_direction(face: usize, u: f64, v: f64) -> Vec3 {
+    match face {
+        0 => [1.0, -u, v],  // +X east: right is south (−y)
+        1 => [-1.0, u, v],  // −X west: right is north
+        2 => [u, 1.0, v],   // +Y north: right is east
+        3 => [-u, -1.0, v], // −Y south: right is west
+        4 => [-u, v, 1.0],  // +Z up, north at the top: right is west
+        _ => [u, v, -1.0],  // −Z down, north at the top: right is east
+    }
+}
