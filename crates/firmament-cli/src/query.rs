@@ -6,6 +6,8 @@ use firmament::geometry::direction_from_zenith_azimuth;
 use firmament::spectrum::{spectrum_to_xyz, xyz_to_linear_srgb};
 use serde_json::json;
 
+use firmament::reference::{self, ReferenceSettings};
+
 use crate::common::{check_range, AtmosphereArgs};
 
 /// Arguments of `firmament query`.
@@ -29,9 +31,16 @@ pub struct QueryArgs {
         allow_hyphen_values = true
     )]
     pub views: Vec<String>,
-    /// Method: `lut` (precomputed tables).
-    #[arg(long, default_value = "lut")]
+    /// Method for the views: `lut` (precomputed tables) or `reference` (Monte Carlo path
+    /// tracer; adds `radiance_stderr` and `samples` to each view).
+    #[arg(long, default_value = "lut", value_name = "lut|reference")]
     pub method: String,
+    /// Paths per wavelength and view for `--method reference`.
+    #[arg(long, default_value_t = 10_000)]
+    pub samples: usize,
+    /// Seed of the random streams for `--method reference`.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
 }
 
 fn parse_view(s: &str) -> Result<(f64, f64)> {
@@ -64,12 +73,27 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
         360.0,
         "degrees",
     )?;
-    if args.method != "lut" {
-        anyhow::bail!(
-            "invalid value for `--method`: {} (accepted: lut)",
-            args.method
-        );
-    }
+    let reference = match args.method.as_str() {
+        "lut" => None,
+        "reference" => {
+            let settings = ReferenceSettings {
+                samples: args.samples,
+                seed: args.seed,
+                ..Default::default()
+            };
+            if settings.samples < 2 {
+                anyhow::bail!(
+                    "invalid value for `--samples`: {} (accepted: an integer ≥ 2)",
+                    args.samples
+                );
+            }
+            settings.validate()?;
+            Some(settings)
+        }
+        other => anyhow::bail!(
+            "invalid value for `--method`: {other} (accepted: lut, reference)"
+        ),
+    };
     let views: Vec<(f64, f64)> = args
         .views
         .iter()
@@ -104,12 +128,17 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
     let lux = |v: &[f64]| spectrum_to_xyz(&nm, v)[1];
 
     let mut view_json = Vec::new();
-    for &(z, a) in &views {
+    for (i, &(z, a)) in views.iter().enumerate() {
         let dir = direction_from_zenith_azimuth(z.to_radians(), a.to_radians());
         let (mut radiance, mut t) = (vec![0.0; n], vec![0.0; n]);
         sky.sky_radiance(camera, dir, 0.0, sun, &mut radiance, &mut t);
+        let estimate = reference.as_ref().map(|settings| {
+            let e = reference::sky_radiance_keyed(model, camera, dir, sun, settings, i as u64);
+            radiance.copy_from_slice(&e.radiance);
+            e
+        });
         let xyz = spectrum_to_xyz(&nm, &radiance);
-        view_json.push(json!({
+        let mut entry = json!({
             "zenith_deg": z,
             "azimuth_deg": a,
             "radiance": radiance,
@@ -117,8 +146,25 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
             "xyz": xyz,
             "srgb_linear": xyz_to_linear_srgb(xyz),
             "transmittance": t,
-        }));
+        });
+        if let Some(e) = estimate {
+            let (_, y_err) = e.luminance(&nm);
+            entry["radiance_stderr"] = json!(e.stderr);
+            entry["luminance_cd_m2_stderr"] = json!(y_err);
+            entry["samples"] = json!(e.samples);
+        }
+        view_json.push(entry);
     }
+    let notes = match &reference {
+        None => json!([]),
+        Some(s) => json!([
+            format!(
+                "views: spectral Monte Carlo reference path tracer, {} paths per wavelength and view, seed {} (view i uses stream key i); sky only: the sun disk seen directly and the ground's own radiance are excluded, as for `lut`",
+                s.samples, s.seed
+            ),
+            "transmittance (per view), sun_transmittance, irradiance and optical depths: from the precomputed tables and the model, as for `lut`",
+        ]),
+    };
     Ok(json!({
         "method": args.method,
         "wavelengths_nm": nm,
@@ -140,5 +186,6 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
             "sky_lux": lux(&e_sky),
         },
         "views": view_json,
+        "notes": notes,
     }))
 }

@@ -135,14 +135,19 @@ pub struct Frame {
 }
 
 impl Frame {
-    /// Log-average luminance over the pixels inside the projection (cd/m²).
+    /// Log-average luminance over the pixels inside the projection (cd/m²), leaving out
+    /// black space (below 10⁻⁶ of the brightest pixel) so a planet seen from orbit is
+    /// exposed for itself.
     pub fn log_average_luminance(&self) -> f64 {
+        let lum = |p: &[f32; 3]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
+        let max = self.image.data.iter().map(lum).fold(0.0, f64::max);
+        let floor = (max * 1e-6).max(1e-6);
         let mut sum = 0.0;
         let mut count = 0usize;
         for (p, &m) in self.image.data.iter().zip(&self.mask) {
-            if m {
-                let y = 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
-                sum += (y.max(1e-4)).ln();
+            let y = lum(p);
+            if m && y > floor {
+                sum += y.ln();
                 count += 1;
             }
         }
