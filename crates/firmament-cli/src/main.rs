@@ -6,6 +6,7 @@ mod gallery;
 mod query;
 mod render;
 mod render_bench;
+mod validate;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -50,6 +51,8 @@ enum Command {
     Gallery(gallery::GalleryArgs),
     /// Benchmarks: medians of the precomputation and frame costs.
     Bench(bench::BenchArgs),
+    /// Measure the table method against the Monte Carlo reference (errors per configuration; see docs/accuracy.md).
+    Validate(validate::ValidateArgs),
 }
 
 #[derive(Subcommand, Debug)]
@@ -100,6 +103,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Bench(args) => bench::run(&args)?,
         Command::Render(args) => render::run(&args)?,
         Command::Gallery(args) => gallery::run(&args)?,
+        Command::Validate(args) => validate::run(&args)?,
     }
     Ok(())
 }

@@ -90,9 +90,7 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
             settings.validate()?;
             Some(settings)
         }
-        other => anyhow::bail!(
-            "invalid value for `--method`: {other} (accepted: lut, reference)"
-        ),
+        other => anyhow::bail!("invalid value for `--method`: {other} (accepted: lut, reference)"),
     };
     let views: Vec<(f64, f64)> = args
         .views

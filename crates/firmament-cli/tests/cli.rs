@@ -23,8 +23,16 @@ fn tables() -> &'static Path {
     static T: OnceLock<PathBuf> = OnceLock::new();
     T.get_or_init(|| {
         let p = tmp().join("earth-small.lut");
-        let out = bin().args(["bake", "--table-size", "small", "--orders", "3", "--out"]).arg(&p).output().unwrap();
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let out = bin()
+            .args(["bake", "--table-size", "small", "--orders", "3", "--out"])
+            .arg(&p)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         p
     })
 }
@@ -49,14 +57,32 @@ fn fails_with(o: &Output, words: &[&str]) {
 #[test]
 fn query_prints_the_documented_json() {
     let t = tables().to_str().unwrap();
-    let o = run(&["query", "--tables", t, "--altitude-m", "0", "--sun-zenith-deg", "30", "--sun-azimuth-deg", "180", "--view", "0,0", "--view", "80,90"]);
+    let o = run(&[
+        "query",
+        "--tables",
+        t,
+        "--altitude-m",
+        "0",
+        "--sun-zenith-deg",
+        "30",
+        "--sun-azimuth-deg",
+        "180",
+        "--view",
+        "0,0",
+        "--view",
+        "80,90",
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["wavelengths_nm"].as_array().unwrap().len(), 3);
     assert_eq!(v["sun"]["zenith_deg"], 30.0);
     assert_eq!(v["sun"]["azimuth_deg"], 180.0);
     for key in ["rayleigh", "mie", "ozone", "total"] {
-        assert_eq!(v["optical_depth_zenith"][key].as_array().unwrap().len(), 3, "{key}");
+        assert_eq!(
+            v["optical_depth_zenith"][key].as_array().unwrap().len(),
+            3,
+            "{key}"
+        );
     }
     let tau_r = v["optical_depth_zenith"]["rayleigh"][1].as_f64().unwrap();
     assert!((tau_r - 0.0973).abs() < 0.002, "τ_R(550) {tau_r}");
@@ -64,7 +90,10 @@ fn query_prints_the_documented_json() {
     assert!(lux > 120_000.0 && lux < 140_000.0, "{lux}");
     let sun_lux = v["irradiance"]["sun_lux"].as_f64().unwrap();
     let sky_lux = v["irradiance"]["sky_lux"].as_f64().unwrap();
-    assert!(sun_lux > 60_000.0 && sun_lux < 110_000.0 && sky_lux > 5_000.0 && sky_lux < 30_000.0, "{sun_lux} {sky_lux}");
+    assert!(
+        sun_lux > 60_000.0 && sun_lux < 110_000.0 && sky_lux > 5_000.0 && sky_lux < 30_000.0,
+        "{sun_lux} {sky_lux}"
+    );
     let views = v["views"].as_array().unwrap();
     assert_eq!(views.len(), 2);
     for view in views {
@@ -88,15 +117,70 @@ fn invalid_query_inputs_are_refused_clearly() {
         a.extend_from_slice(extra);
         run(&a)
     };
-    fails_with(&with(&["--altitude-m", "-5"]), &["--altitude-m", "-5", "[0,"]);
-    fails_with(&run(&["query", "--tables", t, "--altitude-m", "0", "--sun-zenith-deg", "200"]), &["--sun-zenith-deg", "200", "[0, 180]"]);
-    fails_with(&with(&["--altitude-m", "0", "--view", "abc"]), &["--view", "ZENITH_DEG,AZIMUTH_DEG"]);
+    fails_with(
+        &with(&["--altitude-m", "-5"]),
+        &["--altitude-m", "-5", "[0,"],
+    );
+    fails_with(
+        &run(&[
+            "query",
+            "--tables",
+            t,
+            "--altitude-m",
+            "0",
+            "--sun-zenith-deg",
+            "200",
+        ]),
+        &["--sun-zenith-deg", "200", "[0, 180]"],
+    );
+    fails_with(
+        &with(&["--altitude-m", "0", "--view", "abc"]),
+        &["--view", "ZENITH_DEG,AZIMUTH_DEG"],
+    );
     fails_with(&with(&["--altitude-m", "nan"]), &["--altitude-m", "NaN"]);
-    fails_with(&run(&["query", "--preset", "venus", "--altitude-m", "0", "--sun-zenith-deg", "30"]), &["unknown preset", "venus", "earth"]);
-    fails_with(&run(&["query", "--wavelengths", "", "--altitude-m", "0", "--sun-zenith-deg", "30"]), &["wavelengths"]);
-    fails_with(&with(&["--altitude-m", "0", "--method", "magic"]), &["--method", "magic"]);
+    fails_with(
+        &run(&[
+            "query",
+            "--preset",
+            "venus",
+            "--altitude-m",
+            "0",
+            "--sun-zenith-deg",
+            "30",
+        ]),
+        &["unknown preset", "venus", "earth"],
+    );
+    fails_with(
+        &run(&[
+            "query",
+            "--wavelengths",
+            "",
+            "--altitude-m",
+            "0",
+            "--sun-zenith-deg",
+            "30",
+        ]),
+        &["wavelengths"],
+    );
+    fails_with(
+        &with(&["--altitude-m", "0", "--method", "magic"]),
+        &["--method", "magic"],
+    );
     // Tables for another atmosphere.
-    fails_with(&run(&["query", "--preset", "hazy", "--tables", t, "--altitude-m", "0", "--sun-zenith-deg", "30"]), &["another atmosphere"]);
+    fails_with(
+        &run(&[
+            "query",
+            "--preset",
+            "hazy",
+            "--tables",
+            t,
+            "--altitude-m",
+            "0",
+            "--sun-zenith-deg",
+            "30",
+        ]),
+        &["another atmosphere"],
+    );
 }
 
 #[test]
@@ -105,23 +189,53 @@ fn bad_atmosphere_files_are_refused_with_the_field() {
     assert!(earth.status.success());
     let text = String::from_utf8(earth.stdout).unwrap();
     let cases = [
-        ("bottom_radius_m = 6360000.0", "bottom_radius_m = -1.0", vec!["bottom_radius_m", "-1"]),
-        ("top_radius_m = 6420000.0", "top_radius_m = 6000000.0", vec!["top_radius_m", "greater than bottom_radius_m"]),
-        ("ground_albedo = 0.1", "ground_albedo = 2.0", vec!["ground_albedo", "[0, 1]"]),
-        ("g = 0.76 }", "g = -1.0 }", vec!["constituents[1].phase.g", "-1"]),
-        ("ground_albedo = 0.1", "ground_albedo = 0.1\nsky_colour = 3", vec!["unknown field", "sky_colour"]),
+        (
+            "bottom_radius_m = 6360000.0",
+            "bottom_radius_m = -1.0",
+            vec!["bottom_radius_m", "-1"],
+        ),
+        (
+            "top_radius_m = 6420000.0",
+            "top_radius_m = 6000000.0",
+            vec!["top_radius_m", "greater than bottom_radius_m"],
+        ),
+        (
+            "ground_albedo = 0.1",
+            "ground_albedo = 2.0",
+            vec!["ground_albedo", "[0, 1]"],
+        ),
+        (
+            "g = 0.76 }",
+            "g = -1.0 }",
+            vec!["constituents[1].phase.g", "-1"],
+        ),
+        (
+            "ground_albedo = 0.1",
+            "ground_albedo = 0.1\nsky_colour = 3",
+            vec!["unknown field", "sky_colour"],
+        ),
         ("[sun]", "[sun", vec!["TOML"]),
     ];
     for (i, (from, to, words)) in cases.iter().enumerate() {
         let p = tmp().join(format!("bad{i}.toml"));
         std::fs::write(&p, text.replacen(from, to, 1)).unwrap();
-        let o = run(&["query", "--atmosphere", p.to_str().unwrap(), "--altitude-m", "0", "--sun-zenith-deg", "30"]);
+        let o = run(&[
+            "query",
+            "--atmosphere",
+            p.to_str().unwrap(),
+            "--altitude-m",
+            "0",
+            "--sun-zenith-deg",
+            "30",
+        ]);
         fails_with(&o, words);
     }
     // Shown presets load back as they are.
     let p = tmp().join("earth.toml");
     std::fs::write(&p, &text).unwrap();
-    assert!(run(&["atmosphere", "check", p.to_str().unwrap()]).status.success());
+    assert!(run(&["atmosphere", "check", p.to_str().unwrap()])
+        .status
+        .success());
     fails_with(&run(&["atmosphere", "show", "venus"]), &["venus"]);
 }
 
@@ -130,16 +244,48 @@ fn bad_table_files_are_refused() {
     let t = std::fs::read(tables()).unwrap();
     let p = tmp().join("truncated.lut");
     std::fs::write(&p, &t[..t.len() / 2]).unwrap();
-    fails_with(&run(&["query", "--tables", p.to_str().unwrap(), "--altitude-m", "0", "--sun-zenith-deg", "30"]), &["truncated or corrupt"]);
+    fails_with(
+        &run(&[
+            "query",
+            "--tables",
+            p.to_str().unwrap(),
+            "--altitude-m",
+            "0",
+            "--sun-zenith-deg",
+            "30",
+        ]),
+        &["truncated or corrupt"],
+    );
 }
 
 #[test]
 fn every_camera_and_format_renders() {
     let t = tables().to_str().unwrap();
-    for (camera, size) in [("perspective", (64, 36)), ("fisheye", (48, 48)), ("equirect", (64, 32)), ("cubemap", (96, 16)), ("orbit", (48, 48))] {
+    for (camera, size) in [
+        ("perspective", (64, 36)),
+        ("fisheye", (48, 48)),
+        ("equirect", (64, 32)),
+        ("cubemap", (96, 16)),
+        ("orbit", (48, 48)),
+    ] {
         for ext in ["png", "exr", "hdr"] {
             let out = tmp().join(format!("{camera}.{ext}"));
-            let o = run(&["render", "--tables", t, "--camera", camera, "--width", &size.0.to_string(), "--height", &size.1.to_string(), "--sun-zenith-deg", "60", "--out", out.to_str().unwrap(), "-q"]);
+            let o = run(&[
+                "render",
+                "--tables",
+                t,
+                "--camera",
+                camera,
+                "--width",
+                &size.0.to_string(),
+                "--height",
+                &size.1.to_string(),
+                "--sun-zenith-deg",
+                "60",
+                "--out",
+                out.to_str().unwrap(),
+                "-q",
+            ]);
             assert!(o.status.success(), "{camera} {ext}: {}", stderr(&o));
             assert!(out.exists() && std::fs::metadata(&out).unwrap().len() > 0);
         }
@@ -148,7 +294,22 @@ fn every_camera_and_format_renders() {
     let a = tmp().join("ev-a.exr");
     let b = tmp().join("ev-b.exr");
     for (p, ev) in [(&a, "10"), (&b, "16")] {
-        assert!(run(&["render", "--tables", t, "--width", "32", "--height", "18", "--ev100", ev, "--out", p.to_str().unwrap(), "-q"]).status.success());
+        assert!(run(&[
+            "render",
+            "--tables",
+            t,
+            "--width",
+            "32",
+            "--height",
+            "18",
+            "--ev100",
+            ev,
+            "--out",
+            p.to_str().unwrap(),
+            "-q"
+        ])
+        .status
+        .success());
     }
     assert_eq!(std::fs::read(a).unwrap(), std::fs::read(b).unwrap());
 }
@@ -158,9 +319,15 @@ fn render_errors_leave_no_file() {
     let t = tables().to_str().unwrap();
     let out = tmp().join("never.png");
     let cases: Vec<(Vec<&str>, Vec<&str>)> = vec![
-        (vec!["--pitch-deg", "120"], vec!["camera.pitch_deg", "120", "[-90, 90]"]),
+        (
+            vec!["--pitch-deg", "120"],
+            vec!["camera.pitch_deg", "120", "[-90, 90]"],
+        ),
         (vec!["--fov-deg", "0"], vec!["camera.fov_deg", "(0, 180)"]),
-        (vec!["--sun-zenith-deg", "-3"], vec!["sun.zenith_deg", "[0, 180]"]),
+        (
+            vec!["--sun-zenith-deg", "-3"],
+            vec!["sun.zenith_deg", "[0, 180]"],
+        ),
         (vec!["--camera", "pinhole"], vec!["--camera", "pinhole"]),
         (vec!["--tonemap", "reinhard"], vec!["--tonemap", "reinhard"]),
         (vec!["--width", "0"], vec!["image.width"]),
@@ -172,14 +339,48 @@ fn render_errors_leave_no_file() {
         assert!(!out.exists());
     }
     // Unknown format, unwritable directory.
-    fails_with(&run(&["render", "--tables", t, "--out", tmp().join("x.jpg").to_str().unwrap()]), &["out", ".png, .exr or .hdr"]);
-    fails_with(&run(&["render", "--tables", t, "--out", "/nonexistent-dir/x.png"]), &["/nonexistent-dir", "does not exist"]);
+    fails_with(
+        &run(&[
+            "render",
+            "--tables",
+            t,
+            "--out",
+            tmp().join("x.jpg").to_str().unwrap(),
+        ]),
+        &["out", ".png, .exr or .hdr"],
+    );
+    fails_with(
+        &run(&["render", "--tables", t, "--out", "/nonexistent-dir/x.png"]),
+        &["/nonexistent-dir", "does not exist"],
+    );
     // Scene files: unknown fields and bad values.
     let scene = tmp().join("bad-scene.toml");
     std::fs::write(&scene, "[atmosphere]\n[camera]\nprojection = \"fisheye\"\naltitude_m = 0.0\nzoom = 2\n[image]\nwidth = 8\nheight = 8\n[sun]\nzenith_deg = 30.0\n[output]\n").unwrap();
-    fails_with(&run(&["render", "--tables", t, "--scene", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]), &["unknown field", "zoom"]);
+    fails_with(
+        &run(&[
+            "render",
+            "--tables",
+            t,
+            "--scene",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]),
+        &["unknown field", "zoom"],
+    );
     std::fs::write(&scene, "[atmosphere]\n[camera]\nprojection = \"fisheye\"\naltitude_m = -10.0\n[image]\nwidth = 8\nheight = 8\n[sun]\nzenith_deg = 30.0\n[output]\n").unwrap();
-    fails_with(&run(&["render", "--tables", t, "--scene", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]), &["camera.altitude_m", "-10"]);
+    fails_with(
+        &run(&[
+            "render",
+            "--tables",
+            t,
+            "--scene",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]),
+        &["camera.altitude_m", "-10"],
+    );
     assert!(!out.exists());
 }
 
@@ -191,15 +392,30 @@ fn example_scenes_are_valid() {
     for entry in std::fs::read_dir(dir).unwrap() {
         let p = entry.unwrap().path();
         if p.extension().is_some_and(|e| e == "toml") {
-            let out = tmp().join(format!("scene-{}.png", p.file_stem().unwrap().to_string_lossy()));
+            let out = tmp().join(format!(
+                "scene-{}.png",
+                p.file_stem().unwrap().to_string_lossy()
+            ));
             let text = std::fs::read_to_string(&p).unwrap();
             // Scenes on the baked tables' atmosphere reuse them; others compute small ones.
-            let tables_args: Vec<&str> = if text.contains("preset = \"earth\"") && !text.contains("spectral") {
-                vec!["--tables", t]
-            } else {
-                vec!["--table-size", "small"]
-            };
-            let mut a = vec!["render", "--scene", p.to_str().unwrap(), "--width", "32", "--height", "32", "--out", out.to_str().unwrap(), "-q"];
+            let tables_args: Vec<&str> =
+                if text.contains("preset = \"earth\"") && !text.contains("spectral") {
+                    vec!["--tables", t]
+                } else {
+                    vec!["--table-size", "small"]
+                };
+            let mut a = vec![
+                "render",
+                "--scene",
+                p.to_str().unwrap(),
+                "--width",
+                "32",
+                "--height",
+                "32",
+                "--out",
+                out.to_str().unwrap(),
+                "-q",
+            ];
             a.extend(&tables_args);
             let o = run(&a);
             assert!(o.status.success(), "{}: {}", p.display(), stderr(&o));

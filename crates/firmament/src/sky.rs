@@ -60,9 +60,26 @@ impl Sky {
 
     /// Rayleigh+multiple and single Mie scattering at (r, μ, μ_s, ν), without phase functions
     /// (Bruneton 2017 `GetCombinedScattering`; the ratio rule for red-only Mie).
-    fn combined_scattering(
+    /// The tables filtered for a fixed observer radius and sun zenith cosine: every view
+    /// ray of a frame from a camera inside the atmosphere shares (r, μ_s), so the 4D lookup
+    /// becomes a 2D one (same values).
+    pub fn slice(&self, r: f64, mu_s: f64) -> SkySlice {
+        let lk = self.lookup();
+        let uvwz =
+            crate::lut::params::scattering_uvwz(&lk.radii, &lk.sizes, r, 0.0, mu_s, 0.0, false);
+        SkySlice {
+            r,
+            mu_s,
+            scattering: self.tables.scattering.slice(uvwz[1], uvwz[3]),
+            mie: self.tables.single_mie.slice(uvwz[1], uvwz[3]),
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn combined_scattering_sliced(
         &self,
         lk: &Lookup,
+        slice: Option<&SkySlice>,
         r: f64,
         mu: f64,
         mu_s: f64,
@@ -73,12 +90,32 @@ impl Sky {
     ) {
         let uvwz =
             crate::lut::params::scattering_uvwz(&lk.radii, &lk.sizes, r, mu, mu_s, nu, ground);
-        self.tables.scattering.sample_into(uvwz, scat);
+        let slice = slice.filter(|s| s.r == r && s.mu_s == mu_s);
+        match slice {
+            Some(s) => {
+                self.tables
+                    .scattering
+                    .sample_slice_into(&s.scattering, uvwz[0], uvwz[2], scat)
+            }
+            None => self.tables.scattering.sample_into(uvwz, scat),
+        }
         match self.tables.config.mie {
-            MieStorage::Separate => self.tables.single_mie.sample_into(uvwz, mie),
+            MieStorage::Separate => match slice {
+                Some(s) => self
+                    .tables
+                    .single_mie
+                    .sample_slice_into(&s.mie, uvwz[0], uvwz[2], mie),
+                None => self.tables.single_mie.sample_into(uvwz, mie),
+            },
             MieStorage::RedOnly => {
                 let mut red = [0.0];
-                self.tables.single_mie.sample_into(uvwz, &mut red);
+                match slice {
+                    Some(s) => self
+                        .tables
+                        .single_mie
+                        .sample_slice_into(&s.mie, uvwz[0], uvwz[2], &mut red),
+                    None => self.tables.single_mie.sample_into(uvwz, &mut red),
+                }
                 let n = scat.len();
                 for k in 0..n {
                     mie[k] = if scat[0] > 0.0 {
@@ -129,6 +166,29 @@ impl Sky {
         radiance: &mut [f64],
         transmittance: &mut [f64],
     ) {
+        self.sky_radiance_sliced(
+            None,
+            camera,
+            view,
+            shadow_length_m,
+            sun,
+            radiance,
+            transmittance,
+        )
+    }
+
+    /// As [`Sky::sky_radiance`], using a [`SkySlice`] for the camera end when it matches.
+    #[allow(clippy::too_many_arguments)]
+    pub fn sky_radiance_sliced(
+        &self,
+        slice: Option<&SkySlice>,
+        camera: Vec3,
+        view: Vec3,
+        shadow_length_m: f64,
+        sun: Vec3,
+        radiance: &mut [f64],
+        transmittance: &mut [f64],
+    ) {
         let n = self.channels();
         let Some((camera, r, rmu)) = self.enter_atmosphere(camera, view) else {
             radiance[..n].iter_mut().for_each(|v| *v = 0.0);
@@ -149,7 +209,7 @@ impl Sky {
         let mut mie = [0.0f64; 64];
         let (scat, mie) = (&mut scat[..n], &mut mie[..n]);
         if shadow_length_m <= 0.0 {
-            self.combined_scattering(&lk, r, mu, mu_s, nu, ground, scat, mie);
+            self.combined_scattering_sliced(&lk, slice, r, mu, mu_s, nu, ground, scat, mie);
         } else {
             let d = shadow_length_m;
             let (r_p, mu_p) = crate::geometry::advance(
@@ -160,7 +220,7 @@ impl Sky {
                 self.model.top_radius_m,
             );
             let mu_s_p = ((r * mu_s + d * nu) / r_p).clamp(-1.0, 1.0);
-            self.combined_scattering(&lk, r_p, mu_p, mu_s_p, nu, ground, scat, mie);
+            self.combined_scattering_sliced(&lk, None, r_p, mu_p, mu_s_p, nu, ground, scat, mie);
             let mut t = [0.0f64; 64];
             lk.transmittance(r, mu, d, ground, &mut t[..n]);
             for k in 0..n {
@@ -178,6 +238,29 @@ impl Sky {
     /// transmittance between them (paper eq. 16's S|x − T(x,x_s)·S|x_s).
     pub fn sky_radiance_to_point(
         &self,
+        camera: Vec3,
+        point: Vec3,
+        shadow_length_m: f64,
+        sun: Vec3,
+        radiance: &mut [f64],
+        transmittance: &mut [f64],
+    ) {
+        self.sky_radiance_to_point_sliced(
+            None,
+            camera,
+            point,
+            shadow_length_m,
+            sun,
+            radiance,
+            transmittance,
+        )
+    }
+
+    /// As [`Sky::sky_radiance_to_point`], using a [`SkySlice`] for the camera end when it matches.
+    #[allow(clippy::too_many_arguments)]
+    pub fn sky_radiance_to_point_sliced(
+        &self,
+        slice: Option<&SkySlice>,
         camera: Vec3,
         point: Vec3,
         shadow_length_m: f64,
@@ -216,11 +299,11 @@ impl Sky {
             &mut scat_p[..n],
             &mut mie_p[..n],
         );
-        self.combined_scattering(&lk, r, mu, mu_s, nu, ground, scat, mie);
+        self.combined_scattering_sliced(&lk, slice, r, mu, mu_s, nu, ground, scat, mie);
         let d = (d_total - shadow_length_m.max(0.0)).max(0.0);
         let (r_p, mu_p) = crate::geometry::advance(r, mu, d, bottom, top);
         let mu_s_p = ((r * mu_s + d * nu) / r_p).clamp(-1.0, 1.0);
-        self.combined_scattering(&lk, r_p, mu_p, mu_s_p, nu, ground, scat_p, mie_p);
+        self.combined_scattering_sliced(&lk, None, r_p, mu_p, mu_s_p, nu, ground, scat_p, mie_p);
         let mut t_p = [0.0f64; 64];
         let t_p = &mut t_p[..n];
         if shadow_length_m > 0.0 {
@@ -304,6 +387,14 @@ impl Sky {
                 );
         }
     }
+}
+
+/// The scattering tables filtered at one (r, μ_s): see [`Sky::slice`].
+pub struct SkySlice {
+    r: f64,
+    mu_s: f64,
+    scattering: Vec<f64>,
+    mie: Vec<f64>,
 }
 
 /// Neckel (1996), Solar Physics 167, 223–248, eq. 2 and Table II: I(μ)/I(1) =

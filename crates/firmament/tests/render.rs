@@ -6,7 +6,9 @@ use std::sync::OnceLock;
 use firmament::atmosphere::Atmosphere;
 use firmament::geometry::direction_from_zenith_azimuth;
 use firmament::lut::{MieStorage, TableConfig, TableSizes, Tables};
-use firmament::render::{self, Camera, ColourMatrix, Projection, Ray, RenderSettings, ShadeOptions};
+use firmament::render::{
+    self, Camera, ColourMatrix, Projection, Ray, RenderSettings, ShadeOptions,
+};
 use firmament::sky::Sky;
 use firmament::spectrum::Wavelengths;
 
@@ -14,7 +16,15 @@ fn sky() -> &'static Sky {
     static SKY: OnceLock<Sky> = OnceLock::new();
     SKY.get_or_init(|| {
         let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
-        let tables = Tables::compute(&model, &TableConfig { sizes: TableSizes::small(), orders: 4, mie: MieStorage::Separate }).unwrap();
+        let tables = Tables::compute(
+            &model,
+            &TableConfig {
+                sizes: TableSizes::small(),
+                orders: 4,
+                mie: MieStorage::Separate,
+            },
+        )
+        .unwrap();
         Sky::new(model, tables).unwrap()
     })
 }
@@ -22,8 +32,14 @@ fn sky() -> &'static Sky {
 /// Linear sRGB (Y in cd/m²) seen from 2 m along (elevation, azimuth) in degrees.
 fn look(sun: (f64, f64), elevation: f64, azimuth: f64) -> [f64; 3] {
     let sky = sky();
-    let ray = Ray { origin: [0.0, 0.0, sky.model.bottom_radius_m + 2.0], dir: direction_from_zenith_azimuth((90.0 - elevation).to_radians(), azimuth.to_radians()) };
-    let options = ShadeOptions { sun: render::sun_direction(sun.0, sun.1), sun_disk: false };
+    let ray = Ray {
+        origin: [0.0, 0.0, sky.model.bottom_radius_m + 2.0],
+        dir: direction_from_zenith_azimuth((90.0 - elevation).to_radians(), azimuth.to_radians()),
+    };
+    let options = ShadeOptions {
+        sun: render::sun_direction(sun.0, sun.1),
+        sun_disk: false,
+    };
     let mut l = [0.0; 3];
     render::shade(sky, &ray, &options, &mut l);
     ColourMatrix::new(sky.model.wavelengths.nm()).to_srgb(&l)
@@ -37,18 +53,30 @@ fn lum(c: [f64; 3]) -> f64 {
 fn noon_zenith_is_blue_and_the_horizon_away_from_the_sun_is_brighter_and_whiter() {
     let sun = (30.0, 180.0);
     let zenith = look(sun, 90.0, 0.0);
-    assert!(zenith[2] > zenith[1] && zenith[1] > zenith[0], "zenith {zenith:?}");
+    assert!(
+        zenith[2] > zenith[1] && zenith[1] > zenith[0],
+        "zenith {zenith:?}"
+    );
     let horizon = look(sun, 2.0, 0.0);
-    assert!(lum(horizon) > lum(zenith), "horizon {horizon:?} zenith {zenith:?}");
+    assert!(
+        lum(horizon) > lum(zenith),
+        "horizon {horizon:?} zenith {zenith:?}"
+    );
     // Whiter: a smaller blue-to-red ratio.
-    assert!(horizon[2] / horizon[0] < zenith[2] / zenith[0], "horizon {horizon:?} zenith {zenith:?}");
+    assert!(
+        horizon[2] / horizon[0] < zenith[2] / zenith[0],
+        "horizon {horizon:?} zenith {zenith:?}"
+    );
 }
 
 #[test]
 fn sunset_sky_near_the_sun_is_red_orange_and_the_zenith_stays_blue() {
     let sun = (89.5, 270.0);
     let near = look(sun, 1.5, 270.0);
-    assert!(near[0] > near[1] && near[1] > near[2], "near the sun {near:?}");
+    assert!(
+        near[0] > near[1] && near[1] > near[2],
+        "near the sun {near:?}"
+    );
     let zenith = look(sun, 90.0, 0.0);
     assert!(zenith[2] > zenith[0], "zenith {zenith:?}");
 }
@@ -62,17 +90,39 @@ fn twilight_shows_the_earth_shadow_under_a_pink_belt() {
     let zenith = look(sun, 90.0, 0.0);
     assert!(lum(shadow) < lum(belt), "shadow {shadow:?} belt {belt:?}");
     // Pinkish: redder than the zenith and than the shadow band below it.
-    assert!(belt[0] / belt[2] > zenith[0] / zenith[2], "belt {belt:?} zenith {zenith:?}");
-    assert!(belt[0] / belt[2] > shadow[0] / shadow[2], "belt {belt:?} shadow {shadow:?}");
+    assert!(
+        belt[0] / belt[2] > zenith[0] / zenith[2],
+        "belt {belt:?} zenith {zenith:?}"
+    );
+    assert!(
+        belt[0] / belt[2] > shadow[0] / shadow[2],
+        "belt {belt:?} shadow {shadow:?}"
+    );
 }
 
 #[test]
 fn from_orbit_the_planet_has_a_bright_limb_and_a_black_night_side() {
     let sky = sky();
-    let camera = Camera { projection: Projection::Orbit, altitude_m: 30_000_000.0, heading_deg: 0.0, pitch_deg: 0.0, roll_deg: 0.0, fov_deg: render::camera::orbit_fit_fov_deg(6_424_000.0, 36_360_000.0) };
+    let camera = Camera {
+        projection: Projection::Orbit,
+        altitude_m: 30_000_000.0,
+        heading_deg: 0.0,
+        pitch_deg: 0.0,
+        roll_deg: 0.0,
+        fov_deg: render::camera::orbit_fit_fov_deg(6_424_000.0, 36_360_000.0),
+    };
     // Sun on the horizon of the point below the camera, in the east: day on the right.
     let (w, h) = (160, 160);
-    let settings = RenderSettings { camera: &camera, width: w, height: h, shade: ShadeOptions { sun: render::sun_direction(90.0, 90.0), sun_disk: false }, white_balance: false };
+    let settings = RenderSettings {
+        camera: &camera,
+        width: w,
+        height: h,
+        shade: ShadeOptions {
+            sun: render::sun_direction(90.0, 90.0),
+            sun_disk: false,
+        },
+        white_balance: false,
+    };
     let frame = render::render(sky, &settings, &|_| {}, None).unwrap();
     let y = |x: usize, row: usize| lum(frame.image.get(x, row).map(|v| v as f64));
     let row = h / 2;
@@ -105,10 +155,15 @@ fn sun_disk_integrates_to_the_solar_irradiance_times_transmittance() {
     let mut e = [0.0; 3];
     for i in 0..nr {
         let theta = (i as f64 + 0.5) / nr as f64 * 1.2 * alpha;
-        let d_omega = theta.sin() * (1.2 * alpha / nr as f64) * (2.0 * std::f64::consts::PI / nphi as f64);
+        let d_omega =
+            theta.sin() * (1.2 * alpha / nr as f64) * (2.0 * std::f64::consts::PI / nphi as f64);
         for j in 0..nphi {
             let phi = j as f64 * 2.0 * std::f64::consts::PI / nphi as f64;
-            let dir = [theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()];
+            let dir = [
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            ];
             let mut l = [0.0; 3];
             render::add_sun_disk(sky, dir, sun, &t, &mut l);
             for k in 0..3 {
@@ -118,7 +173,11 @@ fn sun_disk_integrates_to_the_solar_irradiance_times_transmittance() {
     }
     for k in 0..3 {
         let want = sky.model.solar_irradiance[k] * t[k];
-        assert!((e[k] - want).abs() / want < 0.01, "channel {k}: {} vs {want}", e[k]);
+        assert!(
+            (e[k] - want).abs() / want < 0.01,
+            "channel {k}: {} vs {want}",
+            e[k]
+        );
     }
 }
 
@@ -127,24 +186,76 @@ fn every_projection_renders_finite_pixels_and_hdr_files_read_back() {
     let sky = sky();
     let dir = std::env::temp_dir().join(format!("firmament-render-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    for (projection, w, h) in [(Projection::Perspective, 48, 32), (Projection::Fisheye, 32, 32), (Projection::Equirect, 64, 32), (Projection::Cubemap, 96, 16), (Projection::Orbit, 32, 32)] {
-        let camera = Camera { projection, altitude_m: if projection == Projection::Orbit { 1e7 } else { 100.0 }, heading_deg: 10.0, pitch_deg: 5.0, roll_deg: 0.0, fov_deg: 60.0 };
-        let settings = RenderSettings { camera: &camera, width: w, height: h, shade: ShadeOptions { sun: render::sun_direction(40.0, 100.0), sun_disk: true }, white_balance: false };
+    for (projection, w, h) in [
+        (Projection::Perspective, 48, 32),
+        (Projection::Fisheye, 32, 32),
+        (Projection::Equirect, 64, 32),
+        (Projection::Cubemap, 96, 16),
+        (Projection::Orbit, 32, 32),
+    ] {
+        let camera = Camera {
+            projection,
+            altitude_m: if projection == Projection::Orbit {
+                1e7
+            } else {
+                100.0
+            },
+            heading_deg: 10.0,
+            pitch_deg: 5.0,
+            roll_deg: 0.0,
+            fov_deg: 60.0,
+        };
+        let settings = RenderSettings {
+            camera: &camera,
+            width: w,
+            height: h,
+            shade: ShadeOptions {
+                sun: render::sun_direction(40.0, 100.0),
+                sun_disk: true,
+            },
+            white_balance: false,
+        };
         let frame = render::render(sky, &settings, &|_| {}, None).unwrap();
-        assert!(frame.image.data.iter().all(|p| p.iter().all(|v| v.is_finite() && *v >= 0.0)), "{projection:?}");
-        assert!(frame.image.data.iter().any(|p| p[1] > 0.0), "{projection:?}");
+        assert!(
+            frame
+                .image
+                .data
+                .iter()
+                .all(|p| p.iter().all(|v| v.is_finite() && *v >= 0.0)),
+            "{projection:?}"
+        );
+        assert!(
+            frame.image.data.iter().any(|p| p[1] > 0.0),
+            "{projection:?}"
+        );
         let exr = dir.join("a.exr");
         firmament::io::write_exr(&exr, &frame.image, firmament::io::ExrPrecision::F32).unwrap();
-        assert_eq!(firmament::io::read_exr(&exr).unwrap().data, frame.image.data);
+        assert_eq!(
+            firmament::io::read_exr(&exr).unwrap().data,
+            frame.image.data
+        );
         firmament::io::write_exr(&exr, &frame.image, firmament::io::ExrPrecision::F16).unwrap();
-        for (a, b) in firmament::io::read_exr(&exr).unwrap().data.iter().zip(&frame.image.data) {
+        for (a, b) in firmament::io::read_exr(&exr)
+            .unwrap()
+            .data
+            .iter()
+            .zip(&frame.image.data)
+        {
             for k in 0..3 {
-                assert!((a[k] - b[k]).abs() <= 1e-3 * b[k].abs() + 1e-6, "f16 {a:?} {b:?}");
+                assert!(
+                    (a[k] - b[k]).abs() <= 1e-3 * b[k].abs() + 1e-6,
+                    "f16 {a:?} {b:?}"
+                );
             }
         }
         let hdr = dir.join("a.hdr");
         firmament::io::write_hdr(&hdr, &frame.image).unwrap();
-        for (a, b) in firmament::io::read_hdr(&hdr).unwrap().data.iter().zip(&frame.image.data) {
+        for (a, b) in firmament::io::read_hdr(&hdr)
+            .unwrap()
+            .data
+            .iter()
+            .zip(&frame.image.data)
+        {
             let m = b.iter().cloned().fold(0.0f32, f32::max);
             for k in 0..3 {
                 assert!((a[k] - b[k]).abs() <= m / 128.0 + 1e-30, "rgbe {a:?} {b:?}");

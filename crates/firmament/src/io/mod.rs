@@ -678,7 +678,7 @@ fn parse_hdr(data: &[u8]) -> std::result::Result<ImageRgbF32, String> {
     let bottom_up = parts[0] == "+Y";
     let h: usize = parts[1].parse().map_err(|_| bad_res())?;
     let w: usize = parts[3].parse().map_err(|_| bad_res())?;
-    if w == 0 || h == 0 || w.checked_mul(h).map_or(true, |n| n > (1 << 31)) {
+    if w == 0 || h == 0 || w.checked_mul(h).is_none_or(|n| n > (1 << 31)) {
         return Err(format!("unsupported image size {w}x{h}"));
     }
     let mut img = ImageRgbF32::new(w, h);

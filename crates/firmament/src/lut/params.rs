@@ -78,7 +78,7 @@ impl TableSizes {
                 ));
             }
         }
-        if self.scattering_mu % 2 != 0 || self.scattering_mu < 4 {
+        if !self.scattering_mu.is_multiple_of(2) || self.scattering_mu < 4 {
             return Err(crate::Error::invalid(
                 "tables.scattering_mu",
                 self.scattering_mu,

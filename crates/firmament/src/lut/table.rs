@@ -187,6 +187,61 @@ impl Table4 {
         }
     }
 
+    /// The table filtered at fixed (u_μs, u_r): a 2D (μ, ν) slice, `[(y·nnu + ν)·channels + c]`.
+    /// Sampling the slice with [`Table4::sample_slice_into`] equals [`Table4::sample_into`]
+    /// at that (u_μs, u_r): the filter is separable. Used for every pixel of a frame whose
+    /// camera and sun are fixed.
+    pub fn slice(&self, u_mu_s: f64, u_r: f64) -> Vec<f64> {
+        let (s0, s1, ts) = lerp_weights(u_mu_s, self.nmu_s);
+        let (z0, z1, tz) = lerp_weights(u_r, self.nr);
+        let c = self.channels;
+        let mut out = vec![0.0; self.nmu * self.nnu * c];
+        for y in 0..self.nmu {
+            for nu in 0..self.nnu {
+                let o = &mut out[(y * self.nnu + nu) * c..(y * self.nnu + nu + 1) * c];
+                for (z, wz) in [(z0, 1.0 - tz), (z1, tz)] {
+                    for (sx, wsx) in [(s0, 1.0 - ts), (s1, ts)] {
+                        let w = wz * wsx;
+                        if w == 0.0 {
+                            continue;
+                        }
+                        let i = self.index(nu * self.nmu_s + sx, y, z);
+                        for k in 0..c {
+                            o[k] += w * self.data[i + k] as f64;
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Sample a [`Table4::slice`] at (u_ν, u_μ) into `out`.
+    #[inline]
+    pub fn sample_slice_into(&self, slice: &[f64], u_nu: f64, u_mu: f64, out: &mut [f64]) {
+        let tex_x = u_nu * (self.nnu - 1) as f64;
+        let nu0 = (tex_x.max(0.0) as usize).min(self.nnu - 1);
+        let nu1 = (nu0 + 1).min(self.nnu - 1);
+        let tnu = tex_x - nu0 as f64;
+        let (y0, y1, ty) = lerp_weights(u_mu, self.nmu);
+        let c = self.channels;
+        let (a, b, d, e) = (
+            (y0 * self.nnu + nu0) * c,
+            (y0 * self.nnu + nu1) * c,
+            (y1 * self.nnu + nu0) * c,
+            (y1 * self.nnu + nu1) * c,
+        );
+        let (wa, wb, wd, we) = (
+            (1.0 - ty) * (1.0 - tnu),
+            (1.0 - ty) * tnu,
+            ty * (1.0 - tnu),
+            ty * tnu,
+        );
+        for k in 0..c {
+            out[k] = wa * slice[a + k] + wb * slice[b + k] + wd * slice[d + k] + we * slice[e + k];
+        }
+    }
+
     /// Element-wise a += b.
     pub fn add_assign(&mut self, other: &Table4) {
         for (a, b) in self.data.iter_mut().zip(&other.data) {

@@ -184,7 +184,7 @@ impl DensityProfile {
                     "a finite width ≥ 0 m",
                 ));
             }
-            if !(l.scale_height_m > 0.0) || l.scale_height_m.is_nan() {
+            if l.scale_height_m.is_nan() || l.scale_height_m <= 0.0 {
                 return Err(Error::invalid(
                     f("scale_height_m"),
                     l.scale_height_m,

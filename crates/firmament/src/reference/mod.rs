@@ -373,6 +373,19 @@ pub fn sky_radiance(
     radiance_pixel(model, camera, view, sun, settings, 0, true)
 }
 
+/// [`sky_radiance`] with the random streams keyed by `key` (estimates with different keys
+/// are independent; key 0 is [`sky_radiance`]). Samples run in parallel.
+pub fn sky_radiance_keyed(
+    model: &Model,
+    camera: Vec3,
+    view: Vec3,
+    sun: Vec3,
+    settings: &ReferenceSettings,
+    key: u64,
+) -> RadianceEstimate {
+    radiance_pixel(model, camera, view, sun, settings, key, true)
+}
+
 /// [`sky_radiance`] for many (camera, view) rays, in parallel over pixels; pixel `i` uses
 /// the random streams of index `i` (so the first pixel equals [`sky_radiance`]).
 pub fn render_pixels(
@@ -392,10 +405,24 @@ pub fn render_pixels_with_progress(
     settings: &ReferenceSettings,
     progress: &(dyn Fn() + Sync),
 ) -> Vec<RadianceEstimate> {
+    render_pixels_from(model, rays, 0, sun, settings, progress)
+}
+
+/// [`render_pixels_with_progress`] for a batch of pixels that starts at pixel index
+/// `first` (pixel `first + i` uses the streams of that index), so an image rendered in
+/// batches (e.g. to check for cancellation between them) equals one rendered at once.
+pub fn render_pixels_from(
+    model: &Model,
+    rays: &[(Vec3, Vec3)],
+    first: u64,
+    sun: Vec3,
+    settings: &ReferenceSettings,
+    progress: &(dyn Fn() + Sync),
+) -> Vec<RadianceEstimate> {
     rays.par_iter()
         .enumerate()
         .map(|(i, &(camera, view))| {
-            let e = radiance_pixel(model, camera, view, sun, settings, i as u64, false);
+            let e = radiance_pixel(model, camera, view, sun, settings, first + i as u64, false);
             progress();
             e
         })

@@ -111,6 +111,39 @@ impl Camera {
         px: f64,
         py: f64,
     ) -> Option<Ray> {
+        self.prepare(bottom_radius_m, width, height).ray(px, py)
+    }
+
+    /// Per-frame constants for [`PreparedCamera::ray`].
+    pub fn prepare(&self, bottom_radius_m: f64, width: usize, height: usize) -> PreparedCamera {
+        let (forward, right, up) = match self.projection {
+            Projection::Orbit => Camera {
+                pitch_deg: -90.0,
+                ..self.clone()
+            }
+            .basis(),
+            _ => self.basis(),
+        };
+        PreparedCamera {
+            camera: self.clone(),
+            bottom_radius_m,
+            width,
+            height,
+            forward,
+            right,
+            up,
+            tan_half_fov: (self.fov_deg.to_radians() / 2.0).tan(),
+        }
+    }
+
+    fn ray_slow(
+        &self,
+        bottom_radius_m: f64,
+        width: usize,
+        height: usize,
+        px: f64,
+        py: f64,
+    ) -> Option<Ray> {
         let origin = [0.0, 0.0, bottom_radius_m + self.altitude_m];
         // Normalised device coordinates, x right, y up, in [-1, 1].
         let (u, v) = (
@@ -196,6 +229,46 @@ impl Camera {
         );
         let up = cross(right, forward);
         (forward, normalize(right), normalize(up))
+    }
+}
+
+/// A camera with its per-frame constants (view basis, field of view) computed once.
+#[derive(Clone, Debug)]
+pub struct PreparedCamera {
+    camera: Camera,
+    bottom_radius_m: f64,
+    width: usize,
+    height: usize,
+    forward: Vec3,
+    right: Vec3,
+    up: Vec3,
+    tan_half_fov: f64,
+}
+
+impl PreparedCamera {
+    /// The ray through pixel position (px, py) (pixel centres at +0.5), None outside the
+    /// projection.
+    #[inline]
+    pub fn ray(&self, px: f64, py: f64) -> Option<Ray> {
+        match self.camera.projection {
+            Projection::Perspective | Projection::Orbit => {
+                let (w, h) = (self.width as f64, self.height as f64);
+                let (u, v) = (2.0 * px / w - 1.0, 1.0 - 2.0 * py / h);
+                let t = self.tan_half_fov;
+                let d = add_scaled(
+                    add_scaled(self.forward, u * t * w / h, self.right),
+                    v * t,
+                    self.up,
+                );
+                Some(Ray {
+                    origin: [0.0, 0.0, self.bottom_radius_m + self.camera.altitude_m],
+                    dir: normalize(d),
+                })
+            }
+            _ => self
+                .camera
+                .ray_slow(self.bottom_radius_m, self.width, self.height, px, py),
+        }
     }
 }
 

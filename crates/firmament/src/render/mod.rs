@@ -19,7 +19,7 @@ use crate::geometry::{
     add_scaled, direction_from_zenith_azimuth, dot, normalize, ray_sphere, Vec3,
 };
 use crate::io::ImageRgbF32;
-use crate::sky::{limb_darkening, Sky};
+use crate::sky::{limb_darkening, Sky, SkySlice};
 use crate::spectrum::{spectrum_to_xyz, xyz_to_linear_srgb};
 use crate::{Error, Result};
 
@@ -80,6 +80,23 @@ impl ColourMatrix {
 /// Lambertian sphere lit by sun and sky) seen through aerial perspective, or the sky and
 /// the sun's disk (paper eq. 16).
 pub fn shade(sky: &Sky, ray: &Ray, options: &ShadeOptions, out: &mut [f64]) {
+    shade_sliced(sky, None, ray, options, out)
+}
+
+/// The [`SkySlice`] for rays from `origin` (None when it is outside the atmosphere).
+pub fn camera_slice(sky: &Sky, origin: Vec3, sun: Vec3) -> Option<SkySlice> {
+    let r = crate::geometry::length(origin);
+    (r <= sky.model.top_radius_m).then(|| sky.slice(r, (dot(origin, sun) / r).clamp(-1.0, 1.0)))
+}
+
+/// [`shade`] with a camera slice (see [`Sky::slice`]).
+pub fn shade_sliced(
+    sky: &Sky,
+    slice: Option<&SkySlice>,
+    ray: &Ray,
+    options: &ShadeOptions,
+    out: &mut [f64],
+) {
     let n = sky.channels();
     let model = &sky.model;
     let mut t = [0.0f64; 64];
@@ -93,12 +110,12 @@ pub fn shade(sky: &Sky, ray: &Ray, options: &ShadeOptions, out: &mut [f64]) {
         let [e_sun, e_sky] = &mut buf;
         let (e_sun, e_sky) = (&mut e_sun[..n], &mut e_sky[..n]);
         sky.sun_and_sky_irradiance(p, normal, options.sun, e_sun, e_sky);
-        sky.sky_radiance_to_point(ray.origin, p, 0.0, options.sun, out, t);
+        sky.sky_radiance_to_point_sliced(slice, ray.origin, p, 0.0, options.sun, out, t);
         for k in 0..n {
             out[k] += model.ground_albedo[k] / PI * (e_sun[k] + e_sky[k]) * t[k];
         }
     } else {
-        sky.sky_radiance(ray.origin, ray.dir, 0.0, options.sun, out, t);
+        sky.sky_radiance_sliced(slice, ray.origin, ray.dir, 0.0, options.sun, out, t);
         if options.sun_disk {
             add_sun_disk(sky, ray.dir, options.sun, t, out);
         }
@@ -160,14 +177,26 @@ impl Frame {
     /// Tone-mapped 8-bit sRGB: exposure scale × luminance-scaled colour, then the curve, then
     /// the sRGB transfer function.
     pub fn to_srgb8(&self, exposure: f64, curve: ToneCurve) -> Vec<[u8; 3]> {
+        // The 8-bit code is the one whose interval contains the value: binary search on the
+        // 255 decision levels (decoded mid-points), same result as rounding the encoded value.
+        let levels: Vec<f32> = (0..255)
+            .map(|i| srgb_decode((i as f64 + 0.5) / 255.0) as f32)
+            .collect();
+        let encode = |v: f32| levels.partition_point(|&l| l <= v) as u8;
         self.image
             .data
             .par_iter()
-            .map(|p| {
-                let c = p.map(|v| curve.apply(v as f64 * exposure) as f32);
-                c.map(crate::io::encode_srgb)
-            })
+            .map(|p| p.map(|v| encode(curve.apply(v as f64 * exposure) as f32)))
             .collect()
+    }
+}
+
+/// The sRGB transfer function's inverse (IEC 61966-2-1).
+fn srgb_decode(e: f64) -> f64 {
+    if e <= 0.04045 {
+        e / 12.92
+    } else {
+        ((e + 0.055) / 1.055).powf(2.4)
     }
 }
 
@@ -218,6 +247,13 @@ pub fn render(
     } else {
         [1.0; 3]
     };
+    let origin = [
+        0.0,
+        0.0,
+        sky.model.bottom_radius_m + settings.camera.altitude_m,
+    ];
+    let slice = camera_slice(sky, origin, settings.shade.sun);
+    let prepared = settings.camera.prepare(sky.model.bottom_radius_m, w, h);
     let mut image = ImageRgbF32::new(w, h);
     let mut mask = vec![false; w * h];
     let done = AtomicUsize::new(0);
@@ -235,16 +271,10 @@ pub fn render(
             let mut l = [0.0f64; 64];
             let l = &mut l[..n];
             for x in 0..w {
-                let Some(ray) = settings.camera.ray(
-                    sky.model.bottom_radius_m,
-                    w,
-                    h,
-                    x as f64 + 0.5,
-                    y as f64 + 0.5,
-                ) else {
+                let Some(ray) = prepared.ray(x as f64 + 0.5, y as f64 + 0.5) else {
                     continue;
                 };
-                shade(sky, &ray, &settings.shade, l);
+                shade_sliced(sky, slice.as_ref(), &ray, &settings.shade, l);
                 let c = colour.to_srgb(l);
                 row[x] = [
                     (c[0] * balance[0]) as f32,
@@ -254,7 +284,7 @@ pub fn render(
                 mrow[x] = true;
             }
             let d = done.fetch_add(1, Ordering::Relaxed) + 1;
-            if d % 16 == 0 {
+            if d.is_multiple_of(16) {
                 progress(d as f64 / h as f64);
             }
         });
@@ -262,4 +292,28 @@ pub fn render(
         return Err(Error::Interrupted);
     }
     Ok(Frame { image, mask })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fast_srgb_encoding_equals_the_transfer_function() {
+        let levels: Vec<f32> = (0..255)
+            .map(|i| srgb_decode((i as f64 + 0.5) / 255.0) as f32)
+            .collect();
+        let mut mismatches = 0;
+        for i in 0..=100_000 {
+            let v = i as f32 / 100_000.0;
+            let fast = levels.partition_point(|&l| l <= v) as u8;
+            let exact = crate::io::encode_srgb(v);
+            // Ties at a decision level may round either way in f32.
+            if fast != exact {
+                mismatches += 1;
+                assert!((fast as i32 - exact as i32).abs() <= 1);
+            }
+        }
+        assert!(mismatches < 20, "{mismatches}");
+    }
 }

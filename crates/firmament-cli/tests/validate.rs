@@ -1,0 +1,218 @@
+//! The reference path tracer through the command line: `validate --quick` (the CI check of
+//! the table method's daylight accuracy), `query --method reference`, `render --method
+//! reference`, and the errors for unknown methods.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn firmament(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_firmament"))
+        .args(args)
+        .output()
+        .expect("run the firmament binary")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("firmament-cli-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// The reduced validation runs, passes the daylight thresholds and writes the documented
+/// JSON fields.
+#[test]
+fn validate_quick_passes_and_writes_json() {
+    let dir = temp_dir("validate");
+    let json_path = dir.join("quick.json");
+    let out = firmament(&[
+        "validate",
+        "--quick",
+        "--quiet",
+        "--json",
+        json_path.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    println!("{stdout}\n{}", stderr(&out));
+    assert!(out.status.success(), "validate --quick failed");
+    assert!(stdout.contains("earth daylight"));
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&json_path).unwrap()).unwrap();
+    assert_eq!(v["quick"], true);
+    assert_eq!(v["wavelengths_nm"].as_array().unwrap().len(), 3);
+    assert_eq!(v["thresholds"]["median"], 0.02);
+    assert_eq!(v["thresholds"]["p95"], 0.05);
+    let configs = v["configurations"].as_array().unwrap();
+    assert_eq!(configs.len(), 2);
+    for c in configs {
+        assert_eq!(c["preset"], "earth");
+        assert_eq!(c["altitude_m"], 0.0);
+        let views = c["views"].as_array().unwrap();
+        assert!(views.len() >= 15, "{} views", views.len());
+        for view in views {
+            assert!(view["sun_distance_deg"].as_f64().unwrap() >= 1.0);
+            let r = &view["reference"];
+            assert_eq!(r["radiance"].as_array().unwrap().len(), 3);
+            assert_eq!(r["stderr"].as_array().unwrap().len(), 3);
+            assert!(r["samples"].as_u64().unwrap() >= 2);
+            assert!(r["luminance_cd_m2"].as_f64().unwrap() > 0.0);
+            let t = &view["tables"][0];
+            assert_eq!(t["orders"], 4);
+            assert!(t["relative_error_luminance"].as_f64().is_some());
+        }
+        let s = &c["tables"][0]["summary"]["luminance"];
+        for key in [
+            "median",
+            "p95",
+            "max",
+            "signed_median",
+            "reference_median_relative_stderr",
+        ] {
+            assert!(s[key].as_f64().is_some(), "missing {key}");
+        }
+        assert_eq!(
+            c["tables"][0]["summary"]["wavelengths"]
+                .as_array()
+                .unwrap()
+                .len(),
+            3
+        );
+    }
+    let agg = &v["aggregates"][0];
+    assert_eq!(agg["pass"], true);
+    let y = &agg["summary"]["luminance"];
+    assert!(y["median"].as_f64().unwrap() <= 0.02);
+    assert!(y["p95"].as_f64().unwrap() <= 0.05);
+    // The reference's own noise is reported and small.
+    assert!(y["reference_median_relative_stderr"].as_f64().unwrap() <= 0.011);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn query_method_reference_adds_stderr_and_samples() {
+    let out = firmament(&[
+        "query",
+        "--altitude-m",
+        "0",
+        "--sun-zenith-deg",
+        "45",
+        "--view",
+        "0,0",
+        "--view",
+        "80,180",
+        "--table-size",
+        "small",
+        "--method",
+        "reference",
+        "--samples",
+        "512",
+        "--seed",
+        "3",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["method"], "reference");
+    assert!(!v["notes"].as_array().unwrap().is_empty());
+    let views = v["views"].as_array().unwrap();
+    assert_eq!(views.len(), 2);
+    for view in views {
+        assert_eq!(view["samples"], 512);
+        let radiance = view["radiance"].as_array().unwrap();
+        let se = view["radiance_stderr"].as_array().unwrap();
+        assert_eq!(radiance.len(), 3);
+        assert_eq!(se.len(), 3);
+        for (l, e) in radiance.iter().zip(se) {
+            let (l, e) = (l.as_f64().unwrap(), e.as_f64().unwrap());
+            assert!(l > 0.0 && e > 0.0 && e < 0.2 * l, "radiance {l} ± {e}");
+        }
+        assert!(view["luminance_cd_m2_stderr"].as_f64().unwrap() > 0.0);
+    }
+    // The table method has neither field.
+    let out = firmament(&[
+        "query",
+        "--altitude-m",
+        "0",
+        "--sun-zenith-deg",
+        "45",
+        "--view",
+        "0,0",
+        "--table-size",
+        "small",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["views"][0].get("radiance_stderr").is_none());
+    assert!(v["views"][0].get("samples").is_none());
+}
+
+#[test]
+fn unknown_method_is_a_clear_error() {
+    let out = firmament(&[
+        "query",
+        "--altitude-m",
+        "0",
+        "--sun-zenith-deg",
+        "45",
+        "--view",
+        "0,0",
+        "--method",
+        "magic",
+    ]);
+    assert!(!out.status.success());
+    let e = stderr(&out);
+    assert!(
+        e.contains("invalid value for `--method`: magic (accepted: lut, reference)"),
+        "{e}"
+    );
+    let dir = temp_dir("method");
+    let png = dir.join("x.png");
+    let out = firmament(&[
+        "render",
+        "--method",
+        "magic",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("invalid value for `--method`: magic"));
+    assert!(!png.exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn render_method_reference_writes_the_same_formats() {
+    let dir = temp_dir("render");
+    let png = dir.join("ref.png");
+    let exr = dir.join("ref.exr");
+    let out = firmament(&[
+        "render",
+        "--method",
+        "reference",
+        "--samples",
+        "4",
+        "--camera",
+        "perspective",
+        "--width",
+        "12",
+        "--height",
+        "8",
+        "--pitch-deg",
+        "-5",
+        "--sun-zenith-deg",
+        "70",
+        "--out",
+        png.to_str().unwrap(),
+        "--out",
+        exr.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+    assert!(std::fs::metadata(&exr).unwrap().len() > 0);
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1,0 +1,620 @@
+// Shared by every table pass: the atmosphere parameters, density profiles, phase functions,
+// ray geometry, the table parameterisations and the table lookups. Mirrors, function for
+// function, crates/firmament/src/{geometry.rs, lut/params.rs, lut/context.rs,
+// lut/table.rs, medium/profile.rs, medium/phase.rs} (Bruneton 2017 `functions.glsl`).
+//
+// Units: lengths in km (f32 precision), coefficients in km⁻¹, angles as cosines.
+// Wherever a radius difference would cancel in f32 (r − R_g at 6360 km), the shaders carry
+// ρ = sqrt(r² − R_g²), the distance to the horizon, and use r² − R_g² = ρ²,
+// R_t² − r² = H² − ρ² (exact identities, no cancellation).
+//
+// Tables are storage buffers of vec4<f32>: channel group k (wavelengths 4k..4k+3) of texel i
+// at index i·groups + k, texels in the CPU order (firmament::lut::table). The host drops
+// the padding lanes when it converts them to `Tables`.
+
+const PI: f32 = 3.14159265358979;
+
+// Atmosphere and table sizes; one uniform buffer per precomputation (never baked into the
+// shader source). Filled by firmament_gpu::lut::atmosphere (same field order).
+struct Atmosphere {
+    bottom_radius: f32,
+    top_radius: f32,
+    h: f32,
+    h_sq: f32,
+    mu_s_min: f32,
+    mu_s_big_a: f32,
+    sun_angular_radius: f32,
+    channels: u32,
+    groups: u32,
+    constituents: u32,
+    transmittance_mu: u32,
+    transmittance_r: u32,
+    scattering_r: u32,
+    scattering_mu: u32,
+    scattering_mu_s: u32,
+    scattering_nu: u32,
+    irradiance_mu_s: u32,
+    irradiance_r: u32,
+    solar_offset: u32,
+    albedo_offset: u32,
+    constituent_offset: u32,
+    layer_offset: u32,
+    phase0_kind: u32,
+    phase0_offset: u32,
+    phase0_count: u32,
+    phase0_a: f32,
+    phase0_b: f32,
+    phase0_c: f32,
+    phase1_kind: u32,
+    phase1_offset: u32,
+    phase1_count: u32,
+    phase1_a: f32,
+    phase1_b: f32,
+    phase1_c: f32,
+    group0_present: u32,
+    group1_present: u32,
+}
+
+// Which radiance field a pass reads (0: single scattering, phase functions applied at lookup;
+// 1: the previous order's ΔS as it is) and the scattering order.
+struct PassParams {
+    mode: u32,
+    order: u32,
+    pad0: u32,
+    pad1: u32,
+}
+
+@group(0) @binding(0) var<uniform> atm: Atmosphere;
+@group(0) @binding(1) var<uniform> pass_params: PassParams;
+// Per-wavelength data (vec4 per channel group), constituents, layers, tabulated phases.
+@group(0) @binding(2) var<storage, read> data: array<vec4<f32>>;
+
+const WORKGROUP: u32 = 64u;
+
+// Flat invocation index of a 2D dispatch over 64-wide workgroups.
+fn invocation_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    return gid.x + gid.y * nwg.x * WORKGROUP;
+}
+
+fn solar_irradiance(k: u32) -> vec4<f32> {
+    return data[atm.solar_offset + k];
+}
+
+fn ground_albedo(k: u32) -> vec4<f32> {
+    return data[atm.albedo_offset + k];
+}
+
+// ---------------------------------------------------------------------------------------
+// Density profiles (medium/profile.rs): per layer exp_term·exp(−h/H) + a·h + c, ≥ 0.
+
+fn constituent_base(c: u32) -> u32 {
+    return atm.constituent_offset + c * (1u + 2u * atm.groups);
+}
+
+fn constituent_scattering(c: u32, k: u32) -> vec4<f32> {
+    return data[constituent_base(c) + 1u + k];
+}
+
+fn constituent_extinction(c: u32, k: u32) -> vec4<f32> {
+    return data[constituent_base(c) + 1u + atm.groups + k];
+}
+
+fn layer_density(l: u32, altitude: f32) -> f32 {
+    let a = data[l];
+    let b = data[l + 1u];
+    var e = 0.0;
+    if (a.y != 0.0) {
+        e = a.y * exp(-altitude * a.z);
+    }
+    return max(e + a.w * altitude + b.x, 0.0);
+}
+
+// Dimensionless density of constituent c at `altitude` km above the ground.
+fn constituent_density(c: u32, altitude: f32) -> f32 {
+    let info = data[constituent_base(c)];
+    let first = atm.layer_offset + 2u * u32(info.x);
+    let count = u32(info.y);
+    var base = 0.0;
+    for (var i = 0u; i < count; i++) {
+        let l = first + 2u * i;
+        let width = data[l].x;
+        if (i + 1u == count || altitude < base + width) {
+            return layer_density(l, altitude);
+        }
+        base += width;
+    }
+    return 0.0;
+}
+
+// Scattering coefficient (km⁻¹) of group g (0 molecules, 1 aerosols) at `altitude` km.
+fn group_scattering(g: u32, altitude: f32, k: u32) -> vec4<f32> {
+    var out = vec4<f32>(0.0);
+    for (var c = 0u; c < atm.constituents; c++) {
+        let info = data[constituent_base(c)];
+        if (i32(info.z) == i32(g)) {
+            let rho = constituent_density(c, altitude);
+            if (rho > 0.0) {
+                out += rho * constituent_scattering(c, k);
+            }
+        }
+    }
+    return out;
+}
+
+// Extinction coefficient (km⁻¹) of the whole atmosphere at `altitude` km.
+fn extinction(altitude: f32, k: u32) -> vec4<f32> {
+    var out = vec4<f32>(0.0);
+    for (var c = 0u; c < atm.constituents; c++) {
+        let rho = constituent_density(c, altitude);
+        if (rho > 0.0) {
+            out += rho * constituent_extinction(c, k);
+        }
+    }
+    return out;
+}
+
+// ---------------------------------------------------------------------------------------
+// Phase functions (medium/phase.rs), normalised to 1 over the sphere.
+
+const INV_4PI: f32 = 0.0795774715459477;
+
+fn hg(g: f32, mu: f32) -> f32 {
+    let d = 1.0 + g * g - 2.0 * g * mu;
+    return (1.0 - g * g) * INV_4PI / (d * sqrt(d));
+}
+
+fn tabulated_phase(offset: u32, count: u32, mu: f32) -> f32 {
+    let t = acos(mu);
+    // partition_point(theta ≤ t)
+    var lo = 0u;
+    var hi = count;
+    while (lo < hi) {
+        let mid = (lo + hi) / 2u;
+        if (data[offset + mid].x <= t) {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    let i = clamp(lo, 1u, count - 1u) - 1u;
+    let a = data[offset + i];
+    let b = data[offset + i + 1u];
+    let f = clamp((t - a.x) / (b.x - a.x), 0.0, 1.0);
+    return a.y + f * (b.y - a.y);
+}
+
+fn phase_eval(kind: u32, offset: u32, count: u32, a: f32, b: f32, c: f32, cos_theta: f32) -> f32 {
+    let mu = clamp(cos_theta, -1.0, 1.0);
+    switch kind {
+        case 0u: {
+            return INV_4PI;
+        }
+        case 1u: {
+            // Rayleigh with depolarisation: 3/(4π(3a+b))·(a + bμ²).
+            return 3.0 / (4.0 * PI * (3.0 * a + b)) * (a + b * mu * mu);
+        }
+        case 2u: {
+            return hg(a, mu);
+        }
+        case 3u: {
+            // Cornette–Shanks (Bruneton & Neyret 2008 eq. 4).
+            let g2 = a * a;
+            let d = 1.0 + g2 - 2.0 * a * mu;
+            return 3.0 / (8.0 * PI) * (1.0 - g2) / (2.0 + g2) * (1.0 + mu * mu) / (d * sqrt(d));
+        }
+        case 4u: {
+            // Schlick, a = k.
+            let d = 1.0 - a * mu;
+            return (1.0 - a * a) * INV_4PI / (d * d);
+        }
+        case 5u: {
+            return c * hg(a, mu) + (1.0 - c) * hg(b, mu);
+        }
+        default: {
+            return tabulated_phase(offset, count, mu);
+        }
+    }
+}
+
+// Phase function of scattering group g (0 molecules, 1 aerosols).
+fn group_phase(g: u32, nu: f32) -> f32 {
+    if (g == 0u) {
+        return phase_eval(atm.phase0_kind, atm.phase0_offset, atm.phase0_count, atm.phase0_a, atm.phase0_b, atm.phase0_c, nu);
+    }
+    return phase_eval(atm.phase1_kind, atm.phase1_offset, atm.phase1_count, atm.phase1_a, atm.phase1_b, atm.phase1_c, nu);
+}
+
+// ---------------------------------------------------------------------------------------
+// Ray geometry (geometry.rs), with ρ = sqrt(r² − R_g²) carried along.
+
+fn safe_sqrt(x: f32) -> f32 {
+    return sqrt(max(x, 0.0));
+}
+
+fn clamp_cosine(mu: f32) -> f32 {
+    return clamp(mu, -1.0, 1.0);
+}
+
+// r from ρ.
+fn radius_from_rho(rho: f32) -> f32 {
+    return sqrt(rho * rho + atm.bottom_radius * atm.bottom_radius);
+}
+
+// Distance to the top along (r, μ): the positive root of d² + 2rμd + r² − R_t² = 0, in the
+// form without cancellation for rays going up.
+fn distance_to_top(r: f32, rho: f32, mu: f32) -> f32 {
+    let c = max(atm.h_sq - rho * rho, 0.0);
+    let root = safe_sqrt(r * r * mu * mu + c);
+    if (mu > 0.0) {
+        return c / (r * mu + root);
+    }
+    return max(-r * mu + root, 0.0);
+}
+
+// Distance to the ground along (r, μ) (the smaller root; meaningful for ground rays).
+fn distance_to_bottom(r: f32, rho: f32, mu: f32) -> f32 {
+    let root = safe_sqrt(r * r * mu * mu - rho * rho);
+    let far = -r * mu + root;
+    if (far > 0.0) {
+        return max(rho * rho / far, 0.0);
+    }
+    return max(-r * mu - root, 0.0);
+}
+
+fn ray_intersects_ground(r: f32, rho: f32, mu: f32) -> bool {
+    return mu < 0.0 && r * r * mu * mu - rho * rho >= 0.0;
+}
+
+// ρ at distance d along (r, μ), clamped into the atmosphere (geometry::advance).
+fn rho_at(r: f32, rho: f32, mu: f32, d: f32) -> f32 {
+    return sqrt(clamp(d * d + 2.0 * r * mu * d + rho * rho, 0.0, atm.h_sq));
+}
+
+// Altitude (km) of a point given its ρ and r: (r² − R_g²)/(r + R_g).
+fn altitude_of(rho: f32, r: f32) -> f32 {
+    return rho * rho / (r + atm.bottom_radius);
+}
+
+// ---------------------------------------------------------------------------------------
+// Parameterisations (lut/params.rs).
+
+fn texcoord_from_unit(x: f32, n: u32) -> f32 {
+    return 0.5 / f32(n) + x * (1.0 - 1.0 / f32(n));
+}
+
+// Transmittance table (u, v) for (r, μ).
+fn transmittance_uv(r: f32, rho: f32, mu: f32) -> vec2<f32> {
+    let d = distance_to_top(r, rho, mu);
+    let d_min = (atm.h_sq - rho * rho) / (atm.top_radius + r);
+    let d_max = rho + atm.h;
+    var x_mu = 0.0;
+    if (d_max > d_min) {
+        x_mu = (d - d_min) / (d_max - d_min);
+    }
+    return vec2<f32>(texcoord_from_unit(x_mu, atm.transmittance_mu), texcoord_from_unit(rho / atm.h, atm.transmittance_r));
+}
+
+// (r, ρ, μ) at the centre of transmittance texel (x, y).
+fn transmittance_texel(x: u32, y: u32) -> vec3<f32> {
+    let x_mu = f32(x) / f32(atm.transmittance_mu - 1u);
+    let x_r = f32(y) / f32(atm.transmittance_r - 1u);
+    let rho = atm.h * x_r;
+    let r = radius_from_rho(rho);
+    let d_min = (atm.h_sq - rho * rho) / (atm.top_radius + r);
+    let d_max = rho + atm.h;
+    let d = d_min + x_mu * (d_max - d_min);
+    var mu = 1.0;
+    if (d != 0.0) {
+        mu = clamp_cosine((atm.h_sq - rho * rho - d * d) / (2.0 * r * d));
+    }
+    return vec3<f32>(r, rho, mu);
+}
+
+// Irradiance table: (u, v) for (altitude, μ_s), linear in both.
+fn irradiance_uv(altitude: f32, mu_s: f32) -> vec2<f32> {
+    let x_r = altitude / (atm.top_radius - atm.bottom_radius);
+    let x_mu_s = mu_s * 0.5 + 0.5;
+    return vec2<f32>(texcoord_from_unit(x_mu_s, atm.irradiance_mu_s), texcoord_from_unit(x_r, atm.irradiance_r));
+}
+
+// (r, ρ, μ_s) at the centre of irradiance texel (x, y).
+fn irradiance_texel(x: u32, y: u32) -> vec3<f32> {
+    let x_mu_s = f32(x) / f32(atm.irradiance_mu_s - 1u);
+    let x_r = f32(y) / f32(atm.irradiance_r - 1u);
+    let altitude = x_r * (atm.top_radius - atm.bottom_radius);
+    let r = atm.bottom_radius + altitude;
+    let rho = sqrt(altitude * (r + atm.bottom_radius));
+    return vec3<f32>(r, rho, clamp_cosine(2.0 * x_mu_s - 1.0));
+}
+
+// The non-linear μ_s coordinate in [0, 1] (params::x_mu_s).
+fn x_mu_s(mu_s: f32) -> f32 {
+    let d_min = atm.top_radius - atm.bottom_radius;
+    let d_max = atm.h;
+    let d = distance_to_top(atm.bottom_radius, 0.0, mu_s);
+    let a = (d - d_min) / (d_max - d_min);
+    return clamp(max(1.0 - a / atm.mu_s_big_a, 0.0) / (1.0 + a), 0.0, 1.0);
+}
+
+fn mu_s_from_x(x: f32) -> f32 {
+    let d_min = atm.top_radius - atm.bottom_radius;
+    let d_max = atm.h;
+    let big_a = atm.mu_s_big_a;
+    let a = (big_a - x * big_a) / (1.0 + x * big_a);
+    let d = d_min + min(a, big_a) * (d_max - d_min);
+    if (d == 0.0) {
+        return 1.0;
+    }
+    return clamp_cosine((atm.h_sq - d * d) / (2.0 * atm.bottom_radius * d));
+}
+
+// (u_ν, u_μs, u_μ, u_r) of the scattering table (params::scattering_uvwz).
+fn scattering_uvwz(r: f32, rho: f32, mu: f32, mu_s: f32, nu: f32, ground: bool) -> vec4<f32> {
+    let u_r = texcoord_from_unit(rho / atm.h, atm.scattering_r);
+    let r_mu = r * mu;
+    let discriminant = r_mu * r_mu - rho * rho;
+    let half = atm.scattering_mu / 2u;
+    var u_mu: f32;
+    if (ground) {
+        let d = distance_to_bottom(r, rho, mu);
+        let d_min = rho * rho / (r + atm.bottom_radius);
+        let d_max = rho;
+        var x = 0.0;
+        if (d_max != d_min) {
+            x = clamp((d - d_min) / (d_max - d_min), 0.0, 1.0);
+        }
+        u_mu = 0.5 - 0.5 * texcoord_from_unit(x, half);
+    } else {
+        let d = distance_to_top(r, rho, mu);
+        let d_min = (atm.h_sq - rho * rho) / (atm.top_radius + r);
+        let d_max = rho + atm.h;
+        var x = 0.0;
+        if (d_max > d_min) {
+            x = clamp((d - d_min) / (d_max - d_min), 0.0, 1.0);
+        }
+        u_mu = 0.5 + 0.5 * texcoord_from_unit(x, half);
+    }
+    let u_mu_s = texcoord_from_unit(x_mu_s(mu_s), atm.scattering_mu_s);
+    let u_nu = clamp((nu + 1.0) / 2.0, 0.0, 1.0);
+    return vec4<f32>(u_nu, u_mu_s, u_mu, u_r);
+}
+
+// A scattering texel's parameters.
+struct ScatteringTexel {
+    r: f32,
+    rho: f32,
+    mu: f32,
+    mu_s: f32,
+    nu: f32,
+    ground: bool,
+}
+
+// (r, ρ, μ, μ_s, ν, ground) at the centre of texel (x = ν·N_μs + μ_s, y = μ, z = r), ν
+// clamped to the range μ and μ_s allow (params::scattering_texel). Texel centres map to
+// exact unit coordinates i/(n − 1).
+fn scattering_texel(x: u32, y: u32, z: u32) -> ScatteringTexel {
+    var t: ScatteringTexel;
+    let i_nu = x / atm.scattering_mu_s;
+    let i_mu_s = x % atm.scattering_mu_s;
+    t.rho = atm.h * f32(z) / f32(atm.scattering_r - 1u);
+    t.r = radius_from_rho(t.rho);
+    let half = atm.scattering_mu / 2u;
+    if (y < half) {
+        let x_mu = f32(half - 1u - y) / f32(half - 1u);
+        let d_min = t.rho * t.rho / (t.r + atm.bottom_radius);
+        let d_max = t.rho;
+        let d = d_min + (d_max - d_min) * x_mu;
+        t.mu = -1.0;
+        if (d != 0.0) {
+            t.mu = clamp_cosine(-(t.rho * t.rho + d * d) / (2.0 * t.r * d));
+        }
+        t.ground = true;
+    } else {
+        let x_mu = f32(y - half) / f32(half - 1u);
+        let d_min = (atm.h_sq - t.rho * t.rho) / (atm.top_radius + t.r);
+        let d_max = t.rho + atm.h;
+        let d = d_min + (d_max - d_min) * x_mu;
+        t.mu = 1.0;
+        if (d != 0.0) {
+            t.mu = clamp_cosine((atm.h_sq - t.rho * t.rho - d * d) / (2.0 * t.r * d));
+        }
+        t.ground = false;
+    }
+    t.mu_s = mu_s_from_x(f32(i_mu_s) / f32(atm.scattering_mu_s - 1u));
+    let nu = clamp_cosine(f32(i_nu) / f32(atm.scattering_nu - 1u) * 2.0 - 1.0);
+    let spread = sqrt(max((1.0 - t.mu * t.mu) * (1.0 - t.mu_s * t.mu_s), 0.0));
+    t.nu = clamp(nu, t.mu * t.mu_s - spread, t.mu * t.mu_s + spread);
+    return t;
+}
+
+fn scattering_width() -> u32 {
+    return atm.scattering_nu * atm.scattering_mu_s;
+}
+
+fn scattering_texels() -> u32 {
+    return scattering_width() * atm.scattering_mu * atm.scattering_r;
+}
+
+// ---------------------------------------------------------------------------------------
+// Filtering with GPU texture semantics (lut/table.rs), done by hand on storage buffers so
+// the weights are exact f32 (hardware samplers quantise them).
+
+// (i0, i1, t) of linear filtering at texture coordinate u over n texels (clamp to edge).
+struct Lerp {
+    i0: u32,
+    i1: u32,
+    t: f32,
+}
+
+fn lerp_weights(u: f32, n: u32) -> Lerp {
+    let x = clamp(u * f32(n) - 0.5, 0.0, f32(n - 1u));
+    var l: Lerp;
+    l.i0 = min(u32(floor(x)), n - 1u);
+    l.i1 = min(l.i0 + 1u, n - 1u);
+    l.t = x - f32(l.i0);
+    return l;
+}
+
+// The 16 texels and weights of a 4D scattering lookup (Table4::sample_rows_into): trilinear
+// in (μ_s, μ, r) at the two nearest ν slices, then a lerp in ν.
+struct Filter4 {
+    index: array<u32, 16>,
+    weight: array<f32, 16>,
+}
+
+fn scattering_filter_rows(u_nu: f32, u_mu_s: f32, ly: Lerp, lz: Lerp) -> Filter4 {
+    let nnu = atm.scattering_nu;
+    let nmu_s = atm.scattering_mu_s;
+    let tex_x = u_nu * f32(nnu - 1u);
+    let nu0 = min(u32(floor(tex_x)), nnu - 1u);
+    let nu1 = min(nu0 + 1u, nnu - 1u);
+    let tnu = tex_x - f32(nu0);
+    let ls = lerp_weights(u_mu_s, nmu_s);
+    let width = scattering_width();
+    var zs = array<u32, 2>(lz.i0, lz.i1);
+    var wz = array<f32, 2>(1.0 - lz.t, lz.t);
+    var ys = array<u32, 2>(ly.i0, ly.i1);
+    var wy = array<f32, 2>(1.0 - ly.t, ly.t);
+    var ns = array<u32, 2>(nu0, nu1);
+    var wn = array<f32, 2>(1.0 - tnu, tnu);
+    var ss = array<u32, 2>(ls.i0, ls.i1);
+    var ws = array<f32, 2>(1.0 - ls.t, ls.t);
+    var f: Filter4;
+    var j = 0u;
+    for (var a = 0u; a < 2u; a++) {
+        for (var b = 0u; b < 2u; b++) {
+            let row = (zs[a] * atm.scattering_mu + ys[b]) * width;
+            for (var e = 0u; e < 2u; e++) {
+                for (var g = 0u; g < 2u; g++) {
+                    f.index[j] = (row + ns[e] * nmu_s + ss[g]) * atm.groups;
+                    f.weight[j] = wz[a] * wy[b] * wn[e] * ws[g];
+                    j++;
+                }
+            }
+        }
+    }
+    return f;
+}
+
+fn scattering_filter(uvwz: vec4<f32>) -> Filter4 {
+    return scattering_filter_rows(uvwz.x, uvwz.y, lerp_weights(uvwz.z, atm.scattering_mu), lerp_weights(uvwz.w, atm.scattering_r));
+}
+
+// Bilinear filter of a 2D table: the four texels (vec4 indices without the group) and weights.
+struct Filter2 {
+    index: vec4<u32>,
+    weight: vec4<f32>,
+}
+
+fn table2_filter(uv: vec2<f32>, width: u32, height: u32) -> Filter2 {
+    let lx = lerp_weights(uv.x, width);
+    let ly = lerp_weights(uv.y, height);
+    var f: Filter2;
+    f.index = vec4<u32>(ly.i0 * width + lx.i0, ly.i0 * width + lx.i1, ly.i1 * width + lx.i0, ly.i1 * width + lx.i1) * atm.groups;
+    f.weight = vec4<f32>((1.0 - lx.t) * (1.0 - ly.t), lx.t * (1.0 - ly.t), (1.0 - lx.t) * ly.t, lx.t * ly.t);
+    return f;
+}
+
+// Simpson weight (in units of the step) of sample s of the 50 intervals along view rays
+// (lut::precompute::RaySamples; Simpson rather than Bruneton's trapezoids).
+fn ray_weight(s: u32) -> f32 {
+    if (s == 0u || s == 50u) {
+        return 1.0 / 3.0;
+    }
+    return select(2.0 / 3.0, 4.0 / 3.0, s % 2u == 1u);
+}
+
+// GLSL smoothstep with the CPU's handling of an empty edge interval.
+fn smoothstep_safe(e0: f32, e1: f32, x: f32) -> f32 {
+    if (e1 <= e0) {
+        return select(1.0, 0.0, x < e0);
+    }
+    let t = clamp((x - e0) / (e1 - e0), 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
+}
+
+// ---------------------------------------------------------------------------------------
+// Table lookups (lut/context.rs). Passes bind the tables they read at these slots.
+
+@group(0) @binding(3) var<storage, read> transmittance_table: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> delta_irradiance_table: array<vec4<f32>>;
+// Order 2: ΔS_Rayleigh and ΔS_Mie (single scattering); order ≥ 3: ΔS twice. Also ΔJ for the
+// multiple-scattering pass (slot a).
+@group(0) @binding(5) var<storage, read> scattering_a: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read> scattering_b: array<vec4<f32>>;
+
+// T(r, μ) to the top of the atmosphere (ray assumed not to hit the ground).
+fn transmittance_to_top(r: f32, rho: f32, mu: f32, k: u32) -> vec4<f32> {
+    let f = table2_filter(transmittance_uv(r, rho, mu), atm.transmittance_mu, atm.transmittance_r);
+    return f.weight.x * transmittance_table[f.index.x + k] + f.weight.y * transmittance_table[f.index.y + k]
+        + f.weight.z * transmittance_table[f.index.z + k] + f.weight.w * transmittance_table[f.index.w + k];
+}
+
+// Transmittance over d km from (r, μ), from ratios of table values; the reversed ray when
+// it hits the ground (Bruneton 2017 `GetTransmittance`).
+fn transmittance(r: f32, rho: f32, mu: f32, d: f32, ground: bool, k: u32) -> vec4<f32> {
+    let rho_d = rho_at(r, rho, mu, d);
+    let r_d = radius_from_rho(rho_d);
+    let mu_d = clamp_cosine((r * mu + d) / r_d);
+    var a: vec4<f32>;
+    var b: vec4<f32>;
+    if (ground) {
+        a = transmittance_to_top(r_d, rho_d, -mu_d, k);
+        b = transmittance_to_top(r, rho, -mu, k);
+    } else {
+        a = transmittance_to_top(r, rho, mu, k);
+        b = transmittance_to_top(r_d, rho_d, mu_d, k);
+    }
+    return select(vec4<f32>(0.0), min(a / b, vec4<f32>(1.0)), b > vec4<f32>(0.0));
+}
+
+// Visible fraction of the sun's disk above the planet (smoothstep in μ_s over ± the sun's
+// angular radius around the horizon).
+fn sun_visible_fraction(r: f32, rho: f32, mu_s: f32) -> f32 {
+    let sin_theta_h = atm.bottom_radius / r;
+    let cos_theta_h = -rho / r;
+    let e = sin_theta_h * atm.sun_angular_radius;
+    return smoothstep_safe(-e, e, mu_s - cos_theta_h);
+}
+
+// Transmittance to the sun times its visible fraction (Bruneton 2017 `GetTransmittanceToSun`).
+fn transmittance_to_sun(r: f32, rho: f32, mu_s: f32, k: u32) -> vec4<f32> {
+    let fraction = sun_visible_fraction(r, rho, mu_s);
+    if (fraction <= 0.0) {
+        return vec4<f32>(0.0);
+    }
+    return transmittance_to_top(r, rho, mu_s, k) * fraction;
+}
+
+// ΔE at (altitude, μ_s).
+fn delta_irradiance(altitude: f32, mu_s: f32, k: u32) -> vec4<f32> {
+    let f = table2_filter(irradiance_uv(altitude, mu_s), atm.irradiance_mu_s, atm.irradiance_r);
+    return f.weight.x * delta_irradiance_table[f.index.x + k] + f.weight.y * delta_irradiance_table[f.index.y + k]
+        + f.weight.z * delta_irradiance_table[f.index.z + k] + f.weight.w * delta_irradiance_table[f.index.w + k];
+}
+
+fn sample_scattering_a(f: Filter4, k: u32) -> vec4<f32> {
+    var out = vec4<f32>(0.0);
+    for (var i = 0u; i < 16u; i++) {
+        out += f.weight[i] * scattering_a[f.index[i] + k];
+    }
+    return out;
+}
+
+fn sample_scattering_b(f: Filter4, k: u32) -> vec4<f32> {
+    var out = vec4<f32>(0.0);
+    for (var i = 0u; i < 16u; i++) {
+        out += f.weight[i] * scattering_b[f.index[i] + k];
+    }
+    return out;
+}
+
+// Radiance of the previous order towards (r, μ) for the sun at (μ_s, ν): single scattering
+// with the phase functions applied (mode 0), or ΔS (mode 1).
+fn previous_radiance(r: f32, rho: f32, mu: f32, mu_s: f32, nu: f32, ground: bool, k: u32) -> vec4<f32> {
+    let f = scattering_filter(scattering_uvwz(r, rho, mu, mu_s, nu, ground));
+    if (pass_params.mode == 0u) {
+        return sample_scattering_a(f, k) * group_phase(0u, nu) + sample_scattering_b(f, k) * group_phase(1u, nu);
+    }
+    return sample_scattering_a(f, k);
+}

@@ -1,0 +1,202 @@
+//! The adapter, device and queue, and how errors reported by the device reach the caller
+//! (never as a panic: wgpu's default handler for uncaptured errors panics).
+
+use std::sync::{Arc, Mutex};
+
+use crate::GpuError;
+
+/// A wgpu device chosen for compute work: a hardware GPU when there is one, a software
+/// rasteriser (Mesa's lavapipe, WARP, SwiftShader) otherwise.
+pub struct GpuContext {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    info: wgpu::AdapterInfo,
+    limits: wgpu::Limits,
+    /// Errors the device reported outside error scopes.
+    uncaptured: Arc<Mutex<Vec<String>>>,
+    /// Set when the device is lost.
+    lost: Arc<Mutex<Option<String>>>,
+}
+
+impl std::fmt::Debug for GpuContext {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GpuContext")
+            .field("adapter", &self.info.name)
+            .field("backend", &self.info.backend)
+            .finish()
+    }
+}
+
+/// Preference order of adapter kinds: hardware first, software last.
+fn rank(t: wgpu::DeviceType) -> u32 {
+    match t {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Other => 3,
+        wgpu::DeviceType::Cpu => 4,
+    }
+}
+
+impl GpuContext {
+    /// Open the best adapter with compute shaders: a discrete GPU, then an integrated or
+    /// virtual one, then a software rasteriser. Honours wgpu's environment variables
+    /// (`WGPU_BACKEND`, …). Errors when there is none.
+    pub fn new() -> Result<GpuContext, GpuError> {
+        pollster::block_on(Self::new_async())
+    }
+
+    async fn new_async() -> Result<GpuContext, GpuError> {
+        let desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        let backends = desc.backends;
+        let instance = wgpu::Instance::new(desc);
+        let mut adapters: Vec<wgpu::Adapter> = instance
+            .enumerate_adapters(backends)
+            .await
+            .into_iter()
+            .filter(|a| {
+                a.get_downlevel_capabilities()
+                    .flags
+                    .contains(wgpu::DownlevelFlags::COMPUTE_SHADERS)
+            })
+            .collect();
+        if adapters.is_empty() {
+            return Err(GpuError::NoAdapter(format!(
+                "backends searched: {backends:?}"
+            )));
+        }
+        adapters.sort_by_key(|a| rank(a.get_info().device_type));
+        let adapter = adapters.swap_remove(0);
+        let info = adapter.get_info();
+        // The adapter's own limits: the tables are large storage buffers.
+        let limits = adapter.limits();
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("firmament"),
+                required_features: wgpu::Features::empty(),
+                required_limits: limits.clone(),
+                experimental_features: wgpu::ExperimentalFeatures::default(),
+                memory_hints: wgpu::MemoryHints::Performance,
+                trace: wgpu::Trace::Off,
+            })
+            .await
+            .map_err(|e| GpuError::Device {
+                adapter: info.name.clone(),
+                reason: e.to_string(),
+            })?;
+        let uncaptured = Arc::new(Mutex::new(Vec::new()));
+        let sink = uncaptured.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            if let Ok(mut v) = sink.lock() {
+                v.push(e.to_string());
+            }
+        }));
+        let lost = Arc::new(Mutex::new(None));
+        let lost_sink = lost.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            if let Ok(mut v) = lost_sink.lock() {
+                *v = Some(format!("device lost ({reason:?}): {message}"));
+            }
+        });
+        let limits = device.limits();
+        Ok(GpuContext {
+            device,
+            queue,
+            info,
+            limits,
+            uncaptured,
+            lost,
+        })
+    }
+
+    /// The adapter's name, e.g. "NVIDIA GeForce RTX 4090" or "llvmpipe (LLVM 15.0.6, 256 bits)".
+    pub fn adapter_name(&self) -> &str {
+        &self.info.name
+    }
+
+    /// The graphics API in use (Vulkan, Metal, Dx12, …).
+    pub fn backend(&self) -> String {
+        format!("{:?}", self.info.backend)
+    }
+
+    /// Whether the adapter is a software rasteriser running on the CPU (lavapipe and the like).
+    pub fn is_software(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
+    /// The wgpu device.
+    pub fn device(&self) -> &wgpu::Device {
+        &self.device
+    }
+
+    /// The wgpu queue.
+    pub fn queue(&self) -> &wgpu::Queue {
+        &self.queue
+    }
+
+    /// The device's limits (the adapter's own, requested in full).
+    pub fn limits(&self) -> &wgpu::Limits {
+        &self.limits
+    }
+
+    /// Errors reported since the last call (uncaptured errors and device loss), as one
+    /// message, clearing them.
+    pub(crate) fn take_reported_errors(&self) -> Option<String> {
+        let mut messages = Vec::new();
+        if let Ok(mut v) = self.uncaptured.lock() {
+            messages.append(&mut v);
+        }
+        if let Ok(v) = self.lost.lock() {
+            if let Some(m) = v.as_ref() {
+                messages.push(m.clone());
+            }
+        }
+        if messages.is_empty() {
+            None
+        } else {
+            Some(messages.join("; "))
+        }
+    }
+}
+
+/// A context for test suites: `Some` when an adapter is found; when none is, `None` (the
+/// caller skips, saying so on stderr) unless the environment variable `CI` is set, in which
+/// case this panics so that a CI machine without a working driver fails instead of
+/// silently skipping the GPU tests.
+pub fn test_context() -> Option<GpuContext> {
+    decide_test_context(GpuContext::new(), std::env::var_os("CI").is_some())
+}
+
+fn decide_test_context(result: Result<GpuContext, GpuError>, ci: bool) -> Option<GpuContext> {
+    match result {
+        Ok(ctx) => Some(ctx),
+        Err(e) if ci => panic!("CI is set but no GPU adapter could be opened: {e}"),
+        Err(e) => {
+            eprintln!("skipping GPU test: {e}");
+            None
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    #[should_panic(expected = "CI is set")]
+    fn missing_adapter_fails_under_ci() {
+        decide_test_context(Err(GpuError::NoAdapter("test".into())), true);
+    }
+
+    #[test]
+    fn missing_adapter_skips_outside_ci() {
+        assert!(decide_test_context(Err(GpuError::NoAdapter("test".into())), false).is_none());
+    }
+
+    #[test]
+    fn hardware_ranks_before_software() {
+        assert!(rank(wgpu::DeviceType::DiscreteGpu) < rank(wgpu::DeviceType::IntegratedGpu));
+        assert!(rank(wgpu::DeviceType::IntegratedGpu) < rank(wgpu::DeviceType::Cpu));
+        assert!(rank(wgpu::DeviceType::Other) < rank(wgpu::DeviceType::Cpu));
+    }
+}

@@ -1,0 +1,245 @@
+//! The atmosphere as the shaders read it: the `Atmosphere` uniform of `functions.wgsl` (same
+//! field order) and a storage buffer of vec4 with per-wavelength data (channel groups of 4),
+//! constituents, density layers and tabulated phase functions. Lengths in km, coefficients
+//! in km⁻¹, computed in f64 and rounded once.
+
+use firmament::atmosphere::Model;
+use firmament::geometry::distance_to_top_atmosphere_boundary;
+use firmament::lut::TableSizes;
+use firmament::medium::{ConstituentKind, PhaseFunction};
+
+/// Wavelengths per channel group (one vec4).
+pub const GROUP: usize = 4;
+
+/// Channel groups for `channels` wavelengths.
+pub fn groups(channels: usize) -> usize {
+    channels.div_ceil(GROUP)
+}
+
+/// The scattering groups as the tables store them (lut::precompute::Groups): 0 molecules,
+/// 1 everything else that scatters; each group's phase function is its first member's.
+pub struct ScatteringGroups {
+    /// Group of each constituent (None: does not scatter).
+    pub of_constituent: Vec<Option<usize>>,
+    /// Phase function of each group.
+    pub phase: [PhaseFunction; 2],
+    /// Whether each group has members.
+    pub present: [bool; 2],
+    /// Group scattering coefficient at the ground per wavelength (m⁻¹).
+    pub ground_scattering: [Vec<f64>; 2],
+}
+
+impl ScatteringGroups {
+    pub fn new(model: &Model) -> ScatteringGroups {
+        let n = model.channels();
+        let mut of_constituent = Vec::new();
+        let mut phase = [
+            PhaseFunction::Rayleigh {
+                depolarization: 0.0,
+            },
+            PhaseFunction::HenyeyGreenstein { g: 0.0 },
+        ];
+        let mut present = [false, false];
+        let mut ground_scattering = [vec![0.0; n], vec![0.0; n]];
+        for c in &model.constituents {
+            if c.scattering.iter().all(|&s| s == 0.0) {
+                of_constituent.push(None);
+                continue;
+            }
+            let g = if c.kind == ConstituentKind::Molecules {
+                0
+            } else {
+                1
+            };
+            if !present[g] {
+                phase[g] = c.phase.clone();
+                present[g] = true;
+            }
+            let rho = c.density.density(0.0);
+            for k in 0..n {
+                ground_scattering[g][k] += rho * c.scattering[k];
+            }
+            of_constituent.push(Some(g));
+        }
+        ScatteringGroups {
+            of_constituent,
+            phase,
+            present,
+            ground_scattering,
+        }
+    }
+
+    /// β_M/β_R scaled to channel 0 (the ratio rule of `MieStorage::RedOnly`).
+    pub fn mie_ratio(&self) -> Vec<f64> {
+        let [r, m] = &self.ground_scattering;
+        (0..r.len())
+            .map(|k| {
+                if r[k] > 0.0 && m[0] > 0.0 && r[0] > 0.0 {
+                    (r[0] / m[0]) * (m[k] / r[k])
+                } else {
+                    0.0
+                }
+            })
+            .collect()
+    }
+}
+
+/// The packed atmosphere.
+pub struct Packed {
+    /// The `Atmosphere` uniform, one 32-bit word per field (padded to 16 bytes).
+    pub uniform: Vec<u32>,
+    /// The data storage buffer, 4 floats per vec4.
+    pub data: Vec<f32>,
+}
+
+/// A phase function as (kind, offset, count, a, b, c) of `phase_eval` in functions.wgsl;
+/// tabulated knots are appended to `data`.
+fn pack_phase(p: &PhaseFunction, data: &mut Vec<f32>) -> [u32; 6] {
+    let f = |x: f64| (x as f32).to_bits();
+    match p {
+        PhaseFunction::Isotropic => [0, 0, 0, 0, 0, 0],
+        PhaseFunction::Rayleigh { depolarization } => {
+            let gamma = depolarization / (2.0 - depolarization);
+            [1, 0, 0, f(1.0 + 3.0 * gamma), f(1.0 - gamma), 0]
+        }
+        PhaseFunction::HenyeyGreenstein { g } => [2, 0, 0, f(*g), 0, 0],
+        PhaseFunction::CornetteShanks { g } => [3, 0, 0, f(*g), 0, 0],
+        PhaseFunction::Schlick { g } => [4, 0, 0, f(1.55 * g - 0.55 * g * g * g), 0, 0],
+        PhaseFunction::DualLobeHg { g1, g2, weight } => [5, 0, 0, f(*g1), f(*g2), f(*weight)],
+        PhaseFunction::Tabulated(t) => {
+            let offset = (data.len() / 4) as u32;
+            for (theta, value) in t.angles().iter().zip(t.values()) {
+                data.extend_from_slice(&[*theta as f32, *value as f32, 0.0, 0.0]);
+            }
+            [6, offset, t.angles().len() as u32, 0, 0, 0]
+        }
+    }
+}
+
+/// Pack `model` for tables of `sizes`.
+pub fn pack(model: &Model, sizes: &TableSizes, groups_info: &ScatteringGroups) -> Packed {
+    let n = model.channels();
+    let g = groups(n);
+    let km = 1e-3;
+    let (bottom, top) = (model.bottom_radius_m, model.top_radius_m);
+    let h = (top * top - bottom * bottom).sqrt();
+    // The A of the μ_s mapping (params::x_mu_s) for μ_s,min.
+    let d_min = top - bottom;
+    let big_d = distance_to_top_atmosphere_boundary(bottom, model.mu_s_min, top);
+    let big_a = (big_d - d_min) / (h - d_min);
+
+    let mut data: Vec<f32> = Vec::new();
+    let per_wavelength = |data: &mut Vec<f32>, values: &[f64], scale: f64| {
+        for k in 0..g * GROUP {
+            data.push(if k < n {
+                (values[k] * scale) as f32
+            } else {
+                0.0
+            });
+        }
+    };
+    let solar_offset = data.len() / 4;
+    per_wavelength(&mut data, &model.solar_irradiance, 1.0);
+    let albedo_offset = data.len() / 4;
+    per_wavelength(&mut data, &model.ground_albedo, 1.0);
+    // Per constituent: info (first layer, layer count, group or −1), scattering, extinction.
+    let constituent_offset = data.len() / 4;
+    let mut first_layer = 0usize;
+    for (c, group) in model.constituents.iter().zip(&groups_info.of_constituent) {
+        let group = group.map_or(-1.0, |x| x as f32);
+        data.extend_from_slice(&[
+            first_layer as f32,
+            c.density.layers.len() as f32,
+            group,
+            0.0,
+        ]);
+        per_wavelength(&mut data, &c.scattering, 1.0 / km);
+        per_wavelength(&mut data, &c.extinction, 1.0 / km);
+        first_layer += c.density.layers.len();
+    }
+    // Layers: (width km, exp term, 1/H km⁻¹, linear term km⁻¹), (constant, 0, 0, 0).
+    let layer_offset = data.len() / 4;
+    for c in &model.constituents {
+        for l in &c.density.layers {
+            let inv_h = if l.scale_height_m.is_finite() && l.scale_height_m != 0.0 {
+                1.0 / (l.scale_height_m * km)
+            } else {
+                0.0
+            };
+            data.extend_from_slice(&[
+                (l.width_m * km) as f32,
+                l.exp_term as f32,
+                inv_h as f32,
+                (l.linear_term_per_m / km) as f32,
+                l.constant_term as f32,
+                0.0,
+                0.0,
+                0.0,
+            ]);
+        }
+    }
+    let phase0 = pack_phase(&groups_info.phase[0], &mut data);
+    let phase1 = pack_phase(&groups_info.phase[1], &mut data);
+
+    let f = |x: f64| (x as f32).to_bits();
+    let u = |x: usize| x as u32;
+    let mut uniform = vec![
+        f(bottom * km),
+        f(top * km),
+        f(h * km),
+        f(h * km * h * km),
+        f(model.mu_s_min),
+        f(big_a),
+        f(model.sun_angular_radius_rad),
+        u(n),
+        u(g),
+        u(model.constituents.len()),
+        u(sizes.transmittance_mu),
+        u(sizes.transmittance_r),
+        u(sizes.scattering_r),
+        u(sizes.scattering_mu),
+        u(sizes.scattering_mu_s),
+        u(sizes.scattering_nu),
+        u(sizes.irradiance_mu_s),
+        u(sizes.irradiance_r),
+        u(solar_offset),
+        u(albedo_offset),
+        u(constituent_offset),
+        u(layer_offset),
+    ];
+    uniform.extend_from_slice(&phase0);
+    uniform.extend_from_slice(&phase1);
+    uniform.push(groups_info.present[0] as u32);
+    uniform.push(groups_info.present[1] as u32);
+    while !uniform.len().is_multiple_of(4) {
+        uniform.push(0);
+    }
+    Packed { uniform, data }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use firmament::atmosphere::Atmosphere;
+    use firmament::spectrum::Wavelengths;
+
+    #[test]
+    fn uniform_has_the_shader_struct_size() {
+        let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
+        let groups_info = ScatteringGroups::new(&model);
+        let p = pack(&model, &TableSizes::small(), &groups_info);
+        // 36 fields of the WGSL `Atmosphere` struct.
+        assert_eq!(p.uniform.len(), 36);
+        assert_eq!(p.data.len() % 4, 0);
+        assert!(groups_info.present[0]);
+    }
+
+    #[test]
+    fn channel_groups_round_up() {
+        assert_eq!(groups(1), 1);
+        assert_eq!(groups(3), 1);
+        assert_eq!(groups(4), 1);
+        assert_eq!(groups(5), 2);
+        assert_eq!(groups(16), 4);
+    }
+}

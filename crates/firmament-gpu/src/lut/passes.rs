@@ -1,0 +1,196 @@
+//! Compute pipelines: one per WGSL pass file, each with `functions.wgsl` prepended, an
+//! explicit bind group layout (slots 0–2 always: atmosphere, pass parameters, data), and a
+//! dispatch helper that spreads large tables over two dispatch dimensions.
+
+use wgpu::util::DeviceExt;
+
+/// Shared functions, prepended to every pass.
+const FUNCTIONS: &str = include_str!("../../shaders/functions.wgsl");
+
+/// Workgroup size of every pass (`WORKGROUP` in functions.wgsl).
+pub const WORKGROUP: u32 = 64;
+
+/// How a pass uses a binding slot.
+#[derive(Clone, Copy, Debug)]
+pub enum Slot {
+    Uniform,
+    Read,
+    Write,
+}
+
+/// Binding slots every pass has.
+const COMMON: [(u32, Slot); 3] = [(0, Slot::Uniform), (1, Slot::Uniform), (2, Slot::Read)];
+
+/// A compute pipeline and its bind group layout.
+pub struct Pass {
+    pub name: &'static str,
+    pub pipeline: wgpu::ComputePipeline,
+    pub layout: wgpu::BindGroupLayout,
+    slots: Vec<u32>,
+}
+
+impl Pass {
+    /// Compile `source` (a pass file) with the shared functions; `slots` are the pass's own
+    /// bindings besides the common ones.
+    pub fn new(
+        device: &wgpu::Device,
+        name: &'static str,
+        source: &str,
+        slots: &[(u32, Slot)],
+    ) -> Pass {
+        let code = format!("{FUNCTIONS}\n{source}");
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(name),
+            source: wgpu::ShaderSource::Wgsl(code.into()),
+        });
+        let entries: Vec<wgpu::BindGroupLayoutEntry> = COMMON
+            .iter()
+            .chain(slots)
+            .map(|&(binding, slot)| wgpu::BindGroupLayoutEntry {
+                binding,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: match slot {
+                    Slot::Uniform => wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    Slot::Read => wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    Slot::Write => wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: false },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                },
+                count: None,
+            })
+            .collect();
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(name),
+            entries: &entries,
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(name),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(name),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some("main"),
+            compilation_options: wgpu::PipelineCompilationOptions::default(),
+            cache: None,
+        });
+        let slots = COMMON.iter().chain(slots).map(|s| s.0).collect();
+        Pass {
+            name,
+            pipeline,
+            layout,
+            slots,
+        }
+    }
+
+    /// A bind group with `common` at slots 0–2 and `buffers` at the pass's own slots, in
+    /// the order they were declared.
+    pub fn bind(
+        &self,
+        device: &wgpu::Device,
+        common: [&wgpu::Buffer; 3],
+        buffers: &[&wgpu::Buffer],
+    ) -> wgpu::BindGroup {
+        assert_eq!(
+            self.slots.len(),
+            3 + buffers.len(),
+            "{}: wrong number of buffers",
+            self.name
+        );
+        let entries: Vec<wgpu::BindGroupEntry> = self
+            .slots
+            .iter()
+            .zip(common.iter().chain(buffers))
+            .map(|(&binding, b)| wgpu::BindGroupEntry {
+                binding,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(self.name),
+            layout: &self.layout,
+            entries: &entries,
+        })
+    }
+}
+
+/// Workgroup counts (x, y) covering `invocations` with 64-wide workgroups, x at most
+/// `max_per_dimension` (the shaders rebuild the flat index from both).
+pub fn workgroups(invocations: usize, max_per_dimension: u32) -> (u32, u32) {
+    let total = invocations.div_ceil(WORKGROUP as usize).max(1);
+    let x = total.min(max_per_dimension as usize);
+    let y = total.div_ceil(x);
+    (x as u32, y as u32)
+}
+
+/// Record one dispatch of `pass` over `invocations`, for `groups` channel groups (z).
+pub fn dispatch(
+    cpass: &mut wgpu::ComputePass,
+    pass: &Pass,
+    bind_group: &wgpu::BindGroup,
+    invocations: usize,
+    groups: usize,
+    max_per_dimension: u32,
+) {
+    let (x, y) = workgroups(invocations, max_per_dimension);
+    cpass.set_pipeline(&pass.pipeline);
+    cpass.set_bind_group(0, bind_group, &[]);
+    cpass.dispatch_workgroups(x, y, groups as u32);
+}
+
+/// A storage buffer of `bytes` bytes (at least 16).
+pub fn storage(device: &wgpu::Device, label: &str, bytes: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes.max(16),
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+/// A buffer initialised with `contents` (at least 16 bytes).
+pub fn init(
+    device: &wgpu::Device,
+    label: &str,
+    contents: &[u8],
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    let mut bytes = contents.to_vec();
+    while bytes.len() < 16 || !bytes.len().is_multiple_of(16) {
+        bytes.push(0);
+    }
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: &bytes,
+        usage,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn workgroups_cover_large_tables_within_the_dimension_limit() {
+        assert_eq!(workgroups(1, 65535), (1, 1));
+        assert_eq!(workgroups(64, 65535), (1, 1));
+        assert_eq!(workgroups(65, 65535), (2, 1));
+        let (x, y) = workgroups(64 << 20, 65535);
+        assert!(x <= 65535 && y <= 65535);
+        assert!(x as usize * y as usize * 64 >= 64 << 20);
+    }
+}
