@@ -37,6 +37,8 @@ struct View {
     camera: Camera,
     sun: (f64, f64),
     size: (usize, usize),
+    /// Added to the automatic exposure (stops darker), for views whose bright part is small.
+    ev_offset: f64,
 }
 
 fn views(width: usize) -> Vec<View> {
@@ -51,15 +53,15 @@ fn views(width: usize) -> Vec<View> {
     };
     use Projection::*;
     vec![
-        View { name: "noon", title: "Noon from the ground, looking north (sun 60° high in the south)", camera: cam(Perspective, 2.0, 0.0, 12.0, 80.0), sun: (30.0, 180.0), size: (width, h) },
-        View { name: "afternoon", title: "Afternoon, facing the sun (30° high)", camera: cam(Perspective, 2.0, 240.0, 12.0, 80.0), sun: (60.0, 240.0), size: (width, h) },
-        View { name: "sunset", title: "Sunset (sun 1° high in the west)", camera: cam(Perspective, 2.0, 270.0, 6.0, 80.0), sun: (89.0, 270.0), size: (width, h) },
-        View { name: "twilight", title: "Twilight, facing east away from the sun 4° below the horizon: Earth's shadow and the Belt of Venus", camera: cam(Perspective, 2.0, 90.0, 8.0, 80.0), sun: (94.0, 270.0), size: (width, h) },
-        View { name: "altitude-10km", title: "From 10 km, looking down the aerial perspective", camera: cam(Perspective, 10_000.0, 200.0, -8.0, 80.0), sun: (50.0, 160.0), size: (width, h) },
-        View { name: "low-orbit", title: "From low orbit (400 km), the limb with the sun low", camera: cam(Perspective, 400_000.0, 90.0, -17.0, 60.0), sun: (75.0, 90.0), size: (width, h) },
-        View { name: "planet", title: "The whole planet from 30 000 km: limb, terminator, night side", camera: cam(Orbit, 30_000_000.0, 0.0, 0.0, orbit_fit_fov_deg(6_424_000.0, 36_360_000.0)), sun: (75.0, 90.0), size: (width * 2 / 3, width * 2 / 3) },
-        View { name: "fisheye", title: "All-sky fisheye (equidistant, north up, east left), sun 45° high in the south-east", camera: cam(Fisheye, 2.0, 0.0, 0.0, 60.0), sun: (45.0, 135.0), size: (width * 2 / 3, width * 2 / 3) },
-        View { name: "equirect", title: "Equirectangular environment map (north at the centre column), sun 20° high in the east-south-east", camera: cam(Equirect, 2.0, 0.0, 0.0, 60.0), sun: (70.0, 120.0), size: (width, width / 2) },
+        View { name: "noon", title: "Noon from the ground, looking north (sun 60° high in the south)", camera: cam(Perspective, 2.0, 0.0, 12.0, 80.0), sun: (30.0, 180.0), size: (width, h), ev_offset: 0.0 },
+        View { name: "afternoon", title: "Afternoon, facing the sun (30° high)", camera: cam(Perspective, 2.0, 240.0, 12.0, 80.0), sun: (60.0, 240.0), size: (width, h), ev_offset: 0.0 },
+        View { name: "sunset", title: "Sunset (sun 1° high in the west)", camera: cam(Perspective, 2.0, 270.0, 6.0, 80.0), sun: (89.0, 270.0), size: (width, h), ev_offset: 0.0 },
+        View { name: "twilight", title: "Twilight, facing east away from the sun 4° below the horizon: Earth's shadow and the Belt of Venus", camera: cam(Perspective, 2.0, 90.0, 8.0, 80.0), sun: (94.0, 270.0), size: (width, h), ev_offset: 0.0 },
+        View { name: "altitude-10km", title: "From 10 km, looking down the aerial perspective", camera: cam(Perspective, 10_000.0, 200.0, -8.0, 80.0), sun: (50.0, 160.0), size: (width, h), ev_offset: 0.0 },
+        View { name: "low-orbit", title: "From low orbit (400 km), the limb with the sun low", camera: cam(Perspective, 400_000.0, 90.0, -17.0, 60.0), sun: (75.0, 90.0), size: (width, h), ev_offset: 0.0 },
+        View { ev_offset: 1.5, name: "planet", title: "The whole planet from 30 000 km: limb, terminator, night side", camera: cam(Orbit, 30_000_000.0, 0.0, 0.0, orbit_fit_fov_deg(6_424_000.0, 36_360_000.0)), sun: (75.0, 90.0), size: (width * 2 / 3, width * 2 / 3) },
+        View { name: "fisheye", title: "All-sky fisheye (equidistant, north up, east left), sun 45° high in the south-east", camera: cam(Fisheye, 2.0, 0.0, 0.0, 60.0), sun: (45.0, 135.0), size: (width * 2 / 3, width * 2 / 3), ev_offset: 0.0 },
+        View { name: "equirect", title: "Equirectangular environment map (north at the centre column), sun 20° high in the east-south-east", camera: cam(Equirect, 2.0, 0.0, 0.0, 60.0), sun: (70.0, 120.0), size: (width, width / 2), ev_offset: 0.0 },
     ]
 }
 
@@ -93,6 +95,7 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
         scene.validate()?;
         let t = Instant::now();
         let (frame, ev100) = render_scene(&sky, &scene, true)?;
+        let ev100 = ev100 + v.ev_offset;
         write_outputs(&frame, &scene, ev100, false, true)?;
         if !args.quiet {
             eprintln!(

@@ -520,30 +520,45 @@ fn compute_single_scattering(model: &Model, lookup: &Lookup, groups: &Groups) ->
                     groups.scattering_into(model, g, alt, &mut beta[g][i * n..(i + 1) * n]);
                 }
             }
-            let sun_rows: Vec<SunRow> =
-                (0..count).map(|i| SunRow::new(lookup, rays.r[i])).collect();
+            let texels: Vec<(f64, f64)> = (0..width)
+                .map(|x| {
+                    let (_, _, mu_s, nu, _) = params::scattering_texel(&lookup.radii, &s, x, y, z);
+                    (mu_s, nu)
+                })
+                .collect();
+            // Samples outer, texels inner: each sample's transmittance row stays in cache.
             let mut t_sun = vec![0.0; n];
-            let mut acc = [vec![0.0; n], vec![0.0; n]];
-            for x in 0..width {
-                let (_, _, mu_s, nu, _) = params::scattering_texel(&lookup.radii, &s, x, y, z);
-                acc.iter_mut()
-                    .for_each(|a| a.iter_mut().for_each(|v| *v = 0.0));
-                for i in 0..count {
-                    let r_d = rays.r[i];
-                    let mu_s_d = ((r * mu_s + rays.d[i] * nu) / r_d).clamp(-1.0, 1.0);
-                    if !sun_rows[i].transmittance_to_sun(lookup, mu_s_d, &mut t_sun) {
+            let mut acc_r = vec![0.0; width * n];
+            let mut acc_m = vec![0.0; width * n];
+            let mut tb = [vec![0.0; n], vec![0.0; n]];
+            for i in 0..count {
+                let sun_row = SunRow::new(lookup, rays.r[i]);
+                let (d_i, inv_r_i) = (rays.d[i], 1.0 / rays.r[i]);
+                for k in 0..n {
+                    let t = rays.w[i] * rays.t[i * n + k];
+                    tb[0][k] = t * beta[0][i * n + k];
+                    tb[1][k] = t * beta[1][i * n + k];
+                }
+                for (x, &(mu_s, nu)) in texels.iter().enumerate() {
+                    let mu_s_d = ((r * mu_s + d_i * nu) * inv_r_i).clamp(-1.0, 1.0);
+                    if !sun_row.transmittance_to_sun(lookup, mu_s_d, &mut t_sun) {
                         continue;
                     }
+                    let (ar, am) = (
+                        &mut acc_r[x * n..(x + 1) * n],
+                        &mut acc_m[x * n..(x + 1) * n],
+                    );
                     for k in 0..n {
-                        let t = rays.w[i] * rays.t[i * n + k] * t_sun[k];
-                        acc[0][k] += t * beta[0][i * n + k];
-                        acc[1][k] += t * beta[1][i * n + k];
+                        ar[k] += tb[0][k] * t_sun[k];
+                        am[k] += tb[1][k] * t_sun[k];
                     }
                 }
+            }
+            for x in 0..width {
                 for k in 0..n {
                     let e = model.solar_irradiance[k] * rays.dx;
-                    out_r[x * n + k] = (acc[0][k] * e) as f32;
-                    out_m[x * n + k] = (acc[1][k] * e) as f32;
+                    out_r[x * n + k] = (acc_r[x * n + k] * e) as f32;
+                    out_m[x * n + k] = (acc_m[x * n + k] * e) as f32;
                 }
             }
         });
@@ -923,24 +938,31 @@ fn compute_multiple_scattering(model: &Model, lookup: &Lookup, density: &Table4)
             }
             let nmu_s = s.scattering_mu_s;
             let mu_s_map = params::MuSMap::new(&g);
-            let mut acc = vec![0.0; n];
-            for x in 0..width {
-                let (_, _, mu_s, nu, _) = params::scattering_texel(&g, &s, x, y, z);
-                let tex_x = ((nu + 1.0) / 2.0).clamp(0.0, 1.0) * (s.scattering_nu - 1) as f64;
-                let nu0 = (tex_x as usize).min(s.scattering_nu - 1);
-                let nu1 = (nu0 + 1).min(s.scattering_nu - 1);
-                let tnu = tex_x - nu0 as f64;
-                acc.iter_mut().for_each(|v| *v = 0.0);
-                for i in 0..count {
-                    let mu_s_i = ((r * mu_s + rays.d[i] * nu) / rays.r[i]).clamp(-1.0, 1.0);
+            // Per texel: (μ_s, ν) and the ν filter, once.
+            let texels: Vec<(f64, f64, usize, usize, f64)> = (0..width)
+                .map(|x| {
+                    let (_, _, mu_s, nu, _) = params::scattering_texel(&g, &s, x, y, z);
+                    let tex_x = ((nu + 1.0) / 2.0).clamp(0.0, 1.0) * (s.scattering_nu - 1) as f64;
+                    let nu0 = (tex_x as usize).min(s.scattering_nu - 1);
+                    let nu1 = (nu0 + 1).min(s.scattering_nu - 1);
+                    (mu_s, nu, nu0 * nmu_s, nu1 * nmu_s, tex_x - nu0 as f64)
+                })
+                .collect();
+            // Samples outer, texels inner: each sample's filtered row stays in cache.
+            let mut acc = vec![0.0; width * n];
+            for i in 0..count {
+                let b = &blended[i * row_len..(i + 1) * row_len];
+                let t_i = &rays.t[i * n..(i + 1) * n];
+                let (d_i, inv_r_i, wt) = (rays.d[i], 1.0 / rays.r[i], rays.w[i]);
+                for (x, &(mu_s, nu, base0, base1, tnu)) in texels.iter().enumerate() {
+                    let mu_s_i = ((r * mu_s + d_i * nu) * inv_r_i).clamp(-1.0, 1.0);
                     let u_mu_s = params::texcoord_from_unit(mu_s_map.x(mu_s_i), nmu_s);
                     let (s0, s1, ts) = lerp_weights(u_mu_s, nmu_s);
-                    let b = &blended[i * row_len..(i + 1) * row_len];
                     let (a0, a1, a2, a3) = (
-                        (nu0 * nmu_s + s0) * n,
-                        (nu0 * nmu_s + s1) * n,
-                        (nu1 * nmu_s + s0) * n,
-                        (nu1 * nmu_s + s1) * n,
+                        (base0 + s0) * n,
+                        (base0 + s1) * n,
+                        (base1 + s0) * n,
+                        (base1 + s1) * n,
                     );
                     let (w0, w1, w2, w3) = (
                         (1.0 - tnu) * (1.0 - ts),
@@ -948,15 +970,15 @@ fn compute_multiple_scattering(model: &Model, lookup: &Lookup, density: &Table4)
                         tnu * (1.0 - ts),
                         tnu * ts,
                     );
-                    let wt = rays.w[i];
+                    let a = &mut acc[x * n..(x + 1) * n];
                     for k in 0..n {
                         let j = w0 * b[a0 + k] + w1 * b[a1 + k] + w2 * b[a2 + k] + w3 * b[a3 + k];
-                        acc[k] += wt * rays.t[i * n + k] * j;
+                        a[k] += wt * t_i[k] * j;
                     }
                 }
-                for k in 0..n {
-                    o[x * n + k] = (acc[k] * rays.dx) as f32;
-                }
+            }
+            for (o, a) in o.iter_mut().zip(&acc) {
+                *o = (a * rays.dx) as f32;
             }
         });
     out

@@ -177,16 +177,20 @@ impl Frame {
     /// Tone-mapped 8-bit sRGB: exposure scale × luminance-scaled colour, then the curve, then
     /// the sRGB transfer function.
     pub fn to_srgb8(&self, exposure: f64, curve: ToneCurve) -> Vec<[u8; 3]> {
-        // The 8-bit code is the one whose interval contains the value: binary search on the
-        // 255 decision levels (decoded mid-points), same result as rounding the encoded value.
+        // A 2¹⁶-entry table of the 8-bit code of each tone-mapped value in [0, 1]: the code
+        // whose interval contains it (binary search on the 255 decision levels, the decoded
+        // mid-points), then one lookup per channel.
         let levels: Vec<f32> = (0..255)
             .map(|i| srgb_decode((i as f64 + 0.5) / 255.0) as f32)
             .collect();
-        let encode = |v: f32| levels.partition_point(|&l| l <= v) as u8;
+        let table: Vec<u8> = (0..=65535u32)
+            .map(|i| levels.partition_point(|&l| l <= i as f32 / 65535.0) as u8)
+            .collect();
+        let encode = |v: f64| table[(v.clamp(0.0, 1.0) * 65535.0 + 0.5) as usize];
         self.image
             .data
             .par_iter()
-            .map(|p| p.map(|v| encode(curve.apply(v as f64 * exposure) as f32)))
+            .map(|p| p.map(|v| encode(curve.apply(v as f64 * exposure))))
             .collect()
     }
 }
