@@ -375,8 +375,7 @@ fn scattering_uvwz(r: f32, rho: f32, mu: f32, mu_s: f32, nu: f32, ground: bool) 
         u_mu = 0.5 + 0.5 * texcoord_from_unit(x, half);
     }
     let u_mu_s = texcoord_from_unit(x_mu_s(mu_s), atm.scattering_mu_s);
-    let u_nu = clamp((nu + 1.0) / 2.0, 0.0, 1.0);
-    return vec4<f32>(u_nu, u_mu_s, u_mu, u_r);
+    return vec4<f32>(u_nu_from_nu(nu), u_mu_s, u_mu, u_r);
 }
 
 // A scattering texel's parameters.
@@ -421,7 +420,7 @@ fn scattering_texel(x: u32, y: u32, z: u32) -> ScatteringTexel {
         t.ground = false;
     }
     t.mu_s = mu_s_from_x(f32(i_mu_s) / f32(atm.scattering_mu_s - 1u));
-    let nu = clamp_cosine(f32(i_nu) / f32(atm.scattering_nu - 1u) * 2.0 - 1.0);
+    let nu = nu_from_u_nu(f32(i_nu) / f32(atm.scattering_nu - 1u));
     let spread = sqrt(max((1.0 - t.mu * t.mu) * (1.0 - t.mu_s * t.mu_s), 0.0));
     t.nu = clamp(nu, t.mu * t.mu_s - spread, t.mu * t.mu_s + spread);
     return t;
@@ -617,4 +616,15 @@ fn previous_radiance(r: f32, rho: f32, mu: f32, mu_s: f32, nu: f32, ground: bool
         return sample_scattering_a(f, k) * group_phase(0u, nu) + sample_scattering_b(f, k) * group_phase(1u, nu);
     }
     return sample_scattering_a(f, k);
+}
+
+// The ν coordinate, mirroring params.rs: u_ν = 1 − sqrt((1 − ν)/2), uniform in the angle
+// from the sun.
+fn u_nu_from_nu(nu: f32) -> f32 {
+    return 1.0 - sqrt(0.5 * (1.0 - clamp(nu, -1.0, 1.0)));
+}
+
+fn nu_from_u_nu(u_nu: f32) -> f32 {
+    let x = 1.0 - clamp(u_nu, 0.0, 1.0);
+    return clamp_cosine(1.0 - 2.0 * x * x);
 }

@@ -28,7 +28,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         ray_length = distance_to_top(t.r, t.rho, t.mu);
     }
     let dx = ray_length / f32(RAY_INTERVALS);
-    let u_nu = clamp((t.nu + 1.0) / 2.0, 0.0, 1.0);
+    let u_nu = u_nu_from_nu(t.nu);
     var acc = vec4<f32>(0.0);
     for (var s = 0u; s <= RAY_INTERVALS; s++) {
         let d = f32(s) * dx;

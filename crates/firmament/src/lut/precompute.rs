@@ -942,7 +942,7 @@ fn compute_multiple_scattering(model: &Model, lookup: &Lookup, density: &Table4)
             let texels: Vec<(f64, f64, usize, usize, f64)> = (0..width)
                 .map(|x| {
                     let (_, _, mu_s, nu, _) = params::scattering_texel(&g, &s, x, y, z);
-                    let tex_x = ((nu + 1.0) / 2.0).clamp(0.0, 1.0) * (s.scattering_nu - 1) as f64;
+                    let tex_x = params::u_nu_from_nu(nu) * (s.scattering_nu - 1) as f64;
                     let nu0 = (tex_x as usize).min(s.scattering_nu - 1);
                     let nu1 = (nu0 + 1).min(s.scattering_nu - 1);
                     (mu_s, nu, nu0 * nmu_s, nu1 * nmu_s, tex_x - nu0 as f64)
