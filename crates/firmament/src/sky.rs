@@ -88,9 +88,19 @@ impl Sky {
         scat: &mut [f64],
         mie: &mut [f64],
     ) {
-        let uvwz =
-            crate::lut::params::scattering_uvwz(&lk.radii, &lk.sizes, r, mu, mu_s, nu, ground);
         let slice = slice.filter(|s| s.r == r && s.mu_s == mu_s);
+        let uvwz = match slice {
+            // The slice already filtered (μ_s, r): only u_ν and u_μ are needed.
+            Some(_) => [
+                crate::lut::params::u_nu_from_nu(nu),
+                0.0,
+                crate::lut::params::scattering_u_mu(&lk.radii, &lk.sizes, r, mu, ground),
+                0.0,
+            ],
+            None => {
+                crate::lut::params::scattering_uvwz(&lk.radii, &lk.sizes, r, mu, mu_s, nu, ground)
+            }
+        };
         match slice {
             Some(s) => {
                 self.tables
@@ -192,7 +202,7 @@ impl Sky {
         let n = self.channels();
         let Some((camera, r, rmu)) = self.enter_atmosphere(camera, view) else {
             radiance[..n].iter_mut().for_each(|v| *v = 0.0);
-            transmittance[..n].iter_mut().for_each(|v| *v = 1.0);
+            transmittance.iter_mut().for_each(|v| *v = 1.0);
             return;
         };
         let lk = self.lookup();
@@ -200,7 +210,9 @@ impl Sky {
         let mu_s = (dot(camera, sun) / r).clamp(-1.0, 1.0);
         let nu = dot(view, sun).clamp(-1.0, 1.0);
         let ground = ray_intersects_ground(r, mu, self.model.bottom_radius_m);
-        if ground {
+        // An empty `transmittance` asks for radiance only (saves a lookup per sky pixel).
+        if transmittance.is_empty() {
+        } else if ground {
             transmittance[..n].iter_mut().for_each(|v| *v = 0.0);
         } else {
             lk.transmittance_to_top(r, mu, transmittance);

@@ -199,13 +199,28 @@ pub fn scattering_uvwz(
     nu: f64,
     ray_r_mu_intersects_ground: bool,
 ) -> [f64; 4] {
+    let rho = safe_sqrt(r * r - g.bottom * g.bottom);
+    let u_r = texcoord_from_unit(rho / g.h(), s.scattering_r);
+    let u_mu = scattering_u_mu(g, s, r, mu, ray_r_mu_intersects_ground);
+    let u_mu_s = texcoord_from_unit(x_mu_s(g, mu_s), s.scattering_mu_s);
+    [u_nu_from_nu(nu), u_mu_s, u_mu, u_r]
+}
+
+/// The u_μ coordinate of [`scattering_uvwz`] alone (for lookups at a known (r, μ_s)).
+#[inline]
+pub fn scattering_u_mu(
+    g: &Radii,
+    s: &TableSizes,
+    r: f64,
+    mu: f64,
+    ray_r_mu_intersects_ground: bool,
+) -> f64 {
     let h = g.h();
     let rho = safe_sqrt(r * r - g.bottom * g.bottom);
-    let u_r = texcoord_from_unit(rho / h, s.scattering_r);
     let r_mu = r * mu;
     let discriminant = r_mu * r_mu - r * r + g.bottom * g.bottom;
     let half = s.scattering_mu / 2;
-    let u_mu = if ray_r_mu_intersects_ground {
+    if ray_r_mu_intersects_ground {
         // Distance to the ground, mapped to the lower half [0, 0.5].
         let d = -r_mu - safe_sqrt(discriminant);
         let d_min = r - g.bottom;
@@ -227,9 +242,7 @@ pub fn scattering_uvwz(
             0.0
         };
         0.5 + 0.5 * texcoord_from_unit(x, half)
-    };
-    let u_mu_s = texcoord_from_unit(x_mu_s(g, mu_s), s.scattering_mu_s);
-    [u_nu_from_nu(nu), u_mu_s, u_mu, u_r]
+    }
 }
 
 /// [`x_mu_s`] with its constants computed once (hot loops).
@@ -263,6 +276,41 @@ impl MuSMap {
         let d = distance_to_top_atmosphere_boundary(self.bottom, mu_s, self.top);
         let a = (d - self.d_min) * self.inv_range;
         ((1.0 - a / self.big_a).max(0.0) / (1.0 + a)).clamp(0.0, 1.0)
+    }
+}
+
+/// [`x_mu_s`] tabulated as texel positions for fast filtering (multiple-scattering hot loop):
+/// `position(μ_s)` = u·n − 0.5 clamped to [0, n − 1], linear in a 4097-entry table over
+/// μ_s ∈ [−1, 1] (the mapping is smooth; the table error is below 10⁻⁵ texel).
+pub struct MuSPositions {
+    n: usize,
+    table: Vec<f64>,
+}
+
+impl MuSPositions {
+    /// For `n` μ_s texels.
+    pub fn new(g: &Radii, n: usize) -> MuSPositions {
+        let map = MuSMap::new(g);
+        let k = 4096;
+        let table = (0..=k)
+            .map(|j| {
+                let mu_s = -1.0 + 2.0 * j as f64 / k as f64;
+                (texcoord_from_unit(map.x(mu_s), n) * n as f64 - 0.5).clamp(0.0, (n - 1) as f64)
+            })
+            .collect();
+        MuSPositions { n, table }
+    }
+
+    /// (s0, s1, t): the two texels and the weight of s1.
+    #[inline]
+    pub fn filter(&self, mu_s: f64) -> (usize, usize, f64) {
+        let k = self.table.len() - 1;
+        let f = (mu_s.clamp(-1.0, 1.0) + 1.0) * 0.5 * k as f64;
+        let j = (f as usize).min(k - 1);
+        let t = f - j as f64;
+        let p = self.table[j] + t * (self.table[j + 1] - self.table[j]);
+        let s0 = (p as usize).min(self.n - 1);
+        (s0, (s0 + 1).min(self.n - 1), p - s0 as f64)
     }
 }
 

@@ -433,6 +433,7 @@ impl RaySamples {
 struct SunRow {
     r: f64,
     rho: f64,
+    h: f64,
     cos_h: f64,
     eps: f64,
     row: Vec<f64>,
@@ -453,6 +454,7 @@ impl SunRow {
             .collect();
         let sin_h = g.bottom / r;
         SunRow {
+            h: g.h(),
             r,
             rho,
             cos_h: -crate::geometry::safe_sqrt(1.0 - sin_h * sin_h),
@@ -471,7 +473,7 @@ impl SunRow {
         let g = &lookup.radii;
         let d = crate::geometry::distance_to_top_atmosphere_boundary(self.r, mu_s, g.top);
         let d_min = g.top - self.r;
-        let d_max = self.rho + g.h();
+        let d_max = self.rho + self.h;
         let x_mu = if d_max > d_min {
             (d - d_min) / (d_max - d_min)
         } else {
@@ -904,6 +906,7 @@ fn compute_multiple_scattering(model: &Model, lookup: &Lookup, density: &Table4)
     let row_len = out.row_len();
     let width = out.width();
     let g = lookup.radii;
+    let mu_s_positions = params::MuSPositions::new(&g, s.scattering_mu_s);
     out.data
         .par_chunks_mut(row_len)
         .enumerate()
@@ -937,7 +940,6 @@ fn compute_multiple_scattering(model: &Model, lookup: &Lookup, density: &Table4)
                 }
             }
             let nmu_s = s.scattering_mu_s;
-            let mu_s_map = params::MuSMap::new(&g);
             // Per texel: (μ_s, ν) and the ν filter, once.
             let texels: Vec<(f64, f64, usize, usize, f64)> = (0..width)
                 .map(|x| {
@@ -956,8 +958,7 @@ fn compute_multiple_scattering(model: &Model, lookup: &Lookup, density: &Table4)
                 let (d_i, inv_r_i, wt) = (rays.d[i], 1.0 / rays.r[i], rays.w[i]);
                 for (x, &(mu_s, nu, base0, base1, tnu)) in texels.iter().enumerate() {
                     let mu_s_i = ((r * mu_s + d_i * nu) * inv_r_i).clamp(-1.0, 1.0);
-                    let u_mu_s = params::texcoord_from_unit(mu_s_map.x(mu_s_i), nmu_s);
-                    let (s0, s1, ts) = lerp_weights(u_mu_s, nmu_s);
+                    let (s0, s1, ts) = mu_s_positions.filter(mu_s_i);
                     let (a0, a1, a2, a3) = (
                         (base0 + s0) * n,
                         (base0 + s1) * n,

@@ -115,9 +115,13 @@ pub fn shade_sliced(
             out[k] += model.ground_albedo[k] / PI * (e_sun[k] + e_sky[k]) * t[k];
         }
     } else {
-        sky.sky_radiance_sliced(slice, ray.origin, ray.dir, 0.0, options.sun, out, t);
-        if options.sun_disk {
+        let in_disk =
+            options.sun_disk && dot(ray.dir, options.sun) > model.sun_angular_radius_rad.cos();
+        if in_disk {
+            sky.sky_radiance_sliced(slice, ray.origin, ray.dir, 0.0, options.sun, out, t);
             add_sun_disk(sky, ray.dir, options.sun, t, out);
+        } else {
+            sky.sky_radiance_sliced(slice, ray.origin, ray.dir, 0.0, options.sun, out, &mut []);
         }
     }
 }
