@@ -246,30 +246,12 @@ fn check_unit(field: &str, v: f64) -> Result<()> {
 }
 
 fn check_table(field: &str, wavelengths_nm: &[f64], values: &[f64]) -> Result<()> {
-    if wavelengths_nm.is_empty() {
-        return Err(Error::invalid(
-            format!("{field}.wavelengths_nm"),
-            "[]",
-            "at least one wavelength",
-        ));
-    }
-    if wavelengths_nm.len() != values.len() {
-        return Err(Error::invalid(
-            format!("{field}.values"),
-            format!("{} values", values.len()),
-            format!("as many values as wavelengths ({})", wavelengths_nm.len()),
-        ));
-    }
-    for (i, w) in wavelengths_nm.iter().enumerate() {
-        if !(w.is_finite() && *w > 0.0) || (i > 0 && *w <= wavelengths_nm[i - 1]) {
-            return Err(Error::invalid(
-                format!("{field}.wavelengths_nm[{i}]"),
-                w,
-                "positive wavelengths in increasing order",
-            ));
-        }
-    }
-    Ok(())
+    crate::medium::constituent::check_wavelength_table(
+        field,
+        "values",
+        wavelengths_nm,
+        values.len(),
+    )
 }
 
 /// Linear interpolation in a table with held ends.

@@ -191,18 +191,8 @@ impl Model {
         if length_m <= 0.0 {
             return;
         }
-        const X: [f64; 4] = [
-            -0.861_136_311_594_052_6,
-            -0.339_981_043_584_856_3,
-            0.339_981_043_584_856_3,
-            0.861_136_311_594_052_6,
-        ];
-        const W: [f64; 4] = [
-            0.347_854_845_137_453_9,
-            0.652_145_154_862_546_1,
-            0.652_145_154_862_546_1,
-            0.347_854_845_137_453_9,
-        ];
+        const X: [f64; 4] = crate::medium::profile::GL4_NODES;
+        const W: [f64; 4] = crate::medium::profile::GL4_WEIGHTS;
         let h = length_m / segments as f64;
         for i in 0..segments {
             let c = (i as f64 + 0.5) * h;

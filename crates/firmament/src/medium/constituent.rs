@@ -99,29 +99,7 @@ impl Coefficient {
                 wavelengths_nm,
                 values_per_m,
             } => {
-                if wavelengths_nm.is_empty() {
-                    return Err(Error::invalid(
-                        format!("{field}.wavelengths_nm"),
-                        "[]",
-                        "at least one wavelength",
-                    ));
-                }
-                if wavelengths_nm.len() != values_per_m.len() {
-                    return Err(Error::invalid(
-                        format!("{field}.values_per_m"),
-                        format!("{} values", values_per_m.len()),
-                        format!("as many values as wavelengths ({})", wavelengths_nm.len()),
-                    ));
-                }
-                for (i, w) in wavelengths_nm.iter().enumerate() {
-                    if !(w.is_finite() && *w > 0.0) || (i > 0 && *w <= wavelengths_nm[i - 1]) {
-                        return Err(Error::invalid(
-                            format!("{field}.wavelengths_nm[{i}]"),
-                            w,
-                            "positive wavelengths in increasing order",
-                        ));
-                    }
-                }
+                check_wavelength_table(field, "values_per_m", wavelengths_nm, values_per_m.len())?;
                 for (i, v) in values_per_m.iter().enumerate() {
                     nonneg(&format!("values_per_m[{i}]"), *v)?;
                 }
@@ -208,6 +186,40 @@ impl Coefficient {
             })
             .collect()
     }
+}
+
+/// Check a table over wavelength: non-empty, as many values (field `values_name`) as
+/// wavelengths, wavelengths positive and increasing. `field` is the table's path.
+pub(crate) fn check_wavelength_table(
+    field: &str,
+    values_name: &str,
+    wavelengths_nm: &[f64],
+    values: usize,
+) -> Result<()> {
+    if wavelengths_nm.is_empty() {
+        return Err(Error::invalid(
+            format!("{field}.wavelengths_nm"),
+            "[]",
+            "at least one wavelength",
+        ));
+    }
+    if wavelengths_nm.len() != values {
+        return Err(Error::invalid(
+            format!("{field}.{values_name}"),
+            format!("{values} values"),
+            format!("as many values as wavelengths ({})", wavelengths_nm.len()),
+        ));
+    }
+    for (i, w) in wavelengths_nm.iter().enumerate() {
+        if !(w.is_finite() && *w > 0.0) || (i > 0 && *w <= wavelengths_nm[i - 1]) {
+            return Err(Error::invalid(
+                format!("{field}.wavelengths_nm[{i}]"),
+                w,
+                "positive wavelengths in increasing order",
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Interpolate a table as a power law between samples (linear in log–log), extrapolating

@@ -404,18 +404,8 @@ impl<'a> Channel<'a> {
     /// Optical depth along [0, t_end] (composite Gauss–Legendre, split at the closest
     /// approach to the planet centre).
     pub(crate) fn optical_depth(&self, x0: f64, b: f64, t_end: f64) -> f64 {
-        const X: [f64; 4] = [
-            -0.861_136_311_594_052_6,
-            -0.339_981_043_584_856_3,
-            0.339_981_043_584_856_3,
-            0.861_136_311_594_052_6,
-        ];
-        const W: [f64; 4] = [
-            0.347_854_845_137_453_9,
-            0.652_145_154_862_546_1,
-            0.652_145_154_862_546_1,
-            0.347_854_845_137_453_9,
-        ];
+        const X: [f64; 4] = crate::medium::profile::GL4_NODES;
+        const W: [f64; 4] = crate::medium::profile::GL4_WEIGHTS;
         if t_end <= 0.0 || self.parts.is_empty() {
             return 0.0;
         }
@@ -537,18 +527,8 @@ impl<'a> Channel<'a> {
 
     /// The cumulative optical depth along a camera ray, for forced first collisions.
     pub(crate) fn primary(&self, frame: &Frame, o: Vec3, d: Vec3, intervals: usize) -> Primary {
-        const X: [f64; 4] = [
-            -0.861_136_311_594_052_6,
-            -0.339_981_043_584_856_3,
-            0.339_981_043_584_856_3,
-            0.861_136_311_594_052_6,
-        ];
-        const W: [f64; 4] = [
-            0.347_854_845_137_453_9,
-            0.652_145_154_862_546_1,
-            0.652_145_154_862_546_1,
-            0.347_854_845_137_453_9,
-        ];
+        const X: [f64; 4] = crate::medium::profile::GL4_NODES;
+        const W: [f64; 4] = crate::medium::profile::GL4_WEIGHTS;
         let x0 = frame.x(o);
         let b = frame.b(o, d);
         let (t_end, ground) = self.boundary(x0, b);
