@@ -3,7 +3,7 @@
 
 use super::{interpolate_linear, Albedo, Atmosphere, LimbDarkening, SolarSpectrum};
 use crate::geometry;
-use crate::medium::{profile::gauss_legendre, ConstituentKind, ResolvedConstituent};
+use crate::medium::{ConstituentKind, ResolvedConstituent};
 use crate::spectrum::{self, Wavelengths};
 
 /// Resolved atmosphere. Per-wavelength vectors all have `wavelengths.len()` entries.
@@ -254,13 +254,6 @@ impl Model {
             }
         }
         d
-    }
-
-    /// Column of a constituent's absorber in Dobson units (its number density times the
-    /// profile, for `ozone-column` coefficients: recovered from the resolved coefficient).
-    pub fn column_integral_m(&self, index: usize) -> f64 {
-        let c = &self.constituents[index];
-        gauss_legendre(|h| c.density.density(h), 0.0, self.height_m(), 2048)
     }
 }
 

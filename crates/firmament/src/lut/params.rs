@@ -334,14 +334,7 @@ pub fn nu_from_u_nu(u_nu: f64) -> f64 {
 /// along the sun ray from the ground, with the configurable minimum sun elevation.
 #[inline]
 pub fn x_mu_s(g: &Radii, mu_s: f64) -> f64 {
-    let h = g.h();
-    let d_min = g.top - g.bottom;
-    let d_max = h;
-    let d = distance_to_top_atmosphere_boundary(g.bottom, mu_s, g.top);
-    let a = (d - d_min) / (d_max - d_min);
-    let big_d = distance_to_top_atmosphere_boundary(g.bottom, g.mu_s_min, g.top);
-    let big_a = (big_d - d_min) / (d_max - d_min);
-    ((1.0 - a / big_a).max(0.0) / (1.0 + a)).clamp(0.0, 1.0)
+    MuSMap::new(g).x(mu_s)
 }
 
 /// Inverse of [`x_mu_s`].

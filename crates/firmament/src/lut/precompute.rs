@@ -181,7 +181,7 @@ pub fn precompute(
     let mut scattering = delta_rayleigh.clone();
 
     if orders >= 2 {
-        let kernels = PhaseKernels::new(model, &lookup, &groups);
+        let kernels = PhaseKernels::new(&lookup, &groups);
         let mut delta_multiple = Table4::new(
             s.scattering_r,
             s.scattering_mu,
@@ -191,39 +191,27 @@ pub fn precompute(
         );
         for order in 2..=orders {
             report(&format!("scattering density, order {order}"));
-            let density = {
-                let previous = if order == 2 {
-                    Previous::Single {
-                        rayleigh: &delta_rayleigh,
-                        mie: &delta_mie,
-                        groups: &groups,
-                    }
-                } else {
-                    Previous::Multiple(&delta_multiple)
-                };
-                compute_scattering_density(
-                    model,
-                    &lookup,
-                    &groups,
-                    &kernels,
-                    &previous,
-                    &delta_irradiance,
-                )
+            // The radiance of the previous order feeds both ΔJ and ΔE.
+            let previous = if order == 2 {
+                Previous::Single {
+                    rayleigh: &delta_rayleigh,
+                    mie: &delta_mie,
+                    groups: &groups,
+                }
+            } else {
+                Previous::Multiple(&delta_multiple)
             };
+            let density = compute_scattering_density(
+                model,
+                &lookup,
+                &groups,
+                &kernels,
+                &previous,
+                &delta_irradiance,
+            );
             check_cancel(cancel)?;
             report(&format!("indirect irradiance, order {}", order - 1));
-            delta_irradiance = {
-                let previous = if order == 2 {
-                    Previous::Single {
-                        rayleigh: &delta_rayleigh,
-                        mie: &delta_mie,
-                        groups: &groups,
-                    }
-                } else {
-                    Previous::Multiple(&delta_multiple)
-                };
-                compute_indirect_irradiance(model, &lookup, &previous)
-            };
+            delta_irradiance = compute_indirect_irradiance(model, &lookup, &previous);
             irradiance.add_assign(&delta_irradiance);
             report(&format!("multiple scattering, order {order}"));
             delta_multiple = compute_multiple_scattering(model, &lookup, &density);
@@ -619,11 +607,10 @@ struct PhaseKernels {
 }
 
 impl PhaseKernels {
-    fn new(model: &Model, lookup: &Lookup, groups: &Groups) -> PhaseKernels {
+    fn new(lookup: &Lookup, groups: &Groups) -> PhaseKernels {
         let s = &lookup.sizes;
         let per_row = DENSITY_THETA * 2 * HARMONICS;
         let mut b = vec![0.0; s.scattering_r * s.scattering_mu * per_row];
-        let _ = model;
         b.par_chunks_mut(per_row)
             .enumerate()
             .for_each(|(row, out)| {

@@ -136,7 +136,7 @@ impl Camera {
         }
     }
 
-    fn ray_slow(
+    fn ray_all_round(
         &self,
         bottom_radius_m: f64,
         width: usize,
@@ -151,16 +151,9 @@ impl Camera {
             1.0 - 2.0 * py / height as f64,
         );
         let local = match self.projection {
-            Projection::Perspective => {
-                self.perspective(u, v, width as f64 / height as f64, self.fov_deg)
-            }
-            Projection::Orbit => {
-                // Look straight down (towards the centre), `heading` at the top of the image.
-                let down = Camera {
-                    pitch_deg: -90.0,
-                    ..self.clone()
-                };
-                down.perspective(u, v, width as f64 / height as f64, self.fov_deg)
+            // Pinhole projections go through PreparedCamera::ray.
+            Projection::Perspective | Projection::Orbit => {
+                unreachable!("handled by PreparedCamera")
             }
             Projection::Fisheye => {
                 // Square inscribed circle; zenith angle proportional to radius (equidistant).
@@ -198,14 +191,6 @@ impl Camera {
             origin,
             dir: normalize(local),
         })
-    }
-
-    /// A perspective ray in the local frame for NDC (u, v).
-    fn perspective(&self, u: f64, v: f64, aspect: f64, fov_deg: f64) -> Vec3 {
-        let (forward, right, up) = self.basis();
-        let t = (fov_deg.to_radians() / 2.0).tan();
-        let d = add_scaled(add_scaled(forward, u * t * aspect, right), v * t, up);
-        normalize(d)
     }
 
     /// (forward, right, up) unit vectors of the view in the local frame.
@@ -267,7 +252,7 @@ impl PreparedCamera {
             }
             _ => self
                 .camera
-                .ray_slow(self.bottom_radius_m, self.width, self.height, px, py),
+                .ray_all_round(self.bottom_radius_m, self.width, self.height, px, py),
         }
     }
 }
