@@ -351,10 +351,15 @@ fn mu_s_from_x(x: f32) -> f32 {
 // (u_ν, u_μs, u_μ, u_r) of the scattering table (params::scattering_uvwz).
 fn scattering_uvwz(r: f32, rho: f32, mu: f32, mu_s: f32, nu: f32, ground: bool) -> vec4<f32> {
     let u_r = texcoord_from_unit(rho / atm.h, atm.scattering_r);
-    let r_mu = r * mu;
-    let discriminant = r_mu * r_mu - rho * rho;
+    let u_mu = scattering_u_mu(r, rho, mu, ground);
+    let u_mu_s = texcoord_from_unit(x_mu_s(mu_s), atm.scattering_mu_s);
+    return vec4<f32>(u_nu_from_nu(nu), u_mu_s, u_mu, u_r);
+}
+
+// The u_μ coordinate alone (params::scattering_u_mu): the distance to the ground mapped to
+// the lower half for rays that hit it, the distance to the top to the upper half otherwise.
+fn scattering_u_mu(r: f32, rho: f32, mu: f32, ground: bool) -> f32 {
     let half = atm.scattering_mu / 2u;
-    var u_mu: f32;
     if (ground) {
         let d = distance_to_bottom(r, rho, mu);
         let d_min = rho * rho / (r + atm.bottom_radius);
@@ -363,19 +368,16 @@ fn scattering_uvwz(r: f32, rho: f32, mu: f32, mu_s: f32, nu: f32, ground: bool) 
         if (d_max != d_min) {
             x = clamp((d - d_min) / (d_max - d_min), 0.0, 1.0);
         }
-        u_mu = 0.5 - 0.5 * texcoord_from_unit(x, half);
-    } else {
-        let d = distance_to_top(r, rho, mu);
-        let d_min = (atm.h_sq - rho * rho) / (atm.top_radius + r);
-        let d_max = rho + atm.h;
-        var x = 0.0;
-        if (d_max > d_min) {
-            x = clamp((d - d_min) / (d_max - d_min), 0.0, 1.0);
-        }
-        u_mu = 0.5 + 0.5 * texcoord_from_unit(x, half);
+        return 0.5 - 0.5 * texcoord_from_unit(x, half);
     }
-    let u_mu_s = texcoord_from_unit(x_mu_s(mu_s), atm.scattering_mu_s);
-    return vec4<f32>(u_nu_from_nu(nu), u_mu_s, u_mu, u_r);
+    let d = distance_to_top(r, rho, mu);
+    let d_min = (atm.h_sq - rho * rho) / (atm.top_radius + r);
+    let d_max = rho + atm.h;
+    var x = 0.0;
+    if (d_max > d_min) {
+        x = clamp((d - d_min) / (d_max - d_min), 0.0, 1.0);
+    }
+    return 0.5 + 0.5 * texcoord_from_unit(x, half);
 }
 
 // A scattering texel's parameters.
@@ -455,10 +457,15 @@ fn lerp_weights(u: f32, n: u32) -> Lerp {
 }
 
 // The 16 texels and weights of a 4D scattering lookup (Table4::sample_rows_into): trilinear
-// in (μ_s, μ, r) at the two nearest ν slices, then a lerp in ν.
+// in (μ_s, μ, r) at the two nearest ν slices, then a lerp in ν. Texel (i, j) is
+// row[i] + col[j] with weight wrow[i]·wcol[j]: rows are the (r, μ) pairs (z0 y0, z0 y1,
+// z1 y0, z1 y1), columns the (ν, μ_s) pairs (ν0 s0, ν0 s1, ν1 s0, ν1 s1). Vectors, not
+// arrays: no dynamically indexed private memory (slow on software rasterisers).
 struct Filter4 {
-    index: array<u32, 16>,
-    weight: array<f32, 16>,
+    row: vec4<u32>,
+    col: vec4<u32>,
+    wrow: vec4<f32>,
+    wcol: vec4<f32>,
 }
 
 fn scattering_filter_rows(u_nu: f32, u_mu_s: f32, ly: Lerp, lz: Lerp) -> Filter4 {
@@ -470,28 +477,15 @@ fn scattering_filter_rows(u_nu: f32, u_mu_s: f32, ly: Lerp, lz: Lerp) -> Filter4
     let tnu = tex_x - f32(nu0);
     let ls = lerp_weights(u_mu_s, nmu_s);
     let width = scattering_width();
-    var zs = array<u32, 2>(lz.i0, lz.i1);
-    var wz = array<f32, 2>(1.0 - lz.t, lz.t);
-    var ys = array<u32, 2>(ly.i0, ly.i1);
-    var wy = array<f32, 2>(1.0 - ly.t, ly.t);
-    var ns = array<u32, 2>(nu0, nu1);
-    var wn = array<f32, 2>(1.0 - tnu, tnu);
-    var ss = array<u32, 2>(ls.i0, ls.i1);
-    var ws = array<f32, 2>(1.0 - ls.t, ls.t);
+    let z = vec4<u32>(lz.i0, lz.i0, lz.i1, lz.i1);
+    let y = vec4<u32>(ly.i0, ly.i1, ly.i0, ly.i1);
+    let n = vec4<u32>(nu0, nu0, nu1, nu1);
+    let ms = vec4<u32>(ls.i0, ls.i1, ls.i0, ls.i1);
     var f: Filter4;
-    var j = 0u;
-    for (var a = 0u; a < 2u; a++) {
-        for (var b = 0u; b < 2u; b++) {
-            let row = (zs[a] * atm.scattering_mu + ys[b]) * width;
-            for (var e = 0u; e < 2u; e++) {
-                for (var g = 0u; g < 2u; g++) {
-                    f.index[j] = (row + ns[e] * nmu_s + ss[g]) * atm.groups;
-                    f.weight[j] = wz[a] * wy[b] * wn[e] * ws[g];
-                    j++;
-                }
-            }
-        }
-    }
+    f.row = (z * atm.scattering_mu + y) * width;
+    f.col = n * nmu_s + ms;
+    f.wrow = vec4<f32>(1.0 - lz.t, 1.0 - lz.t, lz.t, lz.t) * vec4<f32>(1.0 - ly.t, ly.t, 1.0 - ly.t, ly.t);
+    f.wcol = vec4<f32>(1.0 - tnu, 1.0 - tnu, tnu, tnu) * vec4<f32>(1.0 - ls.t, ls.t, 1.0 - ls.t, ls.t);
     return f;
 }
 
@@ -592,20 +586,27 @@ fn delta_irradiance(altitude: f32, mu_s: f32, k: u32) -> vec4<f32> {
         + f.weight.z * delta_irradiance_table[f.index.z + k] + f.weight.w * delta_irradiance_table[f.index.w + k];
 }
 
+// Σ over the four (ν, μ_s) columns of one (r, μ) row, channel group k.
+fn scattering_a_row(f: Filter4, row: u32, k: u32) -> vec4<f32> {
+    let g = atm.groups;
+    return f.wcol.x * scattering_a[(row + f.col.x) * g + k] + f.wcol.y * scattering_a[(row + f.col.y) * g + k]
+        + f.wcol.z * scattering_a[(row + f.col.z) * g + k] + f.wcol.w * scattering_a[(row + f.col.w) * g + k];
+}
+
+fn scattering_b_row(f: Filter4, row: u32, k: u32) -> vec4<f32> {
+    let g = atm.groups;
+    return f.wcol.x * scattering_b[(row + f.col.x) * g + k] + f.wcol.y * scattering_b[(row + f.col.y) * g + k]
+        + f.wcol.z * scattering_b[(row + f.col.z) * g + k] + f.wcol.w * scattering_b[(row + f.col.w) * g + k];
+}
+
 fn sample_scattering_a(f: Filter4, k: u32) -> vec4<f32> {
-    var out = vec4<f32>(0.0);
-    for (var i = 0u; i < 16u; i++) {
-        out += f.weight[i] * scattering_a[f.index[i] + k];
-    }
-    return out;
+    return f.wrow.x * scattering_a_row(f, f.row.x, k) + f.wrow.y * scattering_a_row(f, f.row.y, k)
+        + f.wrow.z * scattering_a_row(f, f.row.z, k) + f.wrow.w * scattering_a_row(f, f.row.w, k);
 }
 
 fn sample_scattering_b(f: Filter4, k: u32) -> vec4<f32> {
-    var out = vec4<f32>(0.0);
-    for (var i = 0u; i < 16u; i++) {
-        out += f.weight[i] * scattering_b[f.index[i] + k];
-    }
-    return out;
+    return f.wrow.x * scattering_b_row(f, f.row.x, k) + f.wrow.y * scattering_b_row(f, f.row.y, k)
+        + f.wrow.z * scattering_b_row(f, f.row.z, k) + f.wrow.w * scattering_b_row(f, f.row.w, k);
 }
 
 // Radiance of the previous order towards (r, μ) for the sun at (μ_s, ν): single scattering

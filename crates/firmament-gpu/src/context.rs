@@ -70,10 +70,12 @@ impl GpuContext {
         let info = adapter.get_info();
         // The adapter's own limits: the tables are large storage buffers.
         let limits = adapter.limits();
+        // Timestamp queries when offered: GPU-side timings of the render dispatch.
+        let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("firmament"),
-                required_features: wgpu::Features::empty(),
+                required_features: features,
                 required_limits: limits.clone(),
                 experimental_features: wgpu::ExperimentalFeatures::default(),
                 memory_hints: wgpu::MemoryHints::Performance,
@@ -122,6 +124,13 @@ impl GpuContext {
     /// Whether the adapter is a software rasteriser running on the CPU (lavapipe and the like).
     pub fn is_software(&self) -> bool {
         self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
+    /// Whether the device writes timestamp queries (`wgpu::Features::TIMESTAMP_QUERY`).
+    pub fn supports_timestamps(&self) -> bool {
+        self.device
+            .features()
+            .contains(wgpu::Features::TIMESTAMP_QUERY)
     }
 
     /// The wgpu device.

@@ -19,8 +19,8 @@ pub enum GpuError {
     /// Parameters the CPU path refuses too.
     #[error(transparent)]
     Invalid(#[from] firmament::Error),
-    /// Tables that do not fit the device's limits.
-    #[error("{what} needs {needed} but the GPU adapter `{adapter}` allows at most {limit} ({limit_name}); use smaller tables or fewer wavelengths")]
+    /// Tables or frames that do not fit the device's limits.
+    #[error("{what} needs {needed} but the GPU adapter `{adapter}` allows at most {limit} ({limit_name}); use smaller tables, fewer wavelengths or a smaller frame")]
     Limit {
         /// What needed too much.
         what: String,

@@ -15,6 +15,12 @@
 //! assert_eq!(tables.channels(), 3);
 //! ```
 //!
+//! Frames render on the GPU too ([`render`]): [`GpuSky`] holds the tables (uploaded from a
+//! CPU [`firmament::sky::Sky`], or precomputed and kept on the device with
+//! [`GpuSky::precompute`]), [`GpuRenderer::render`] returns the CPU renderer's
+//! [`firmament::render::Frame`] for the same settings, and [`GpuRenderer::time_render`]
+//! times the dispatch alone.
+//!
 //! Shaders are WGSL under `shaders/`, one file per pass plus `functions.wgsl` shared by all
 //! (it mirrors the CPU's parameterisations and lookups). The atmosphere travels in uniform
 //! and storage buffers; changing it compiles nothing.
@@ -22,7 +28,9 @@
 mod context;
 mod error;
 pub mod lut;
+pub mod render;
 
 pub use context::{test_context, GpuContext};
 pub use error::GpuError;
 pub use lut::precompute;
+pub use render::{GpuRenderer, GpuSky, RenderTiming};

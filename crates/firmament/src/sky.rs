@@ -416,24 +416,35 @@ pub fn limb_darkening(law: LimbDarkening, mu: f64, lambda_nm: f64) -> f64 {
     match law {
         LimbDarkening::None => 1.0,
         LimbDarkening::Neckel1996 => {
+            let mu = mu.clamp(0.0, 1.0);
+            let mut s = 0.0;
+            let mut p = 1.0;
+            for c in limb_darkening_coefficients(law, lambda_nm) {
+                s += c * p;
+                p *= mu;
+            }
+            s.max(0.0)
+        }
+    }
+}
+
+/// The polynomial coefficients a_0..a_5 of [`limb_darkening`] at `lambda_nm`
+/// (I(μ)/I(1) = max(Σ a_k μ^k, 0), μ clamped to [0, 1]); `[1, 0, …]` without darkening.
+/// For backends that evaluate the law themselves (the GPU renderer).
+pub fn limb_darkening_coefficients(law: LimbDarkening, lambda_nm: f64) -> [f64; 6] {
+    match law {
+        LimbDarkening::None => [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        LimbDarkening::Neckel1996 => {
             let l = (lambda_nm.clamp(422.5, 1100.0)) / 1000.0;
             let l5 = l.powi(5);
-            let a = [
+            [
                 0.75267 - 0.265577 / l,
                 0.93874 + 0.265577 / l - 0.004095 / l5,
                 -1.89287 + 0.012582 / l5,
                 2.42234 - 0.017117 / l5,
                 -1.71150 + 0.011977 / l5,
                 0.49062 - 0.003347 / l5,
-            ];
-            let mu = mu.clamp(0.0, 1.0);
-            let mut s = 0.0;
-            let mut p = 1.0;
-            for c in a {
-                s += c * p;
-                p *= mu;
-            }
-            s.max(0.0)
+            ]
         }
     }
 }

@@ -10,7 +10,7 @@
 //! weights, as `firmament::lut::table` does, so CPU and GPU compare texel by texel.
 
 pub mod atmosphere;
-mod passes;
+pub(crate) mod passes;
 
 use firmament::atmosphere::Model;
 use firmament::lut::{MieStorage, Table2, Table4, TableConfig, Tables};
@@ -24,6 +24,19 @@ const DENSITY_THETA: usize = 32;
 const HARMONICS: usize = 16;
 /// Storage buffers bound at once by the widest pass (the density field).
 const STORAGE_BUFFERS_NEEDED: u32 = 6;
+
+/// The tables as the precomputation leaves them on the device: channel groups padded to
+/// vec4, single Mie in full even for [`MieStorage::RedOnly`] (the host keeps channel 0), and
+/// the packed atmosphere they were computed with.
+pub(crate) struct DeviceTables {
+    pub atmosphere: wgpu::Buffer,
+    pub data: wgpu::Buffer,
+    pub transmittance: wgpu::Buffer,
+    pub irradiance: wgpu::Buffer,
+    pub scattering: wgpu::Buffer,
+    pub single_mie: wgpu::Buffer,
+    pub row_sums: wgpu::Buffer,
+}
 
 /// Compiled pipelines, reusable across precomputations on one context.
 pub struct Precomputer {
@@ -51,7 +64,7 @@ pub fn precompute(
 
 /// Run `f` inside validation, out-of-memory and internal error scopes; the first error
 /// reported (or reported to the uncaptured handler, or a device loss) becomes `Err`.
-fn scoped<T>(
+pub(crate) fn scoped<T>(
     ctx: &GpuContext,
     during: &str,
     f: impl FnOnce() -> Result<T, GpuError>,
@@ -151,6 +164,114 @@ impl Precomputer {
         model: &Model,
         config: &TableConfig,
     ) -> Result<Tables, GpuError> {
+        let tables = self.run_on_device(ctx, model, config)?;
+        let n = model.channels();
+        let s = config.sizes;
+        let g = groups(n);
+        let orders = config.orders;
+        let t_texels = s.transmittance_mu * s.transmittance_r;
+        let e_texels = s.irradiance_mu_s * s.irradiance_r;
+        let s_texels = s.scattering_r * s.scattering_mu * s.scattering_mu_s * s.scattering_nu;
+        let rows = s.scattering_r * s.scattering_mu;
+        let groups_info = ScatteringGroups::new(model);
+        let device = ctx.device();
+        let staging = scoped(ctx, "table precomputation", || {
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("firmament tables readback"),
+            });
+            let sources = [
+                &tables.transmittance,
+                &tables.irradiance,
+                &tables.scattering,
+                &tables.single_mie,
+                &tables.row_sums,
+            ];
+            let staging: Vec<wgpu::Buffer> = sources
+                .iter()
+                .map(|src| {
+                    let b = device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("readback"),
+                        size: src.size(),
+                        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                        mapped_at_creation: false,
+                    });
+                    encoder.copy_buffer_to_buffer(src, 0, &b, 0, src.size());
+                    b
+                })
+                .collect();
+            ctx.queue().submit([encoder.finish()]);
+            Ok(staging)
+        })?;
+        let values = scoped(ctx, "reading the tables back", || read_back(ctx, &staging))?;
+        let [t_data, e_data, s_data, m_data, rows_data] =
+            <[Vec<f32>; 5]>::try_from(values).expect("five buffers");
+        let unpad = |v: &[f32], texels: usize| -> Vec<f32> {
+            let mut out = Vec::with_capacity(texels * n);
+            for t in 0..texels {
+                out.extend_from_slice(&v[t * g * GROUP..t * g * GROUP + n]);
+            }
+            out
+        };
+        let transmittance = Table2 {
+            width: s.transmittance_mu,
+            height: s.transmittance_r,
+            channels: n,
+            data: unpad(&t_data, t_texels),
+        };
+        let irradiance = Table2 {
+            width: s.irradiance_mu_s,
+            height: s.irradiance_r,
+            channels: n,
+            data: unpad(&e_data, e_texels),
+        };
+        let table4 = |data: Vec<f32>, channels: usize| Table4 {
+            nr: s.scattering_r,
+            nmu: s.scattering_mu,
+            nmu_s: s.scattering_mu_s,
+            nnu: s.scattering_nu,
+            channels,
+            data,
+        };
+        let scattering = table4(unpad(&s_data, s_texels), n);
+        let single_mie = match config.mie {
+            MieStorage::Separate => table4(unpad(&m_data, s_texels), n),
+            MieStorage::RedOnly => {
+                table4((0..s_texels).map(|t| m_data[t * g * GROUP]).collect(), 1)
+            }
+        };
+        let order_means = (0..orders)
+            .map(|o| {
+                let mut sum = vec![0.0f64; n];
+                for row in 0..rows {
+                    let base = ((o * rows + row) * g) * GROUP;
+                    for (k, acc) in sum.iter_mut().enumerate() {
+                        *acc += rows_data[base + k] as f64;
+                    }
+                }
+                sum.iter().map(|v| v / s_texels as f64).collect()
+            })
+            .collect();
+        Ok(Tables {
+            config: *config,
+            wavelengths_nm: model.wavelengths.nm().to_vec(),
+            atmosphere_hash: model.hash,
+            transmittance,
+            irradiance,
+            scattering,
+            single_mie,
+            order_means,
+            mie_ratio: groups_info.mie_ratio(),
+        })
+    }
+
+    /// Precompute every table for `model` and leave them on the device (submitted, not
+    /// waited for): the buffers [`crate::GpuSky::precompute`] renders from.
+    pub(crate) fn run_on_device(
+        &self,
+        ctx: &GpuContext,
+        model: &Model,
+        config: &TableConfig,
+    ) -> Result<DeviceTables, GpuError> {
         config.validate()?;
         let n = model.channels();
         if n > 64 {
@@ -193,7 +314,7 @@ impl Precomputer {
         let max_dim = ctx.limits().max_compute_workgroups_per_dimension;
         let device = ctx.device();
 
-        let staging = scoped(ctx, "table precomputation", || {
+        scoped(ctx, "table precomputation", || {
             let uniform = wgpu::BufferUsages::UNIFORM;
             let atm = init(
                 device,
@@ -359,83 +480,16 @@ impl Precomputer {
                     dispatch(&mut cpass, &self.order_sums, &bg, rows, g, max_dim);
                 }
             }
-            let sources = [&transmittance, &irradiance, &scattering, &mie, &row_sums];
-            let staging: Vec<wgpu::Buffer> = sources
-                .iter()
-                .map(|src| {
-                    let b = device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("readback"),
-                        size: src.size(),
-                        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                        mapped_at_creation: false,
-                    });
-                    encoder.copy_buffer_to_buffer(src, 0, &b, 0, src.size());
-                    b
-                })
-                .collect();
             ctx.queue().submit([encoder.finish()]);
-            Ok(staging)
-        })?;
-
-        let values = scoped(ctx, "reading the tables back", || read_back(ctx, &staging))?;
-        let [t_data, e_data, s_data, m_data, rows_data] =
-            <[Vec<f32>; 5]>::try_from(values).expect("five buffers");
-        let unpad = |v: &[f32], texels: usize| -> Vec<f32> {
-            let mut out = Vec::with_capacity(texels * n);
-            for t in 0..texels {
-                out.extend_from_slice(&v[t * g * GROUP..t * g * GROUP + n]);
-            }
-            out
-        };
-        let transmittance = Table2 {
-            width: s.transmittance_mu,
-            height: s.transmittance_r,
-            channels: n,
-            data: unpad(&t_data, t_texels),
-        };
-        let irradiance = Table2 {
-            width: s.irradiance_mu_s,
-            height: s.irradiance_r,
-            channels: n,
-            data: unpad(&e_data, e_texels),
-        };
-        let table4 = |data: Vec<f32>, channels: usize| Table4 {
-            nr: s.scattering_r,
-            nmu: s.scattering_mu,
-            nmu_s: s.scattering_mu_s,
-            nnu: s.scattering_nu,
-            channels,
-            data,
-        };
-        let scattering = table4(unpad(&s_data, s_texels), n);
-        let single_mie = match config.mie {
-            MieStorage::Separate => table4(unpad(&m_data, s_texels), n),
-            MieStorage::RedOnly => {
-                table4((0..s_texels).map(|t| m_data[t * g * GROUP]).collect(), 1)
-            }
-        };
-        let order_means = (0..orders)
-            .map(|o| {
-                let mut sum = vec![0.0f64; n];
-                for row in 0..rows {
-                    let base = ((o * rows + row) * g) * GROUP;
-                    for (k, acc) in sum.iter_mut().enumerate() {
-                        *acc += rows_data[base + k] as f64;
-                    }
-                }
-                sum.iter().map(|v| v / s_texels as f64).collect()
+            Ok(DeviceTables {
+                atmosphere: atm,
+                data,
+                transmittance,
+                irradiance,
+                scattering,
+                single_mie: mie,
+                row_sums,
             })
-            .collect();
-        Ok(Tables {
-            config: *config,
-            wavelengths_nm: model.wavelengths.nm().to_vec(),
-            atmosphere_hash: model.hash,
-            transmittance,
-            irradiance,
-            scattering,
-            single_mie,
-            order_means,
-            mie_ratio: groups_info.mie_ratio(),
         })
     }
 
@@ -446,27 +500,9 @@ impl Precomputer {
         buffers: &[(&str, u64)],
         largest_dispatch: usize,
     ) -> Result<(), GpuError> {
+        check_buffers(ctx, buffers)?;
         let limits = ctx.limits();
         let adapter = ctx.adapter_name().to_string();
-        for &(what, bytes) in buffers {
-            for (limit, name) in [
-                (
-                    limits.max_storage_buffer_binding_size,
-                    "max_storage_buffer_binding_size",
-                ),
-                (limits.max_buffer_size, "max_buffer_size"),
-            ] {
-                if bytes > limit {
-                    return Err(GpuError::Limit {
-                        what: format!("the {what}"),
-                        needed: format!("{bytes} bytes"),
-                        limit: format!("{limit} bytes"),
-                        limit_name: name,
-                        adapter,
-                    });
-                }
-            }
-        }
         let max_dim = limits.max_compute_workgroups_per_dimension;
         let (_, y) = passes::workgroups(largest_dispatch, max_dim);
         if y > max_dim {
@@ -491,8 +527,37 @@ impl Precomputer {
     }
 }
 
+/// Refuse storage buffers larger than the device binds or allocates, before allocating
+/// anything: (what, bytes) each.
+pub(crate) fn check_buffers(ctx: &GpuContext, buffers: &[(&str, u64)]) -> Result<(), GpuError> {
+    let limits = ctx.limits();
+    for &(what, bytes) in buffers {
+        for (limit, name) in [
+            (
+                limits.max_storage_buffer_binding_size,
+                "max_storage_buffer_binding_size",
+            ),
+            (limits.max_buffer_size, "max_buffer_size"),
+        ] {
+            if bytes > limit {
+                return Err(GpuError::Limit {
+                    what: format!("the {what}"),
+                    needed: format!("{bytes} bytes"),
+                    limit: format!("{limit} bytes"),
+                    limit_name: name,
+                    adapter: ctx.adapter_name().to_string(),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Map the staging buffers, wait for the device, and copy their contents out as f32.
-fn read_back(ctx: &GpuContext, staging: &[wgpu::Buffer]) -> Result<Vec<Vec<f32>>, GpuError> {
+pub(crate) fn read_back(
+    ctx: &GpuContext,
+    staging: &[wgpu::Buffer],
+) -> Result<Vec<Vec<f32>>, GpuError> {
     let (tx, rx) = std::sync::mpsc::channel();
     for (i, b) in staging.iter().enumerate() {
         let tx = tx.clone();

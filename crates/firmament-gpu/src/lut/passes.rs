@@ -27,6 +27,8 @@ pub struct Pass {
     pub pipeline: wgpu::ComputePipeline,
     pub layout: wgpu::BindGroupLayout,
     slots: Vec<u32>,
+    module: wgpu::ShaderModule,
+    pipeline_layout: wgpu::PipelineLayout,
 }
 
 impl Pass {
@@ -92,7 +94,21 @@ impl Pass {
             pipeline,
             layout,
             slots,
+            module,
+            pipeline_layout,
         }
+    }
+
+    /// Another entry point of the same source, with the same bind group layout.
+    pub fn entry_point(&self, device: &wgpu::Device, entry: &str) -> wgpu::ComputePipeline {
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout: Some(&self.pipeline_layout),
+            module: &self.module,
+            entry_point: Some(entry),
+            compilation_options: wgpu::PipelineCompilationOptions::default(),
+            cache: None,
+        })
     }
 
     /// A bind group with `common` at slots 0–2 and `buffers` at the pass's own slots, in

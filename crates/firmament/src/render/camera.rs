@@ -231,6 +231,17 @@ pub struct PreparedCamera {
 }
 
 impl PreparedCamera {
+    /// The view's (forward, right, up) unit vectors in the local frame, as the pinhole
+    /// projections use them (the orbit camera's looks straight down).
+    pub fn basis(&self) -> (Vec3, Vec3, Vec3) {
+        (self.forward, self.right, self.up)
+    }
+
+    /// tan(fov/2) of the pinhole projections.
+    pub fn tan_half_fov(&self) -> f64 {
+        self.tan_half_fov
+    }
+
     /// The ray through pixel position (px, py) (pixel centres at +0.5), None outside the
     /// projection.
     #[inline]

@@ -15,6 +15,7 @@ pub use camera::{Camera, Projection, Ray};
 pub use scene::Scene;
 pub use tonemap::ToneCurve;
 
+use crate::atmosphere::Model;
 use crate::geometry::{
     add_scaled, direction_from_zenith_azimuth, dot, normalize, ray_sphere, Vec3,
 };
@@ -223,6 +224,41 @@ pub struct RenderSettings<'a> {
     pub white_balance: bool,
 }
 
+impl RenderSettings<'_> {
+    /// The checks [`render`] makes before drawing (shared with other backends): image size,
+    /// camera values, the cube map's 6:1 shape.
+    pub fn validate(&self) -> Result<()> {
+        let (w, h) = (self.width, self.height);
+        if w == 0 || h == 0 || w > 32768 || h > 32768 {
+            return Err(Error::invalid(
+                "width/height",
+                format!("{w}×{h}"),
+                "between 1 and 32768 pixels each",
+            ));
+        }
+        self.camera.validate()?;
+        if self.camera.projection == Projection::Cubemap && w != 6 * h {
+            return Err(Error::invalid(
+                "width",
+                w,
+                format!("6 × height ({}) for a cube map", 6 * h),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Per-channel factors applied to linear sRGB: with `enabled`, those that make the
+/// top-of-atmosphere sun white at its own luminance; `[1, 1, 1]` otherwise.
+pub fn white_balance(model: &Model, colour: &ColourMatrix, enabled: bool) -> [f64; 3] {
+    if !enabled {
+        return [1.0; 3];
+    }
+    let sun = colour.to_srgb(&model.solar_irradiance);
+    let y = colour.to_xyz(&model.solar_irradiance)[1];
+    sun.map(|c| if c > 0.0 { y / c } else { 1.0 })
+}
+
 /// Render a frame on the CPU, rows in parallel. `progress` receives the fraction done.
 pub fn render(
     sky: &Sky,
@@ -230,31 +266,11 @@ pub fn render(
     progress: &(dyn Fn(f64) + Sync),
     cancel: Option<&AtomicBool>,
 ) -> Result<Frame> {
+    settings.validate()?;
     let (w, h) = (settings.width, settings.height);
-    if w == 0 || h == 0 || w > 32768 || h > 32768 {
-        return Err(Error::invalid(
-            "width/height",
-            format!("{w}×{h}"),
-            "between 1 and 32768 pixels each",
-        ));
-    }
-    settings.camera.validate()?;
-    if settings.camera.projection == Projection::Cubemap && w != 6 * h {
-        return Err(Error::invalid(
-            "width",
-            w,
-            format!("6 × height ({}) for a cube map", 6 * h),
-        ));
-    }
     let n = sky.channels();
     let colour = ColourMatrix::new(sky.model.wavelengths.nm());
-    let balance = if settings.white_balance {
-        let sun = colour.to_srgb(&sky.model.solar_irradiance);
-        let y = colour.to_xyz(&sky.model.solar_irradiance)[1];
-        sun.map(|c| if c > 0.0 { y / c } else { 1.0 })
-    } else {
-        [1.0; 3]
-    };
+    let balance = white_balance(&sky.model, &colour, settings.white_balance);
     let origin = [
         0.0,
         0.0,
