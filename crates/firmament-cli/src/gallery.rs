@@ -9,6 +9,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use firmament::render::{camera::orbit_fit_fov_deg, Camera, Projection, Scene};
 
+use crate::backend::{Backend, BackendChoice, RenderSky};
 use crate::render::{atmosphere_args, render_scene, write_outputs};
 
 /// Arguments of `firmament gallery`.
@@ -29,6 +30,10 @@ pub struct GalleryArgs {
     /// Print nothing but errors.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Where tables are precomputed and views rendered: `cpu`, `gpu` (wgpu, any adapter) or
+    /// `auto` (a hardware GPU when wgpu finds one, else the CPU).
+    #[arg(long, value_enum, value_name = "cpu|gpu|auto", default_value_t = BackendChoice::Auto)]
+    pub backend: BackendChoice,
 }
 
 struct View {
@@ -71,8 +76,13 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
         .with_context(|| format!("creating {}", args.out.display()))?;
     let mut base = Scene::default();
     base.atmosphere.preset = args.preset.clone();
+    let backend = Backend::open(args.backend, args.quiet)?;
     let t = Instant::now();
-    let sky = atmosphere_args(&base, args.tables.clone(), "default").sky(args.quiet)?;
+    let sky = RenderSky::new(
+        &backend,
+        &atmosphere_args(&base, args.tables.clone(), "default"),
+        args.quiet,
+    )?;
     if !args.quiet {
         eprintln!("tables ready in {:.2} s", t.elapsed().as_secs_f64());
     }
@@ -99,10 +109,11 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
         write_outputs(&frame, &scene, ev100, false, true)?;
         if !args.quiet {
             eprintln!(
-                "{:14} {}×{} in {:.2} s",
+                "{:14} {}×{}{} in {:.2} s",
                 v.name,
                 v.size.0,
                 v.size.1,
+                sky.on(),
                 t.elapsed().as_secs_f64()
             );
         }

@@ -1,8 +1,10 @@
 //! `firmament`: physically based sky and atmosphere rendering from the command line.
 
+mod backend;
 mod bench;
 mod common;
 mod gallery;
+mod gpu_bench;
 mod query;
 mod render;
 mod render_bench;
@@ -44,6 +46,11 @@ enum Command {
         /// Output table file.
         #[arg(long, value_name = "FILE")]
         out: PathBuf,
+        /// Where the tables are computed: `cpu`, `gpu` (wgpu, any adapter; read back and
+        /// written in the same format) or `auto` (a hardware GPU when wgpu finds one, else
+        /// the CPU; never a software rasteriser such as lavapipe).
+        #[arg(long, value_enum, value_name = "cpu|gpu|auto", default_value_t = backend::BackendChoice::Auto)]
+        backend: backend::BackendChoice,
     },
     /// Render a picture of the sky (with no arguments: a default scene to firmament.png and firmament.exr).
     Render(render::RenderArgs),
@@ -90,13 +97,21 @@ fn run(cli: Cli) -> Result<()> {
                 print!("{}", a.to_toml());
             }
         },
-        Command::Bake { atmosphere, out } => {
+        Command::Bake {
+            atmosphere,
+            out,
+            backend,
+        } => {
             common::check_output_dir(&out, "--out")?;
             if atmosphere.tables.is_some() {
                 anyhow::bail!("`bake` computes tables: --tables makes no sense here");
             }
             let model = atmosphere.model()?;
-            let tables = common::compute_tables(&model, &atmosphere.table_config()?, false)?;
+            let config = atmosphere.table_config()?;
+            let tables = match backend::Backend::open(backend, false)? {
+                backend::Backend::Cpu => common::compute_tables(&model, &config, false)?,
+                backend::Backend::Gpu(gpu) => gpu.tables(&model, &config, false)?,
+            };
             firmament::lut::file::write(&tables, &out)?;
             eprintln!("wrote {}", out.display());
         }
@@ -108,7 +123,24 @@ fn run(cli: Cli) -> Result<()> {
     Ok(())
 }
 
+/// Mesa's Vulkan device-select layer connects to Wayland to find the desktop's GPU and, on
+/// a headless machine (no XDG_RUNTIME_DIR), prints `error: XDG_RUNTIME_DIR is invalid…`
+/// every time the GPU is probed, which `--backend auto` does. firmament ranks the adapters
+/// itself, so the layer is switched off there unless the user configured it.
+fn quiet_headless_vulkan() {
+    let set = |k: &str| std::env::var_os(k).is_some();
+    if !set("XDG_RUNTIME_DIR")
+        && !set("NODEVICE_SELECT")
+        && !set("MESA_VK_DEVICE_SELECT")
+        && !set("DRI_PRIME")
+    {
+        // Before any thread is started.
+        std::env::set_var("NODEVICE_SELECT", "1");
+    }
+}
+
 fn main() -> ExitCode {
+    quiet_headless_vulkan();
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,

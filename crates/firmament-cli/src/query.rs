@@ -8,6 +8,7 @@ use serde_json::json;
 
 use firmament::reference::{self, ReferenceSettings};
 
+use crate::backend::{Backend, BackendChoice};
 use crate::common::{check_range, AtmosphereArgs};
 
 /// Arguments of `firmament query`.
@@ -41,6 +42,14 @@ pub struct QueryArgs {
     /// Seed of the random streams for `--method reference`.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Where the tables are computed when no --tables are given: `cpu`, `gpu` (wgpu, any
+    /// adapter; read back) or `auto` (a hardware GPU when wgpu finds one, else the CPU).
+    /// The views themselves are a few table lookups and run on the CPU.
+    #[arg(long, value_enum, value_name = "cpu|gpu|auto", default_value_t = BackendChoice::Auto)]
+    pub backend: BackendChoice,
+    /// Print nothing on stderr but errors (the JSON still goes to stdout).
+    #[arg(long, short)]
+    pub quiet: bool,
 }
 
 fn parse_view(s: &str) -> Result<(f64, f64)> {
@@ -97,7 +106,21 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
         .iter()
         .map(|v| parse_view(v))
         .collect::<Result<_>>()?;
-    let sky = args.atmosphere.sky(true)?;
+    let sky = match &args.atmosphere.tables {
+        // Nothing to compute: no adapter to open.
+        Some(path) => {
+            if !args.quiet {
+                eprintln!(
+                    "backend: cpu (tables read from {}; the views are CPU lookups)",
+                    path.display()
+                );
+            }
+            args.atmosphere.sky(true)?
+        }
+        None => args
+            .atmosphere
+            .sky_on(&Backend::open(args.backend, args.quiet)?, true)?,
+    };
     let model = &sky.model;
     let nm = model.wavelengths.nm().to_vec();
     let n = nm.len();

@@ -14,8 +14,9 @@ use firmament::render::ColourMatrix;
 use firmament::render::{
     self, tonemap, Projection, RenderSettings, Scene, ShadeOptions, ToneCurve,
 };
-use firmament::sky::{disk_solid_angle_weighted, limb_darkening, Sky};
+use firmament::sky::{disk_solid_angle_weighted, limb_darkening};
 
+use crate::backend::{Backend, BackendChoice, RenderSky};
 use crate::common::{cancel_flag, check_output_dir, progress_bar, AtmosphereArgs};
 
 /// Arguments of `firmament render`; flags override the scene file, which overrides the
@@ -101,6 +102,12 @@ pub struct RenderArgs {
     /// Paths per wavelength and pixel for `--method reference`.
     #[arg(long, default_value_t = 1024)]
     pub samples: usize,
+    /// Where tables are precomputed and frames rendered (`--method lut`): `cpu`, `gpu`
+    /// (wgpu, any adapter; with --tables the file's tables are uploaded) or `auto` (a
+    /// hardware GPU when wgpu finds one, else the CPU; never a software rasteriser such as
+    /// lavapipe). `--method reference` runs on the CPU only.
+    #[arg(long, value_enum, value_name = "cpu|gpu|auto", default_value_t = BackendChoice::Auto)]
+    pub backend: BackendChoice,
 }
 
 fn parse_projection(s: &str) -> Result<Projection> {
@@ -218,8 +225,8 @@ pub fn atmosphere_args(scene: &Scene, tables: Option<PathBuf>, table_size: &str)
     }
 }
 
-/// Render the scene with a sky; returns the frame and the EV100 used.
-pub fn render_scene(sky: &Sky, scene: &Scene, quiet: bool) -> Result<(render::Frame, f64)> {
+/// Render the scene with a sky on its backend; returns the frame and the EV100 used.
+pub fn render_scene(sky: &RenderSky, scene: &Scene, quiet: bool) -> Result<(render::Frame, f64)> {
     let settings = RenderSettings {
         camera: &scene.camera,
         width: scene.image.width,
@@ -230,16 +237,7 @@ pub fn render_scene(sky: &Sky, scene: &Scene, quiet: bool) -> Result<(render::Fr
         },
         white_balance: scene.output.white_balance,
     };
-    let bar = progress_bar(1000, quiet);
-    bar.set_message("rendering");
-    let frame = render::render(
-        sky,
-        &settings,
-        &|f| bar.set_position((f * 1000.0) as u64),
-        Some(cancel_flag()),
-    );
-    bar.finish_and_clear();
-    let frame = frame.context("rendering")?;
+    let frame = sky.render(&settings, quiet).context("rendering")?;
     let ev100 = scene
         .output
         .ev100
@@ -447,6 +445,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             if args.tables.is_some() {
                 anyhow::bail!("`--method reference` uses no tables: --tables makes no sense here");
             }
+            if args.backend == BackendChoice::Gpu {
+                anyhow::bail!(
+                    "`--method reference` runs on the CPU only: `--backend gpu` is not supported with it (use `--backend cpu` or `auto`, or `--method lut` for the GPU)"
+                );
+            }
+            if !args.quiet {
+                eprintln!("backend: cpu (the reference path tracer runs on the CPU only)");
+            }
             let model = atmosphere_args(&scene, None, &args.table_size).model()?;
             let t = Instant::now();
             let (frame, ev100) = render_scene_reference(&model, &scene, args.samples, args.quiet)?;
@@ -464,19 +470,33 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
         other => anyhow::bail!("invalid value for `--method`: {other} (accepted: lut, reference)"),
     }
+    let backend = Backend::open(args.backend, args.quiet)?;
     let t = Instant::now();
-    let sky = atmosphere_args(&scene, args.tables.clone(), &args.table_size).sky(args.quiet)?;
+    let sky = RenderSky::new(
+        &backend,
+        &atmosphere_args(&scene, args.tables.clone(), &args.table_size),
+        args.quiet,
+    )?;
     if !args.quiet && args.tables.is_some() {
-        eprintln!("tables: loaded in {:.2} s", t.elapsed().as_secs_f64());
+        eprintln!(
+            "tables: loaded{} in {:.2} s",
+            if sky.on().is_empty() {
+                ""
+            } else {
+                " and uploaded to the GPU (render shader compiled)"
+            },
+            t.elapsed().as_secs_f64()
+        );
     }
     let t = Instant::now();
     let (frame, ev100) = render_scene(&sky, &scene, args.quiet)?;
     if !args.quiet {
         eprintln!(
-            "render: {}×{} {:?} in {:.2} s (EV100 {:.1}{})",
+            "render: {}×{} {:?}{} in {:.2} s (EV100 {:.1}{})",
             scene.image.width,
             scene.image.height,
             scene.camera.projection,
+            sky.on(),
             t.elapsed().as_secs_f64(),
             ev100,
             if scene.output.ev100.is_none() {

@@ -9,10 +9,28 @@ use serde_json::json;
 
 use crate::bench::{median, BenchArgs};
 
-/// Time one kind of frame.
-fn frame(sky: &Sky, camera: Camera, width: usize, height: usize, runs: usize) -> Result<f64> {
-    let settings = RenderSettings {
-        camera: &camera,
+/// The benchmark cameras: heading 200°, 60° field of view.
+pub fn camera(projection: Projection, altitude_m: f64, pitch_deg: f64) -> Camera {
+    Camera {
+        projection,
+        altitude_m,
+        heading_deg: 200.0,
+        pitch_deg,
+        roll_deg: 0.0,
+        fov_deg: 60.0,
+    }
+}
+
+/// The 1080p frame: from 1.5 km, half sky, half ground with aerial perspective, the sun in
+/// view (the CPU and GPU frame benchmarks).
+pub fn camera_1080p() -> Camera {
+    camera(Projection::Perspective, 1500.0, 20.0)
+}
+
+/// Settings of every benchmark frame: sun 60° from the zenith at azimuth 200°, disk drawn.
+pub fn settings(camera: &Camera, width: usize, height: usize) -> RenderSettings<'_> {
+    RenderSettings {
+        camera,
         width,
         height,
         shade: ShadeOptions {
@@ -20,7 +38,12 @@ fn frame(sky: &Sky, camera: Camera, width: usize, height: usize, runs: usize) ->
             sun_disk: true,
         },
         white_balance: false,
-    };
+    }
+}
+
+/// Time one kind of frame.
+fn frame(sky: &Sky, camera: Camera, width: usize, height: usize, runs: usize) -> Result<f64> {
+    let settings = settings(&camera, width, height);
     let mut times = Vec::new();
     for _ in 0..runs.max(1) {
         let t = Instant::now();
@@ -31,35 +54,27 @@ fn frame(sky: &Sky, camera: Camera, width: usize, height: usize, runs: usize) ->
     Ok(median(times))
 }
 
+/// The CPU frame keys, null (not measured).
+pub const KEYS: [&str; 3] = [
+    "cpu_frame_1080p_perspective_s",
+    "cpu_frame_1024_fisheye_s",
+    "cpu_frame_4096x2048_equirect_s",
+];
+
 /// Add render timings to the benchmark result.
 pub fn extend(result: &mut serde_json::Value, args: &BenchArgs) -> Result<()> {
     let sky = args.atmosphere.sky(true)?;
-    let cam = |projection, altitude_m, pitch_deg| Camera {
-        projection,
-        altitude_m,
-        heading_deg: 200.0,
-        pitch_deg,
-        roll_deg: 0.0,
-        fov_deg: 60.0,
-    };
-    // Half sky, half ground with aerial perspective, the sun in view.
-    result["cpu_frame_1080p_perspective_s"] = json!(frame(
+    result[KEYS[0]] = json!(frame(&sky, camera_1080p(), 1920, 1080, args.runs)?);
+    result[KEYS[1]] = json!(frame(
         &sky,
-        cam(Projection::Perspective, 1500.0, 20.0),
-        1920,
-        1080,
-        args.runs
-    )?);
-    result["cpu_frame_1024_fisheye_s"] = json!(frame(
-        &sky,
-        cam(Projection::Fisheye, 2.0, 0.0),
+        camera(Projection::Fisheye, 2.0, 0.0),
         1024,
         1024,
         args.runs
     )?);
-    result["cpu_frame_4096x2048_equirect_s"] = json!(frame(
+    result[KEYS[2]] = json!(frame(
         &sky,
-        cam(Projection::Equirect, 2.0, 0.0),
+        camera(Projection::Equirect, 2.0, 0.0),
         4096,
         2048,
         args.runs.min(3)

@@ -1,0 +1,319 @@
+//! `--backend cpu|gpu|auto`: where the tables are precomputed and frames rendered. The GPU
+//! work goes through `firmament_gpu` (wgpu); everything after a frame (exposure, tone
+//! mapping, image files) is the CPU code either way.
+
+use std::time::{Duration, Instant};
+
+use anyhow::Result;
+use clap::ValueEnum;
+use firmament::atmosphere::Model;
+use firmament::lut::{TableConfig, Tables};
+use firmament::render::{Frame, RenderSettings};
+use firmament::sky::Sky;
+use firmament_gpu::lut::Precomputer;
+use firmament_gpu::{GpuContext, GpuError, GpuRenderer, GpuSky};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use crate::common::{cancel_flag, AtmosphereArgs};
+
+/// The `--backend` flag of render, bake, query and gallery.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum BackendChoice {
+    /// The CPU (rayon threads).
+    Cpu,
+    /// The GPU through wgpu, whatever adapter it finds (software rasterisers included);
+    /// an error when there is none.
+    Gpu,
+    /// The GPU when wgpu finds a hardware adapter, else the CPU (a software rasteriser such
+    /// as lavapipe is slower than the CPU path, so it is never picked).
+    #[default]
+    Auto,
+}
+
+/// An opened GPU.
+pub struct Gpu {
+    pub ctx: GpuContext,
+}
+
+/// The backend a command runs on.
+pub enum Backend {
+    Cpu,
+    Gpu(Box<Gpu>),
+}
+
+/// The adapter in words: "NAME, BACKEND" (plus "software rasteriser" where it is one).
+pub fn describe(ctx: &GpuContext) -> String {
+    format!(
+        "{}, {}{}",
+        ctx.adapter_name(),
+        ctx.backend(),
+        if ctx.is_software() {
+            ", software rasteriser"
+        } else {
+            ""
+        }
+    )
+}
+
+/// The error for a failed GPU step: what failed, the device's reason, and the way out.
+pub fn gpu_failure(what: &str, e: GpuError) -> anyhow::Error {
+    anyhow::anyhow!("{what} failed on the GPU: {e} (`--backend cpu` does the same work on the CPU)")
+}
+
+/// What `auto` found: a hardware GPU opened, or why not (for the message).
+pub enum Probe {
+    Hardware(Box<GpuContext>),
+    NoHardware(String),
+}
+
+/// Look for a hardware adapter with compute shaders and open it (adapters are enumerated
+/// first: no device is created for a software one). Where there is no hardware GPU this
+/// costs the Vulkan loader's start-up, about 65 ms with Mesa's drivers installed.
+pub fn probe_hardware() -> Probe {
+    let desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+    let backends = desc.backends;
+    let instance = wgpu::Instance::new(desc);
+    let adapters: Vec<wgpu::AdapterInfo> =
+        pollster::block_on(instance.enumerate_adapters(backends))
+            .into_iter()
+            .filter(|a| {
+                a.get_downlevel_capabilities()
+                    .flags
+                    .contains(wgpu::DownlevelFlags::COMPUTE_SHADERS)
+            })
+            .map(|a| a.get_info())
+            .collect();
+    drop(instance);
+    if !adapters
+        .iter()
+        .any(|a| a.device_type != wgpu::DeviceType::Cpu)
+    {
+        return Probe::NoHardware(match adapters.first() {
+            Some(a) => format!("no hardware GPU; found software adapter {}", a.name),
+            None => "no GPU adapter found".into(),
+        });
+    }
+    // GpuContext::new ranks hardware before software: it opens the one found.
+    match GpuContext::new() {
+        Ok(ctx) if !ctx.is_software() => Probe::Hardware(Box::new(ctx)),
+        Ok(ctx) => Probe::NoHardware(format!(
+            "no hardware GPU opened; found software adapter {}",
+            ctx.adapter_name()
+        )),
+        Err(e) => Probe::NoHardware(format!("GPU unusable: {e}")),
+    }
+}
+
+/// Open the GPU for `--backend gpu`: any adapter, or a clear error.
+pub fn open_gpu() -> Result<GpuContext> {
+    GpuContext::new().map_err(|e| {
+        anyhow::anyhow!(
+            "--backend gpu: could not open a GPU: {e} (`--backend cpu` computes on the CPU)"
+        )
+    })
+}
+
+impl Backend {
+    /// Resolve the choice; prints `backend: …` on stderr unless `quiet`.
+    pub fn open(choice: BackendChoice, quiet: bool) -> Result<Backend> {
+        let cpu_line = || format!("cpu ({} threads)", rayon::current_num_threads());
+        let (backend, line) = match choice {
+            BackendChoice::Cpu => (Backend::Cpu, cpu_line()),
+            BackendChoice::Gpu => {
+                let ctx = open_gpu()?;
+                let line = format!("gpu ({})", describe(&ctx));
+                (Backend::Gpu(Box::new(Gpu { ctx })), line)
+            }
+            BackendChoice::Auto => match probe_hardware() {
+                Probe::Hardware(ctx) => {
+                    let line = format!("gpu (auto: {})", describe(&ctx));
+                    (Backend::Gpu(Box::new(Gpu { ctx: *ctx })), line)
+                }
+                Probe::NoHardware(why) => (
+                    Backend::Cpu,
+                    format!(
+                        "cpu (auto: {why}; {} threads)",
+                        rayon::current_num_threads()
+                    ),
+                ),
+            },
+        };
+        if !quiet {
+            eprintln!("backend: {line}");
+        }
+        Ok(backend)
+    }
+}
+
+/// A spinner on stderr for GPU work (which reports no progress); hidden when `quiet`.
+fn spinner(message: &str, quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {msg}")
+            .expect("valid template"),
+    );
+    bar.set_message(message.to_string());
+    bar.enable_steady_tick(Duration::from_millis(200));
+    bar
+}
+
+/// Ctrl-C cannot stop a GPU submission; refuse to go on once it is done.
+fn check_interrupted() -> Result<()> {
+    if cancel_flag().load(std::sync::atomic::Ordering::Relaxed) {
+        anyhow::bail!("interrupted");
+    }
+    Ok(())
+}
+
+/// Wait until the device has finished everything submitted.
+pub fn wait_idle(ctx: &GpuContext, during: &str) -> Result<()> {
+    ctx.device()
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map(|_| ())
+        .map_err(|e| {
+            gpu_failure(
+                during,
+                GpuError::Execution {
+                    during: during.to_string(),
+                    reason: e.to_string(),
+                },
+            )
+        })
+}
+
+impl Gpu {
+    /// Precompute the tables on the GPU and read them back (for files and CPU lookups).
+    pub fn tables(&self, model: &Model, config: &TableConfig, quiet: bool) -> Result<Tables> {
+        let bar = spinner("precomputing tables on the GPU", quiet);
+        let started = Instant::now();
+        let tables = Precomputer::new(&self.ctx)
+            .and_then(|p| p.run(&self.ctx, model, config))
+            .map_err(|e| gpu_failure("precomputing the tables", e));
+        bar.finish_and_clear();
+        let tables = tables?;
+        check_interrupted()?;
+        if !quiet {
+            eprintln!(
+                "tables: {:.2} s on the GPU ({} wavelengths, {} orders; shader compilation and readback included)",
+                started.elapsed().as_secs_f64(),
+                model.channels(),
+                config.orders
+            );
+        }
+        Ok(tables)
+    }
+}
+
+impl AtmosphereArgs {
+    /// Model and tables (read from --tables, or computed on `backend`), paired.
+    pub fn sky_on(&self, backend: &Backend, quiet: bool) -> Result<Sky> {
+        match (backend, &self.tables) {
+            (Backend::Gpu(gpu), None) => {
+                let model = self.model()?;
+                let tables = gpu.tables(&model, &self.table_config()?, quiet)?;
+                Ok(Sky::new(model, tables)?)
+            }
+            _ => self.sky(quiet),
+        }
+    }
+}
+
+/// A sky ready to render on a backend.
+pub enum RenderSky<'a> {
+    Cpu(Box<Sky>),
+    Gpu {
+        gpu: &'a Gpu,
+        sky: Box<GpuSky>,
+        renderer: Box<GpuRenderer>,
+    },
+}
+
+impl<'a> RenderSky<'a> {
+    /// Tables from --tables (uploaded to the GPU for `gpu`) or precomputed on the backend
+    /// (kept on the device for `gpu`).
+    pub fn new(backend: &'a Backend, atmosphere: &AtmosphereArgs, quiet: bool) -> Result<Self> {
+        let gpu = match backend {
+            Backend::Cpu => return Ok(RenderSky::Cpu(Box::new(atmosphere.sky(quiet)?))),
+            Backend::Gpu(gpu) => gpu,
+        };
+        let ctx = &gpu.ctx;
+        let sky = match &atmosphere.tables {
+            Some(_) => {
+                let cpu_sky = atmosphere.sky(quiet)?;
+                GpuSky::from_sky(ctx, &cpu_sky)
+                    .map_err(|e| gpu_failure("uploading the tables", e))?
+            }
+            None => {
+                let model = atmosphere.model()?;
+                let config = atmosphere.table_config()?;
+                let bar = spinner("precomputing tables on the GPU", quiet);
+                let started = Instant::now();
+                let sky = Precomputer::new(ctx)
+                    .and_then(|p| GpuSky::precompute(ctx, &p, &model, &config))
+                    .map_err(|e| gpu_failure("precomputing the tables", e))
+                    .and_then(|sky| {
+                        wait_idle(ctx, "precomputing the tables")?;
+                        Ok(sky)
+                    });
+                bar.finish_and_clear();
+                let sky = sky?;
+                check_interrupted()?;
+                if !quiet {
+                    eprintln!(
+                        "tables: {:.2} s on the GPU ({} wavelengths, {} orders; shader compilation included; kept on the device)",
+                        started.elapsed().as_secs_f64(),
+                        model.channels(),
+                        config.orders
+                    );
+                }
+                sky
+            }
+        };
+        let renderer =
+            GpuRenderer::new(ctx).map_err(|e| gpu_failure("compiling the render shader", e))?;
+        Ok(RenderSky::Gpu {
+            gpu,
+            sky: Box::new(sky),
+            renderer: Box::new(renderer),
+        })
+    }
+
+    /// " on the GPU" or "", for messages.
+    pub fn on(&self) -> &'static str {
+        match self {
+            RenderSky::Cpu(_) => "",
+            RenderSky::Gpu { .. } => " on the GPU",
+        }
+    }
+
+    /// Render one frame: the CPU renderer with a progress bar, or the GPU renderer.
+    pub fn render(&self, settings: &RenderSettings, quiet: bool) -> Result<Frame> {
+        match self {
+            RenderSky::Cpu(sky) => {
+                let bar = crate::common::progress_bar(1000, quiet);
+                bar.set_message("rendering");
+                let frame = firmament::render::render(
+                    sky,
+                    settings,
+                    &|f| bar.set_position((f * 1000.0) as u64),
+                    Some(cancel_flag()),
+                );
+                bar.finish_and_clear();
+                Ok(frame?)
+            }
+            RenderSky::Gpu { gpu, sky, renderer } => {
+                let bar = spinner("rendering on the GPU", quiet);
+                let frame = renderer
+                    .render(&gpu.ctx, sky, settings)
+                    .map_err(|e| gpu_failure("rendering", e));
+                bar.finish_and_clear();
+                let frame = frame?;
+                check_interrupted()?;
+                Ok(frame)
+            }
+        }
+    }
+}

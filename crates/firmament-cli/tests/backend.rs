@@ -1,0 +1,452 @@
+//! `--backend cpu|gpu|auto` end to end: GPU output matches the CPU's, GPU-baked tables are
+//! usable, bad values and impossible combinations are refused clearly, `bench --json`
+//! reports the GPU keys.
+//!
+//! GPU tests open an adapter first with `firmament_gpu::test_context()`: without one they
+//! skip (saying so), unless `CI` is set, where they fail. They run one at a time (lavapipe
+//! uses every core) on small tables and tiny images.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::{Mutex, MutexGuard, OnceLock};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_firmament"))
+}
+
+fn tmp() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let d =
+            std::env::temp_dir().join(format!("firmament-cli-backend-test-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    })
+}
+
+fn run(args: &[&str]) -> Output {
+    bin().args(args).output().unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn succeeds(o: &Output) {
+    assert!(o.status.success(), "{}", stderr(o));
+    assert!(!stderr(o).contains("panicked"), "{}", stderr(o));
+}
+
+fn fails_with(o: &Output, words: &[&str]) {
+    assert!(!o.status.success(), "should fail: {}", stderr(o));
+    let e = stderr(o);
+    for w in words {
+        assert!(e.contains(w), "missing {w:?} in: {e}");
+    }
+    assert!(!e.contains("panicked"), "{e}");
+}
+
+/// Small RGB tables for the earth preset, baked once on the CPU.
+fn tables() -> &'static str {
+    static T: OnceLock<PathBuf> = OnceLock::new();
+    T.get_or_init(|| {
+        let p = tmp().join("earth-small.lut");
+        let o = bin()
+            .args(["bake", "--backend", "cpu", "--table-size", "small"])
+            .args(["--orders", "3", "--out"])
+            .arg(&p)
+            .output()
+            .unwrap();
+        succeeds(&o);
+        p
+    })
+    .to_str()
+    .unwrap()
+}
+
+/// Whether GPU tests run: an adapter opens (panics under `CI` when none does). Holds the
+/// lock that keeps GPU tests apart.
+fn gpu() -> Option<MutexGuard<'static, ()>> {
+    static AVAILABLE: OnceLock<bool> = OnceLock::new();
+    static LOCK: Mutex<()> = Mutex::new(());
+    let available = *AVAILABLE.get_or_init(|| match firmament_gpu::test_context() {
+        Some(ctx) => {
+            eprintln!(
+                "GPU adapter: {} ({}, software: {})",
+                ctx.adapter_name(),
+                ctx.backend(),
+                ctx.is_software()
+            );
+            true
+        }
+        None => false,
+    });
+    available.then(|| LOCK.lock().unwrap_or_else(|e| e.into_inner()))
+}
+
+/// Mean absolute difference of two 8-bit PNGs of the same size.
+fn png_mean_abs_diff(a: &Path, b: &Path) -> f64 {
+    let (wa, ha, pa) = firmament::io::read_png_srgb8(a).unwrap();
+    let (wb, hb, pb) = firmament::io::read_png_srgb8(b).unwrap();
+    assert_eq!((wa, ha), (wb, hb));
+    let sum: u64 = pa
+        .iter()
+        .zip(&pb)
+        .flat_map(|(x, y)| x.iter().zip(y).map(|(u, v)| u.abs_diff(*v) as u64))
+        .sum();
+    sum as f64 / (3 * pa.len()) as f64
+}
+
+/// Mean relative difference of the luminance of two EXRs, over pixels above 1e-6 of the
+/// brightest.
+fn exr_mean_rel_diff(a: &Path, b: &Path) -> f64 {
+    let (ia, ib) = (
+        firmament::io::read_exr(a).unwrap(),
+        firmament::io::read_exr(b).unwrap(),
+    );
+    let y = |p: [f32; 3]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
+    let max = ib.data.iter().map(|p| y(*p)).fold(0.0, f64::max);
+    let (mut sum, mut n) = (0.0, 0);
+    for (p, q) in ia.data.iter().zip(&ib.data) {
+        if y(*q) > 1e-6 * max {
+            sum += (y(*p) - y(*q)).abs() / y(*q);
+            n += 1;
+        }
+    }
+    assert!(n > 0);
+    sum / n as f64
+}
+
+/// Render the same view on both backends (fixed exposure); returns the PNG and EXR paths
+/// for cpu and gpu.
+fn render_both(name: &str, args: &[&str]) -> [(PathBuf, PathBuf); 2] {
+    ["cpu", "gpu"].map(|backend| {
+        let png = tmp().join(format!("{name}-{backend}.png"));
+        let exr = tmp().join(format!("{name}-{backend}.exr"));
+        let mut a = vec!["render", "--backend", backend, "--ev100", "14"];
+        a.extend_from_slice(args);
+        a.extend_from_slice(&["--out", png.to_str().unwrap()]);
+        a.extend_from_slice(&["--out", exr.to_str().unwrap()]);
+        let o = run(&a);
+        succeeds(&o);
+        assert!(
+            stderr(&o).contains(&format!("backend: {backend}")),
+            "{}",
+            stderr(&o)
+        );
+        (png, exr)
+    })
+}
+
+#[test]
+fn backend_values_are_checked() {
+    for cmd in ["render", "bake", "query", "gallery"] {
+        fails_with(
+            &run(&[cmd, "--backend", "bogus"]),
+            &["--backend", "bogus", "cpu", "gpu", "auto"],
+        );
+    }
+    fails_with(
+        &run(&["bench", "--backend", "bogus"]),
+        &["--backend", "bogus", "auto", "all", "cpu", "gpu"],
+    );
+}
+
+#[test]
+fn reference_method_refuses_the_gpu() {
+    let out = tmp().join("reference-gpu.png");
+    fails_with(
+        &run(&[
+            "render",
+            "--method",
+            "reference",
+            "--backend",
+            "gpu",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--out",
+            out.to_str().unwrap(),
+        ]),
+        &["--method reference", "CPU only", "--backend gpu"],
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn every_command_says_which_backend() {
+    // `auto` is the default; it names what it chose (whatever this machine has).
+    let out = tmp().join("auto.png");
+    let o = run(&[
+        "render",
+        "--tables",
+        tables(),
+        "--width",
+        "16",
+        "--height",
+        "9",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    succeeds(&o);
+    let e = stderr(&o);
+    assert!(
+        e.contains("backend: cpu (auto: ") || e.contains("backend: gpu (auto: "),
+        "{e}"
+    );
+    // `-q` silences it.
+    let o = run(&[
+        "render",
+        "--tables",
+        tables(),
+        "--width",
+        "16",
+        "--height",
+        "9",
+        "--out",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    succeeds(&o);
+    assert!(!stderr(&o).contains("backend:"), "{}", stderr(&o));
+    // query: the views are CPU lookups of the file's tables.
+    let o = run(&[
+        "query",
+        "--tables",
+        tables(),
+        "--altitude-m",
+        "0",
+        "--sun-zenith-deg",
+        "30",
+    ]);
+    succeeds(&o);
+    assert!(
+        stderr(&o).contains("backend: cpu (tables read from"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn missing_gpu_is_a_clear_error_and_auto_falls_back() {
+    // No Vulkan driver manifest: wgpu finds no adapter (Linux only has Vulkan here).
+    let no_gpu = |args: &[&str]| {
+        bin()
+            .args(args)
+            .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+            .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+            .output()
+            .unwrap()
+    };
+    let out = tmp().join("no-gpu.png");
+    let lut = tmp().join("no-gpu.lut");
+    fails_with(
+        &no_gpu(&[
+            "render",
+            "--backend",
+            "gpu",
+            "--tables",
+            tables(),
+            "--width",
+            "16",
+            "--height",
+            "9",
+            "--out",
+            out.to_str().unwrap(),
+        ]),
+        &["--backend gpu", "no GPU adapter", "--backend cpu"],
+    );
+    assert!(!out.exists());
+    fails_with(
+        &no_gpu(&[
+            "bake",
+            "--backend",
+            "gpu",
+            "--table-size",
+            "small",
+            "--out",
+            lut.to_str().unwrap(),
+        ]),
+        &["--backend gpu", "no GPU adapter", "--backend cpu"],
+    );
+    assert!(!lut.exists());
+    let o = no_gpu(&[
+        "render",
+        "--tables",
+        tables(),
+        "--width",
+        "16",
+        "--height",
+        "9",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    succeeds(&o);
+    assert!(
+        stderr(&o).contains("backend: cpu (auto: no GPU adapter found"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn gpu_render_from_table_file_matches_cpu() {
+    let Some(_lock) = gpu() else { return };
+    for (name, camera, w, h) in [
+        ("persp", "perspective", "64", "36"),
+        ("fisheye", "fisheye", "32", "32"),
+    ] {
+        let [(cpu_png, cpu_exr), (gpu_png, gpu_exr)] = render_both(
+            name,
+            &[
+                "--tables",
+                tables(),
+                "--camera",
+                camera,
+                "--width",
+                w,
+                "--height",
+                h,
+                "--sun-zenith-deg",
+                "70",
+            ],
+        );
+        let d8 = png_mean_abs_diff(&gpu_png, &cpu_png);
+        assert!(d8 <= 1.0, "{name}: mean |Δ| of 8-bit values {d8}");
+        let rel = exr_mean_rel_diff(&gpu_exr, &cpu_exr);
+        assert!(
+            rel <= 0.01,
+            "{name}: mean relative luminance difference {rel}"
+        );
+    }
+}
+
+#[test]
+fn gpu_precompute_and_render_matches_cpu() {
+    let Some(_lock) = gpu() else { return };
+    // No --tables: precomputed on each backend (small sizes), the GPU's kept on the device.
+    let [(cpu_png, cpu_exr), (gpu_png, gpu_exr)] = render_both(
+        "precomputed",
+        &[
+            "--table-size",
+            "small",
+            "--width",
+            "48",
+            "--height",
+            "27",
+            "--sun-zenith-deg",
+            "60",
+        ],
+    );
+    let d8 = png_mean_abs_diff(&gpu_png, &cpu_png);
+    assert!(d8 <= 1.0, "mean |Δ| of 8-bit values {d8}");
+    let rel = exr_mean_rel_diff(&gpu_exr, &cpu_exr);
+    assert!(rel <= 0.01, "mean relative luminance difference {rel}");
+}
+
+#[test]
+fn gpu_baked_tables_work_with_query() {
+    let Some(_lock) = gpu() else { return };
+    let query = |lut: &Path| {
+        let o = run(&[
+            "query",
+            "--tables",
+            lut.to_str().unwrap(),
+            "--altitude-m",
+            "0",
+            "--sun-zenith-deg",
+            "30",
+            "--view",
+            "0,0",
+            "--view",
+            "80,90",
+            "-q",
+        ]);
+        succeeds(&o);
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let mut out: Vec<f64> = v["views"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x["luminance_cd_m2"].as_f64().unwrap())
+            .collect();
+        out.push(v["irradiance"]["sky_lux"].as_f64().unwrap());
+        out
+    };
+    let mut answers = Vec::new();
+    for backend in ["gpu", "cpu"] {
+        let lut = tmp().join(format!("baked-{backend}.lut"));
+        let o = run(&[
+            "bake",
+            "--backend",
+            backend,
+            "--table-size",
+            "small",
+            "--orders",
+            "1",
+            "--out",
+            lut.to_str().unwrap(),
+        ]);
+        succeeds(&o);
+        assert!(
+            stderr(&o).contains(&format!("backend: {backend}")),
+            "{}",
+            stderr(&o)
+        );
+        answers.push(query(&lut));
+    }
+    // View luminances are positive; the sky irradiance is 0 with one order on both.
+    assert!(answers[1][0] > 0.0 && answers[1][1] > 0.0, "{answers:?}");
+    for (g, c) in answers[0].iter().zip(&answers[1]) {
+        assert!((g - c).abs() <= 0.01 * c.abs(), "gpu {g} cpu {c}");
+    }
+}
+
+#[test]
+fn bench_json_reports_the_gpu() {
+    let Some(_lock) = gpu() else { return };
+    let o = run(&[
+        "bench",
+        "--json",
+        "--backend",
+        "gpu",
+        "--table-size",
+        "small",
+        "--orders",
+        "1",
+        "--runs",
+        "1",
+    ]);
+    succeeds(&o);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    for key in [
+        "gpu_precompute_s",
+        "gpu_frame_1080p_perspective_s",
+        "gpu_frame_1080p_perspective_with_readback_s",
+        "gpu_pipeline_creation_s",
+    ] {
+        let s = v[key].as_f64().unwrap_or_else(|| panic!("{key}: {v}"));
+        assert!(s > 0.0, "{key}: {s}");
+    }
+    for key in [
+        "gpu_adapter",
+        "gpu_backend",
+        "gpu_frame_timing_method",
+        "gpu_precompute_timing_method",
+    ] {
+        assert!(!v[key].as_str().unwrap_or("").is_empty(), "{key}: {v}");
+    }
+    assert_eq!(v["gpu_precompute_orders"], 1);
+    assert_eq!(v["gpu_precompute_wavelengths"], 3);
+    // The CPU was not asked for: its keys are there, null.
+    for key in [
+        "cpu_precompute_s",
+        "cpu_frame_1080p_perspective_s",
+        "cpu_frame_1024_fisheye_s",
+        "cpu_frame_4096x2048_equirect_s",
+    ] {
+        assert!(v.get(key).is_some_and(|x| x.is_null()), "{key}: {v}");
+    }
+}
