@@ -58,7 +58,8 @@ impl Sky {
         self.groups.phase[1].eval(nu)
     }
 
-    /// Rayleigh+multiple and single Mie scattering at (r, μ, μ_s, ν), without phase functions
+    /// Rayleigh+multiple (divided by the molecular phase function) and single Mie scattering
+    /// at (r, μ, μ_s, ν), without phase functions
     /// (Bruneton 2017 `GetCombinedScattering`; the ratio rule for red-only Mie).
     /// The tables filtered for a fixed observer radius and sun zenith cosine: every view
     /// ray of a frame from a camera inside the atmosphere shares (r, μ_s), so the 4D lookup
@@ -67,10 +68,19 @@ impl Sky {
         let lk = self.lookup();
         let uvwz =
             crate::lut::params::scattering_uvwz(&lk.radii, &lk.sizes, r, 0.0, mu_s, 0.0, false);
+        let n = self.channels();
+        let single = self.tables.scattering.slice(uvwz[1], uvwz[3]);
+        let multiple = self.tables.multiple.slice(uvwz[1], uvwz[3]);
+        // Interleaved per texel, [single; multiple], so one filter serves both.
+        let mut scattering = Vec::with_capacity(2 * single.len());
+        for (a, b) in single.chunks(n).zip(multiple.chunks(n)) {
+            scattering.extend_from_slice(a);
+            scattering.extend_from_slice(b);
+        }
         SkySlice {
             r,
             mu_s,
-            scattering: self.tables.scattering.slice(uvwz[1], uvwz[3]),
+            scattering,
             mie: self.tables.single_mie.slice(uvwz[1], uvwz[3]),
         }
     }
@@ -92,7 +102,7 @@ impl Sky {
         let uvwz = match slice {
             // The slice already filtered (μ_s, r): only u_ν and u_μ are needed.
             Some(_) => [
-                crate::lut::params::u_nu_from_nu(nu),
+                crate::lut::params::u_nu(mu, mu_s, nu),
                 0.0,
                 crate::lut::params::scattering_u_mu(&lk.radii, &lk.sizes, r, mu, ground),
                 0.0,
@@ -101,13 +111,29 @@ impl Sky {
                 crate::lut::params::scattering_uvwz(&lk.radii, &lk.sizes, r, mu, mu_s, nu, ground)
             }
         };
+        let n = scat.len();
+        let mut both = [0.0f64; 128];
         match slice {
             Some(s) => {
-                self.tables
-                    .scattering
-                    .sample_slice_into(&s.scattering, uvwz[0], uvwz[2], scat)
+                self.tables.scattering.sample_slice_channels_into(
+                    &s.scattering,
+                    2 * n,
+                    uvwz[0],
+                    uvwz[2],
+                    &mut both[..2 * n],
+                );
+                scat.copy_from_slice(&both[..n]);
             }
-            None => self.tables.scattering.sample_into(uvwz, scat),
+            None => {
+                self.tables.scattering.sample_into(uvwz, scat);
+                self.tables.multiple.sample_into(uvwz, &mut both[n..2 * n]);
+            }
+        }
+        // Multiple scattering is stored as radiance; callers apply the molecular phase
+        // function to `scat`, so it goes in divided by it.
+        let p = self.rayleigh_phase(nu).max(1e-30);
+        for k in 0..n {
+            scat[k] += both[n + k] / p;
         }
         match self.tables.config.mie {
             MieStorage::Separate => match slice {
@@ -126,7 +152,6 @@ impl Sky {
                         .sample_slice_into(&s.mie, uvwz[0], uvwz[2], &mut red),
                     None => self.tables.single_mie.sample_into(uvwz, &mut red),
                 }
-                let n = scat.len();
                 for k in 0..n {
                     mie[k] = if scat[0] > 0.0 {
                         scat[k] * red[0] / scat[0] * self.tables.mie_ratio[k]

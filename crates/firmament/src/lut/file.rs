@@ -1,12 +1,12 @@
-//! The table file format, version 1 (little-endian):
+//! The table file format, version 2 (little-endian):
 //!
 //! | bytes | content |
 //! |---|---|
 //! | 8 | magic `FIRMLUT\0` |
-//! | 4 | format version (u32, = 1) |
+//! | 4 | format version (u32, = 2; version 1 folded multiple scattering into `scattering` and is refused) |
 //! | 4 | header length L (u32) |
 //! | L | header, UTF-8 JSON: `config` (sizes, orders, mie storage), `wavelengths_nm`, `atmosphere_hash` (hex), `channels`, `order_means`, `mie_ratio` |
-//! | … | f32 arrays: transmittance, irradiance, scattering, single Mie, in that order, sizes from the header |
+//! | … | f32 arrays: transmittance, irradiance, scattering (single molecular), single Mie, multiple scattering, in that order, sizes from the header |
 //! | 8 | FNV-1a 64 checksum of everything before it |
 //!
 //! A truncated, corrupt, wrong-version or mismatched file is refused, never used.
@@ -22,7 +22,7 @@ use crate::{Error, Result};
 
 const MAGIC: &[u8; 8] = b"FIRMLUT\0";
 /// Current format version.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -49,7 +49,8 @@ pub fn to_bytes(t: &Tables) -> Vec<u8> {
     let floats = t.transmittance.data.len()
         + t.irradiance.data.len()
         + t.scattering.data.len()
-        + t.single_mie.data.len();
+        + t.single_mie.data.len()
+        + t.multiple.data.len();
     let mut out = Vec::with_capacity(16 + json.len() + floats * 4 + 8);
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&VERSION.to_le_bytes());
@@ -60,6 +61,7 @@ pub fn to_bytes(t: &Tables) -> Vec<u8> {
         &t.irradiance.data,
         &t.scattering.data,
         &t.single_mie.data,
+        &t.multiple.data,
     ] {
         for v in data.iter() {
             out.extend_from_slice(&v.to_le_bytes());
@@ -119,6 +121,7 @@ pub fn from_bytes(bytes: &[u8], path: &str) -> Result<Tables> {
         s.irradiance_mu_s * s.irradiance_r * n,
         scat * n,
         scat * mie_channels,
+        scat * n,
     ];
     let data = &body[16 + hlen..];
     if data.len() != counts.iter().sum::<usize>() * 4 {
@@ -165,6 +168,8 @@ pub fn from_bytes(bytes: &[u8], path: &str) -> Result<Tables> {
         mie_channels,
     );
     single_mie.data = take(counts[3]);
+    let mut multiple = scattering.clone();
+    multiple.data = take(counts[4]);
     let hash = u64::from_str_radix(&header.atmosphere_hash, 16)
         .map_err(|_| bad("bad atmosphere hash".into()))?;
     Ok(Tables {
@@ -177,6 +182,7 @@ pub fn from_bytes(bytes: &[u8], path: &str) -> Result<Tables> {
         single_mie,
         order_means: header.order_means,
         mie_ratio: header.mie_ratio,
+        multiple,
     })
 }
 

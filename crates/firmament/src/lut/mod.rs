@@ -79,8 +79,8 @@ pub struct Tables {
     pub transmittance: Table2,
     /// Indirect (sky) ground irradiance E(r, μ_s), W·m⁻²·nm⁻¹.
     pub irradiance: Table2,
-    /// Rayleigh single scattering plus all multiple scattering divided by the molecular
-    /// phase function (W·m⁻²·sr⁻¹·nm⁻¹ per unit phase).
+    /// Single scattering by the molecular group without its phase function
+    /// (W·m⁻²·sr⁻¹·nm⁻¹ per unit phase).
     pub scattering: Table4,
     /// Single Mie scattering without phase function (full or first channel only).
     pub single_mie: Table4,
@@ -89,6 +89,11 @@ pub struct Tables {
     pub order_means: Vec<Vec<f64>>,
     /// Ratio rule factors (β_R[0]/β_M[0])·(β_M[k]/β_R[k]) for [`MieStorage::RedOnly`].
     pub mie_ratio: Vec<f64>,
+    /// Multiple scattering, orders 2 to N summed, as radiance (W·m⁻²·sr⁻¹·nm⁻¹). Bruneton
+    /// 2017 folds it into `scattering` divided by the molecular phase function; kept apart,
+    /// its interpolation in μ_s does not mix the phase function's values at different ν
+    /// (that mix read the anti-solar sky near the horizon +8 % high under a high sun).
+    pub multiple: Table4,
 }
 
 impl Tables {

@@ -203,7 +203,7 @@ pub fn scattering_uvwz(
     let u_r = texcoord_from_unit(rho / g.h(), s.scattering_r);
     let u_mu = scattering_u_mu(g, s, r, mu, ray_r_mu_intersects_ground);
     let u_mu_s = texcoord_from_unit(x_mu_s(g, mu_s), s.scattering_mu_s);
-    [u_nu_from_nu(nu), u_mu_s, u_mu, u_r]
+    [u_nu(mu, mu_s, nu), u_mu_s, u_mu, u_r]
 }
 
 /// The u_μ coordinate of [`scattering_uvwz`] alone (for lookups at a known (r, μ_s)).
@@ -314,20 +314,33 @@ impl MuSPositions {
     }
 }
 
-/// The ν coordinate. Bruneton uses u_ν = (ν + 1)/2, which puts 2 of 8 samples within 45° of
-/// the sun; the circumsolar multiple scattering then interpolates 10 % high 30° from the sun
-/// (measured with `firmament validate`). We use u_ν = 1 − sin(γ/2), γ the angle from the sun
-/// (sin(γ/2) = sqrt((1 − ν)/2)): samples uniform in angle, 0°, 16°, 33°, 51°, … for 8.
+/// The ν coordinate, relative to the range of ν that (μ, μ_s) allow. Bruneton uses
+/// u_ν = (ν + 1)/2 and clamps ν per texel to [μμ_s − s, μμ_s + s], s = √((1−μ²)(1−μ_s²)):
+/// most ν texels then hold clamped, repeated values, and interpolating in μ_s mixes
+/// texels for which the same ν means a different direction (the anti-solar sky near the
+/// horizon under a high sun read +11 % in `firmament validate`). We parameterise by the
+/// azimuth φ between the view and the sun around the zenith, cos φ = (ν − μμ_s)/s, with
+/// u_ν = 1 − sin(φ/2): every texel is a real direction, samples are denser towards the
+/// sun (φ = 0°, 16°, 33°, 51°, 69°, 91°, 117°, 180° for 8), and a fixed u_ν is the same
+/// relative geometry at every (μ, μ_s).
 #[inline]
-pub fn u_nu_from_nu(nu: f64) -> f64 {
-    1.0 - (0.5 * (1.0 - nu.clamp(-1.0, 1.0))).sqrt()
+pub fn u_nu(mu: f64, mu_s: f64, nu: f64) -> f64 {
+    let s = ((1.0 - mu * mu) * (1.0 - mu_s * mu_s)).max(0.0).sqrt();
+    if s <= 1e-12 {
+        // φ is undefined and every u_ν holds the same value.
+        return 1.0;
+    }
+    // (1 − cos φ)/2 = sin²(φ/2).
+    let x = ((mu * mu_s + s - nu) / (2.0 * s)).clamp(0.0, 1.0);
+    1.0 - x.sqrt()
 }
 
-/// Inverse of [`u_nu_from_nu`].
+/// Inverse of [`u_nu`] at (μ, μ_s).
 #[inline]
-pub fn nu_from_u_nu(u_nu: f64) -> f64 {
+pub fn nu_from_u_nu(mu: f64, mu_s: f64, u_nu: f64) -> f64 {
+    let s = ((1.0 - mu * mu) * (1.0 - mu_s * mu_s)).max(0.0).sqrt();
     let x = 1.0 - u_nu.clamp(0.0, 1.0);
-    clamp_cosine(1.0 - 2.0 * x * x)
+    clamp_cosine(mu * mu_s + s * (1.0 - 2.0 * x * x))
 }
 
 /// The non-linear μ_s coordinate in [0,1] (Bruneton 2017): from the distance to the top
@@ -388,7 +401,7 @@ pub fn scattering_r_mu_mu_s_nu(
         (mu, false)
     };
     let mu_s = mu_s_from_x(g, unit_from_texcoord(u_mu_s, s.scattering_mu_s));
-    let nu = nu_from_u_nu(u_nu);
+    let nu = nu_from_u_nu(mu, mu_s, u_nu);
     (r, mu, mu_s, nu, ground)
 }
 

@@ -178,7 +178,13 @@ pub fn precompute(
         &groups,
         &lookup,
     )];
-    let mut scattering = delta_rayleigh.clone();
+    let mut multiple = Table4::new(
+        s.scattering_r,
+        s.scattering_mu,
+        s.scattering_mu_s,
+        s.scattering_nu,
+        n,
+    );
 
     if orders >= 2 {
         let kernels = PhaseKernels::new(&lookup, &groups);
@@ -217,7 +223,7 @@ pub fn precompute(
             delta_multiple = compute_multiple_scattering(model, &lookup, &density);
             check_cancel(cancel)?;
             order_means.push(table_mean(&delta_multiple));
-            accumulate_multiple(&mut scattering, &delta_multiple, &groups, &lookup);
+            multiple.add_assign(&delta_multiple);
         }
     }
     progress("done", 1.0);
@@ -244,10 +250,11 @@ pub fn precompute(
         atmosphere_hash: model.hash,
         transmittance,
         irradiance,
-        scattering,
+        scattering: delta_rayleigh,
         single_mie,
         order_means,
         mie_ratio: mie_ratio(&groups, n),
+        multiple,
     })
 }
 
@@ -381,6 +388,8 @@ struct RaySamples {
     t: Vec<f64>,
     /// Quadrature weights (Simpson), in units of the step.
     w: Vec<f64>,
+    /// Quadrature weight × transmittance per sample and channel.
+    tw: Vec<f64>,
 }
 
 impl RaySamples {
@@ -396,6 +405,7 @@ impl RaySamples {
             mu: Vec::with_capacity(count),
             t: vec![0.0; count * n],
             w: Vec::with_capacity(count),
+            tw: Vec::new(),
         };
         for i in 0..count {
             let d = i as f64 * dx;
@@ -412,8 +422,78 @@ impl RaySamples {
             });
             lookup.transmittance(r, mu, d, ground, &mut rs.t[i * n..(i + 1) * n]);
         }
+        rs.tw = exponential_simpson_weights(&rs.t, n);
         rs
     }
+}
+
+/// Quadrature weights (in units of the step) for ∫ g(d)·T(d) dd over the ray samples,
+/// per sample and channel: Simpson's rule with the transmittance T factored out as an
+/// exponential over each pair of intervals (an exponentially fitted Simpson rule, a
+/// Filon-type product rule). Plain Simpson on g·T overestimates when an interval is
+/// optically thick (Δτ ≳ 1: horizontal rays near the ground in the blue, +6.6 % single
+/// scattering at 0.5° elevation, measured against a brute-force quadrature); this rule is
+/// exact for g quadratic and T exponential, and tends to Simpson as Δτ → 0.
+fn exponential_simpson_weights(t: &[f64], n: usize) -> Vec<f64> {
+    let count = t.len() / n;
+    let mut w = vec![0.0; t.len()];
+    for pair in 0..(count - 1) / 2 {
+        let i = 2 * pair;
+        for k in 0..n {
+            let (t0, t1, t2) = (t[i * n + k], t[(i + 1) * n + k], t[(i + 2) * n + k]);
+            if t0 <= 0.0 {
+                continue;
+            }
+            // Decay rate per step of the exponential T_fit(s) = T_0·e^{−a·s} through the
+            // pair's end points (through the first two samples when the last is blocked).
+            let a = if t2 > 0.0 {
+                0.5 * (t0 / t2).ln()
+            } else if t1 > 0.0 {
+                (t0 / t1).ln()
+            } else {
+                0.0
+            }
+            .clamp(0.0, 300.0);
+            let m = lagrange_exponential_moments(a);
+            // g·T = (g·q)·T_fit with q = T/T_fit smooth; g·q interpolated quadratically:
+            // the weight on g_j is T_0·q_j·M_j = T_j·e^{a·j}·M_j.
+            w[i * n + k] += t0 * m[0];
+            w[(i + 1) * n + k] += t1 * a.exp() * m[1];
+            w[(i + 2) * n + k] += t2 * (2.0 * a).exp() * m[2];
+        }
+    }
+    w
+}
+
+/// ∫₀² e^{−a·s} L_j(s) ds for the quadratic Lagrange basis on the nodes 0, 1, 2
+/// (L_0 = (s−1)(s−2)/2, L_1 = s(2−s), L_2 = s(s−1)/2); (1/3, 4/3, 1/3) at a = 0.
+fn lagrange_exponential_moments(a: f64) -> [f64; 3] {
+    // I_m = ∫₀² s^m e^{−a·s} ds.
+    let (i0, i1, i2) = if a < 1.0 {
+        // Series Σ_k (−a)^k/k! · 2^{m+k+1}/(m+k+1): no cancellation for small a.
+        let (mut i0, mut i1, mut i2) = (0.0, 0.0, 0.0);
+        let mut c = 1.0; // (−a)^k/k! · 2^k
+        for k in 0..30 {
+            let kf = k as f64;
+            i0 += c * 2.0 / (kf + 1.0);
+            i1 += c * 4.0 / (kf + 2.0);
+            i2 += c * 8.0 / (kf + 3.0);
+            c *= -2.0 * a / (kf + 1.0);
+        }
+        (i0, i1, i2)
+    } else {
+        let e = (-2.0 * a).exp();
+        (
+            (1.0 - e) / a,
+            (1.0 - e * (1.0 + 2.0 * a)) / (a * a),
+            (2.0 - e * (2.0 + 4.0 * a + 4.0 * a * a)) / (a * a * a),
+        )
+    };
+    [
+        0.5 * (i2 - 3.0 * i1 + 2.0 * i0),
+        2.0 * i1 - i2,
+        0.5 * (i2 - i1),
+    ]
 }
 
 /// The transmittance table filtered to one radius, for lookups towards the sun from one
@@ -525,7 +605,7 @@ fn compute_single_scattering(model: &Model, lookup: &Lookup, groups: &Groups) ->
                 let sun_row = SunRow::new(lookup, rays.r[i]);
                 let (d_i, inv_r_i) = (rays.d[i], 1.0 / rays.r[i]);
                 for k in 0..n {
-                    let t = rays.w[i] * rays.t[i * n + k];
+                    let t = rays.tw[i * n + k];
                     tb[0][k] = t * beta[0][i * n + k];
                     tb[1][k] = t * beta[1][i * n + k];
                 }
@@ -927,25 +1007,27 @@ fn compute_multiple_scattering(model: &Model, lookup: &Lookup, density: &Table4)
                 }
             }
             let nmu_s = s.scattering_mu_s;
-            // Per texel: (μ_s, ν) and the ν filter, once.
-            let texels: Vec<(f64, f64, usize, usize, f64)> = (0..width)
+            let texels: Vec<(f64, f64)> = (0..width)
                 .map(|x| {
                     let (_, _, mu_s, nu, _) = params::scattering_texel(&g, &s, x, y, z);
-                    let tex_x = params::u_nu_from_nu(nu) * (s.scattering_nu - 1) as f64;
-                    let nu0 = (tex_x as usize).min(s.scattering_nu - 1);
-                    let nu1 = (nu0 + 1).min(s.scattering_nu - 1);
-                    (mu_s, nu, nu0 * nmu_s, nu1 * nmu_s, tex_x - nu0 as f64)
+                    (mu_s, nu)
                 })
                 .collect();
+            let nnu = s.scattering_nu;
             // Samples outer, texels inner: each sample's filtered row stays in cache.
             let mut acc = vec![0.0; width * n];
             for i in 0..count {
                 let b = &blended[i * row_len..(i + 1) * row_len];
-                let t_i = &rays.t[i * n..(i + 1) * n];
-                let (d_i, inv_r_i, wt) = (rays.d[i], 1.0 / rays.r[i], rays.w[i]);
-                for (x, &(mu_s, nu, base0, base1, tnu)) in texels.iter().enumerate() {
+                let t_i = &rays.tw[i * n..(i + 1) * n];
+                let (d_i, inv_r_i, wt) = (rays.d[i], 1.0 / rays.r[i], 1.0);
+                let mu_i = rays.mu[i];
+                for (x, &(mu_s, nu)) in texels.iter().enumerate() {
                     let mu_s_i = ((r * mu_s + d_i * nu) * inv_r_i).clamp(-1.0, 1.0);
                     let (s0, s1, ts) = mu_s_positions.filter(mu_s_i);
+                    let tex_x = params::u_nu(mu_i, mu_s_i, nu) * (nnu - 1) as f64;
+                    let nu0 = (tex_x as usize).min(nnu - 1);
+                    let nu1 = (nu0 + 1).min(nnu - 1);
+                    let (base0, base1, tnu) = (nu0 * nmu_s, nu1 * nmu_s, tex_x - nu0 as f64);
                     let (a0, a1, a2, a3) = (
                         (base0 + s0) * n,
                         (base0 + s1) * n,
@@ -970,28 +1052,4 @@ fn compute_multiple_scattering(model: &Model, lookup: &Lookup, density: &Table4)
             }
         });
     out
-}
-
-/// scattering += ΔS / P_molecules(ν) (Bruneton 2017: the table stores Rayleigh-like
-/// radiance divided by the phase function applied at render time).
-fn accumulate_multiple(scattering: &mut Table4, delta: &Table4, groups: &Groups, lookup: &Lookup) {
-    let s = lookup.sizes;
-    let n = scattering.channels;
-    let width = scattering.width();
-    let row_len = scattering.row_len();
-    scattering
-        .data
-        .par_chunks_mut(row_len)
-        .zip(delta.data.par_chunks(row_len))
-        .enumerate()
-        .for_each(|(row, (o, d))| {
-            let (z, y) = (row / s.scattering_mu, row % s.scattering_mu);
-            for x in 0..width {
-                let (_, _, _, nu, _) = params::scattering_texel(&lookup.radii, &s, x, y, z);
-                let p = groups.phase[0].eval(nu).max(1e-6);
-                for k in 0..n {
-                    o[x * n + k] += (d[x * n + k] as f64 / p) as f32;
-                }
-            }
-        });
 }

@@ -219,12 +219,25 @@ impl Table4 {
     /// Sample a [`Table4::slice`] at (u_ν, u_μ) into `out`.
     #[inline]
     pub fn sample_slice_into(&self, slice: &[f64], u_nu: f64, u_mu: f64, out: &mut [f64]) {
+        self.sample_slice_channels_into(slice, self.channels, u_nu, u_mu, out)
+    }
+
+    /// As [`Table4::sample_slice_into`] for a slice of this table's layout holding `c`
+    /// values per texel (several tables' slices interleaved).
+    #[inline]
+    pub fn sample_slice_channels_into(
+        &self,
+        slice: &[f64],
+        c: usize,
+        u_nu: f64,
+        u_mu: f64,
+        out: &mut [f64],
+    ) {
         let tex_x = u_nu * (self.nnu - 1) as f64;
         let nu0 = (tex_x.max(0.0) as usize).min(self.nnu - 1);
         let nu1 = (nu0 + 1).min(self.nnu - 1);
         let tnu = tex_x - nu0 as f64;
         let (y0, y1, ty) = lerp_weights(u_mu, self.nmu);
-        let c = self.channels;
         let (a, b, d, e) = (
             (y0 * self.nnu + nu0) * c,
             (y0 * self.nnu + nu1) * c,
