@@ -137,9 +137,13 @@ fn from_orbit_the_planet_has_a_bright_limb_and_a_black_night_side() {
     // The night side (left, well inside the disk) is black next to the day side.
     let night = (5..w / 2 - 20).map(|x| y(x, row)).fold(0.0, f64::max);
     assert!(night < 1e-3 * ground, "night {night} day {ground}");
-    // The limb is thin: its bright part spans few pixels.
-    let bright = xs.iter().filter(|&&v| v > 0.5 * limb).count();
-    assert!(bright < 15, "{bright} bright limb pixels");
+    // The limb is thin and bright: the peak is at the outer edge of the lit disk, above
+    // the ground just inside it.
+    let edge = xs.iter().rposition(|&v| v > 0.0).unwrap();
+    let peak = xs.iter().position(|&v| v == limb).unwrap();
+    assert!(edge - peak <= 1, "peak at {peak}, edge at {edge}: {xs:?}");
+    let inside = xs[edge - 12..edge - 2].iter().sum::<f64>() / 10.0;
+    assert!(limb > 1.1 * inside, "limb {limb}, just inside {inside}");
 }
 
 #[test]

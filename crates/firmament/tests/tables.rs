@@ -280,7 +280,7 @@ fn scattering_orders_decrease_and_converge() {
     }
     // More orders add light: the summed table grows.
     let three = Tables::compute(&model, &tiny(3)).unwrap();
-    let sum = |t: &Tables| t.scattering.data.iter().map(|&v| v as f64).sum::<f64>();
+    let sum = |t: &Tables| t.multiple.data.iter().map(|&v| v as f64).sum::<f64>();
     assert!(sum(&tables) > sum(&three));
 }
 
@@ -297,6 +297,7 @@ fn every_preset_precomputes_finite_non_negative_tables() {
             &t.single_mie.data,
             &t.irradiance.data,
             &t.transmittance.data,
+            &t.multiple.data,
         ] {
             assert!(
                 table.iter().all(|v| v.is_finite() && *v >= 0.0),
@@ -403,4 +404,70 @@ fn table_files_round_trip_and_bad_files_are_refused() {
         .unwrap_err()
         .to_string()
         .contains("wavelengths"));
+}
+
+/// Single scattering along nearly horizontal rays from the ground, where the ray is
+/// optically thick in the blue (the extinction length at the ground is ~9 km, a table ray
+/// step ~16 km): the tables against an independent brute-force quadrature (midpoint rule,
+/// 10 m steps, the sun's transmittance by Gauss–Legendre per step). Plain Simpson weights
+/// read +6.6 % in the blue at 0.5°; the exponentially fitted rule 0.1 %.
+#[test]
+fn single_scattering_near_the_horizon_matches_brute_force_quadrature() {
+    use firmament::geometry::{dot, Vec3};
+    use firmament::render::sun_direction;
+    use firmament::sky::Sky;
+    let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
+    let config = TableConfig {
+        orders: 1,
+        ..Default::default()
+    };
+    let sky = Sky::new(model.clone(), Tables::compute(&model, &config).unwrap()).unwrap();
+    let sun = sun_direction(30.0, 180.0);
+    let r0 = model.bottom_radius_m + 1.0;
+    let camera: Vec3 = [0.0, 0.0, r0];
+    for elevation_deg in [0.5f64, 2.0] {
+        let view = sun_direction(90.0 - elevation_deg, 0.0);
+        let nu = dot(view, sun);
+        let length = distance_to_top_atmosphere_boundary(
+            r0,
+            elevation_deg.to_radians().sin(),
+            model.top_radius_m,
+        );
+        // Fine steps where the light comes from (the first 200 km), coarser beyond.
+        let mut brute = [0.0f64; 3];
+        let mut tau = [0.0f64; 3];
+        let mut extinction = [0.0; 3];
+        let mut d = 0.0;
+        while d < length {
+            let h = if d < 200e3 { 10.0f64 } else { 200.0 }.min(length - d);
+            let m = d + 0.5 * h;
+            let p = [view[0] * m, view[1] * m, r0 + view[2] * m];
+            let rp = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+            let altitude = rp - model.bottom_radius_m;
+            model.extinction_into(altitude, &mut extinction);
+            let mu_s = dot(p, sun) / rp;
+            let to_sun = distance_to_top_atmosphere_boundary(rp, mu_s, model.top_radius_m);
+            let tau_sun = model.optical_depth_along_ray(rp, mu_s, to_sun);
+            for k in 0..3 {
+                let mut j = 0.0;
+                for c in &model.constituents {
+                    j += c.density.density(altitude) * c.scattering[k] * c.phase.eval(nu);
+                }
+                let t = (-(tau[k] + 0.5 * h * extinction[k]) - tau_sun[k]).exp();
+                brute[k] += h * j * t * model.solar_irradiance[k];
+                tau[k] += h * extinction[k];
+            }
+            d += h;
+        }
+        let (mut table, mut t) = (vec![0.0; 3], vec![0.0; 3]);
+        sky.sky_radiance(camera, view, 0.0, sun, &mut table, &mut t);
+        for k in 0..3 {
+            let e = table[k] / brute[k] - 1.0;
+            println!("elevation {elevation_deg}°, channel {k}: table/brute − 1 = {e:+.4}");
+            assert!(
+                e.abs() < 0.015,
+                "elevation {elevation_deg}°, channel {k}: {e:+.4}"
+            );
+        }
+    }
 }

@@ -463,7 +463,10 @@ mod tests {
             for &mu in &[-0.9, mu_h - 1e-3, mu_h + 1e-3, 0.2, 0.95] {
                 for &mu_s in &[-0.15, 0.0, 0.3, 0.9] {
                     let ground = crate::geometry::ray_intersects_ground(r, mu, G.bottom);
-                    let uvwz = scattering_uvwz(&G, &s, r, mu, mu_s, 0.1, ground);
+                    // A direction that exists: azimuth 72.5° from the sun (cos φ = 0.3).
+                    let spread = ((1.0 - mu * mu) * (1.0 - mu_s * mu_s)).sqrt();
+                    let nu = mu * mu_s + 0.3 * spread;
+                    let uvwz = scattering_uvwz(&G, &s, r, mu, mu_s, nu, ground);
                     // Horizon discontinuity: ground rays in the lower half, sky rays in the upper.
                     assert_eq!(uvwz[2] < 0.5, ground);
                     let (r2, mu2, mu_s2, nu2, g2) = scattering_r_mu_mu_s_nu(&G, &s, uvwz);
@@ -471,10 +474,33 @@ mod tests {
                     assert!((r2 - r).abs() / r < 1e-9);
                     assert!((mu2 - mu).abs() < 1e-6, "mu {mu} -> {mu2} at r {r}");
                     assert!((mu_s2 - mu_s).abs() < 1e-6, "mu_s {mu_s} -> {mu_s2}");
-                    assert!((nu2 - 0.1).abs() < 1e-12);
+                    assert!((nu2 - nu).abs() < 1e-6, "nu {nu} -> {nu2}");
                 }
             }
         }
+    }
+
+    #[test]
+    fn nu_mapping_is_the_azimuth_within_the_valid_range() {
+        for &(mu, mu_s) in &[(0.0, 0.866), (0.5, 0.5), (-0.3, 0.1), (0.99, -0.2)] {
+            let spread = ((1.0f64 - mu * mu) * (1.0 - mu_s * mu_s)).sqrt();
+            let mut last = -1.0;
+            for j in 0..=36 {
+                let phi = std::f64::consts::PI * j as f64 / 36.0;
+                let nu = mu * mu_s + spread * phi.cos();
+                let u = u_nu(mu, mu_s, nu);
+                // u_ν = 1 − sin(φ/2): 1 towards the sun, 0 opposite, every texel valid.
+                assert!(
+                    (u - (1.0 - (0.5 * phi).sin())).abs() < 1e-7,
+                    "u {u} at φ {phi}"
+                );
+                assert!((nu_from_u_nu(mu, mu_s, u) - nu).abs() < 1e-9);
+                assert!(j == 0 || u < last);
+                last = u;
+            }
+        }
+        // Degenerate range (view or sun at the zenith): every u_ν is the same direction.
+        assert_eq!(nu_from_u_nu(1.0, 0.3, 0.2), 0.3);
     }
 
     #[test]
