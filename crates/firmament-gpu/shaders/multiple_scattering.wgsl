@@ -1,13 +1,36 @@
 // Multiple scattering ΔS of order n from ΔJ (paper eq. 12, Bruneton 2017
-// `ComputeMultipleScattering`; lut::precompute::compute_multiple_scattering): 50 Simpson
-// intervals along the view ray. Adds ΔS/P_molecules(ν) to the scattering sum (the table
-// stores Rayleigh-like radiance divided by the phase function applied at render time).
-// Reads ΔJ at slot a.
+// `ComputeMultipleScattering`; lut::precompute::compute_multiple_scattering): 50 intervals
+// along the view ray with the exponentially fitted Simpson rule (Filon-type, functions.wgsl
+// `exponential_simpson_weights`), pair of intervals by pair. ΔJ is looked up at each sample
+// with u_ν from (μ, μ_s) at that sample (params::u_nu: the azimuth relative to the range
+// of ν there). Adds ΔS, as radiance, to the multiple-scattering sum (`Tables::multiple`;
+// not divided by a phase function). Reads ΔJ at slot a.
 
 @group(0) @binding(7) var<storage, read_write> delta_multiple_out: array<vec4<f32>>;
-@group(0) @binding(8) var<storage, read_write> scattering_sum: array<vec4<f32>>;
+@group(0) @binding(8) var<storage, read_write> multiple_sum: array<vec4<f32>>;
 
 const RAY_INTERVALS: u32 = 50u;
+
+// One ray sample: the transmittance from the ray origin and ΔJ there.
+struct MultipleSample {
+    t: vec4<f32>,
+    j: vec4<f32>,
+}
+
+fn multiple_sample(t: ScatteringTexel, d: f32, k: u32) -> MultipleSample {
+    let rho_d = rho_at(t.r, t.rho, t.mu, d);
+    let r_d = radius_from_rho(rho_d);
+    let mu_d = clamp_cosine((t.r * t.mu + d) / r_d);
+    let uvwz = scattering_uvwz(r_d, rho_d, mu_d, 0.0, 0.0, t.ground);
+    let mu_s_d = clamp_cosine((t.r * t.mu_s + d * t.nu) / r_d);
+    let u_mu_s = texcoord_from_unit(x_mu_s(mu_s_d), atm.scattering_mu_s);
+    let u_nu = u_nu_from_nu(mu_d, mu_s_d, t.nu);
+    let f = scattering_filter_rows(u_nu, u_mu_s, lerp_weights(uvwz.z, atm.scattering_mu), lerp_weights(uvwz.w, atm.scattering_r));
+    var s: MultipleSample;
+    s.t = transmittance(t.r, t.rho, t.mu, d, t.ground, k);
+    s.j = sample_scattering_a(f, k);
+    return s;
+}
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -28,22 +51,19 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         ray_length = distance_to_top(t.r, t.rho, t.mu);
     }
     let dx = ray_length / f32(RAY_INTERVALS);
-    let u_nu = u_nu_from_nu(t.nu);
     var acc = vec4<f32>(0.0);
-    for (var s = 0u; s <= RAY_INTERVALS; s++) {
-        let d = f32(s) * dx;
-        let rho_d = rho_at(t.r, t.rho, t.mu, d);
-        let r_d = radius_from_rho(rho_d);
-        let mu_d = clamp_cosine((t.r * t.mu + d) / r_d);
-        let uvwz = scattering_uvwz(r_d, rho_d, mu_d, 0.0, 0.0, t.ground);
-        let mu_s_d = clamp_cosine((t.r * t.mu_s + d * t.nu) / r_d);
-        let u_mu_s = texcoord_from_unit(x_mu_s(mu_s_d), atm.scattering_mu_s);
-        let f = scattering_filter_rows(u_nu, u_mu_s, lerp_weights(uvwz.z, atm.scattering_mu), lerp_weights(uvwz.w, atm.scattering_r));
-        let w = ray_weight(s);
-        acc += w * transmittance(t.r, t.rho, t.mu, d, t.ground, k) * sample_scattering_a(f, k);
+    // Samples 2p, 2p + 1, 2p + 2 of pair p; the last is the next pair's first.
+    var s0 = multiple_sample(t, 0.0, k);
+    for (var p = 0u; p < RAY_INTERVALS / 2u; p++) {
+        let s1 = multiple_sample(t, f32(2u * p + 1u) * dx, k);
+        let s2 = multiple_sample(t, f32(2u * p + 2u) * dx, k);
+        let w = exponential_simpson_weights(s0.t, s1.t, s2.t);
+        acc += w.w0 * s0.j + w.w1 * s1.j + w.w2 * s2.j;
+        s0 = s2;
     }
+    // Clamped at 0 as on the CPU (a negative end weight can take a sum below zero).
     let o = i * atm.groups + k;
-    let delta = acc * dx;
+    let delta = max(acc * dx, vec4<f32>(0.0));
     delta_multiple_out[o] = delta;
-    scattering_sum[o] += delta / max(group_phase(0u, t.nu), 1e-6);
+    multiple_sum[o] += delta;
 }

@@ -5,8 +5,10 @@
 // The tables are bound at the slots functions.wgsl declares for the precomputation passes:
 //   3 transmittance_table     T(r, μ) to the top
 //   4 delta_irradiance_table  the final indirect irradiance E(r, μ_s) (Tables::irradiance)
-//   5 scattering_a            Rayleigh + multiple scattering (Tables::scattering)
+//   5 scattering_a            single molecular scattering (Tables::scattering)
 //   6 scattering_b            single Mie (Tables::single_mie; see Frame.mie_layout)
+//   7 multiple_table          multiple scattering, radiance (Tables::multiple; declared
+//                             here, the precomputation's output slot)
 //
 // Geometry is in km relative to the planet centre, but never through planet-scale
 // differences: the camera's ρ = sqrt(r² − R_g²) and its height above the top of the
@@ -52,18 +54,23 @@ struct Frame {
     pad1: f32,
 }
 
+@group(0) @binding(7) var<storage, read> multiple_table: array<vec4<f32>>;
 @group(0) @binding(10) var<uniform> frame: Frame;
 // Per channel group k, at k·CHANNEL_STRIDE: the linear sRGB rows of the colour matrix
 // (render::ColourMatrix::to_srgb, 3 vec4), the sun's centre radiance times the six
 // limb-darkening polynomial coefficients (Sky::solar_radiance_centre × limb_darkening, 6
-// vec4), and the red-only Mie ratio factors (Tables::mie_ratio, 1 vec4).
-@group(0) @binding(11) var<storage, read> channel_data: array<vec4<f32>>;
+// vec4), and the red-only Mie ratio factors (Tables::mie_ratio, 1 vec4). A uniform, room
+// for 64 wavelengths (16 groups; CHANNEL_DATA_VEC4 in render.rs), so that the pass binds no
+// more than 8 storage buffers.
+@group(0) @binding(11) var<uniform> channel_data: array<vec4<f32>, 160>;
 // Linear sRGB (Y in cd/m²) and 1 in w for pixels inside the projection; zeros outside.
 @group(0) @binding(12) var<storage, read_write> frame_out: array<vec4<f32>>;
 
-// The camera slice (render::camera_slice, Table4::slice): the scattering and single Mie
-// tables filtered at the camera's (u_μs, u_r), written by `camera_slice` each frame; entry
-// (y·N_ν + ν)·2·groups + k for scattering, + groups for Mie (channel 0 in x when red-only).
+// The camera slice (render::camera_slice, Sky::slice): the single, multiple and single Mie
+// scattering tables filtered at the camera's (u_μs, u_r), written by `camera_slice` each
+// frame; entry e = y·N_ν + ν at e·3·groups + k for single scattering, + groups for
+// multiple scattering ([single; multiple] interleaved as in Sky::slice), + 2·groups for
+// Mie (channel 0 in x when red-only).
 @group(0) @binding(13) var<storage, read_write> slice_table: array<vec4<f32>>;
 
 const CHANNEL_STRIDE: u32 = 10u;
@@ -263,9 +270,24 @@ fn sample_mie_red(f: Filter4) -> f32 {
         + f.wrow.z * mie_red_row(f, f.row.z) + f.wrow.w * mie_red_row(f, f.row.w);
 }
 
-// Rayleigh + multiple scattering and single Mie of channel group k (Sky::
-// combined_scattering_sliced). With red-only Mie, `red` is the channel-0 Mie sample and
-// `scat0` the channel-0 scattering, known once group 0 has been read.
+// Multiple scattering of channel group k at a 4D filter (Table4::sample_into on
+// Tables::multiple), as sample_scattering_a does for slot a.
+fn multiple_row(f: Filter4, row: u32, k: u32) -> vec4<f32> {
+    let g = atm.groups;
+    return f.wcol.x * multiple_table[(row + f.col.x) * g + k] + f.wcol.y * multiple_table[(row + f.col.y) * g + k]
+        + f.wcol.z * multiple_table[(row + f.col.z) * g + k] + f.wcol.w * multiple_table[(row + f.col.w) * g + k];
+}
+
+fn sample_multiple(f: Filter4, k: u32) -> vec4<f32> {
+    return f.wrow.x * multiple_row(f, f.row.x, k) + f.wrow.y * multiple_row(f, f.row.y, k)
+        + f.wrow.z * multiple_row(f, f.row.z, k) + f.wrow.w * multiple_row(f, f.row.w, k);
+}
+
+// Single molecular scattering plus multiple scattering divided by the molecular phase
+// function (callers multiply by it), and single Mie, of channel group k (Sky::
+// combined_scattering_sliced). `p_r` is max(P_molecules(ν), 1e-30). With red-only Mie, `red`
+// is the channel-0 Mie sample and `scat0` the channel-0 combined scattering (multiple
+// included, as the CPU's ratio rule takes it), known once group 0 has been read.
 struct Combined {
     scattering: vec4<f32>,
     mie: vec4<f32>,
@@ -284,9 +306,9 @@ fn mie_from_red(scattering: vec4<f32>, k: u32, red: f32, scat0: f32) -> vec4<f32
 }
 
 // From the 4D tables (Table4::sample_into).
-fn combined_scattering(f: Filter4, k: u32, red: f32, scat0: f32) -> Combined {
+fn combined_scattering(f: Filter4, k: u32, red: f32, scat0: f32, p_r: f32) -> Combined {
     var c: Combined;
-    c.scattering = sample_scattering_a(f, k);
+    c.scattering = sample_scattering_a(f, k) + sample_multiple(f, k) / p_r;
     if (frame.mie_layout == 0u) {
         c.mie = sample_scattering_b(f, k);
     } else {
@@ -295,8 +317,8 @@ fn combined_scattering(f: Filter4, k: u32, red: f32, scat0: f32) -> Combined {
     return c;
 }
 
-// The bilinear (ν, μ) filter of the camera slice (Table4::sample_slice_into); indices are
-// slice entries (y·N_ν + ν).
+// The bilinear (ν, μ) filter of the camera slice (Table4::sample_slice_channels_into);
+// indices are slice entries (y·N_ν + ν).
 fn slice_filter(u_nu: f32, u_mu: f32) -> Filter2 {
     let nnu = atm.scattering_nu;
     let tex_x = u_nu * f32(nnu - 1u);
@@ -311,17 +333,17 @@ fn slice_filter(u_nu: f32, u_mu: f32) -> Filter2 {
 }
 
 fn sample_slice(f: Filter2, offset: u32) -> vec4<f32> {
-    let stride = 2u * atm.groups;
+    let stride = 3u * atm.groups;
     return f.weight.x * slice_table[f.index.x * stride + offset] + f.weight.y * slice_table[f.index.y * stride + offset]
         + f.weight.z * slice_table[f.index.z * stride + offset] + f.weight.w * slice_table[f.index.w * stride + offset];
 }
 
 // From the camera slice.
-fn combined_scattering_slice(f: Filter2, k: u32, red: f32, scat0: f32) -> Combined {
+fn combined_scattering_slice(f: Filter2, k: u32, red: f32, scat0: f32, p_r: f32) -> Combined {
     var c: Combined;
-    c.scattering = sample_slice(f, k);
+    c.scattering = sample_slice(f, k) + sample_slice(f, atm.groups + k) / p_r;
     if (frame.mie_layout == 0u) {
-        c.mie = sample_slice(f, atm.groups + k);
+        c.mie = sample_slice(f, 2u * atm.groups + k);
     } else {
         c.mie = mie_from_red(c.scattering, k, red, scat0);
     }
@@ -341,25 +363,25 @@ fn start_lookup(s: ViewStart, nu: f32, ground: bool) -> StartLookup {
     var l: StartLookup;
     l.sliced = s.sliced;
     if (s.sliced) {
-        l.slice = slice_filter(u_nu_from_nu(nu), start_u_mu(s, ground));
+        l.slice = slice_filter(u_nu_from_nu(s.mu, s.mu_s, nu), start_u_mu(s, ground));
     } else {
         let u_mu_s = texcoord_from_unit(x_mu_s(s.mu_s), atm.scattering_mu_s);
         let u_r = texcoord_from_unit(s.rho / atm.h, atm.scattering_r);
-        l.table = scattering_filter(vec4<f32>(u_nu_from_nu(nu), u_mu_s, start_u_mu(s, ground), u_r));
+        l.table = scattering_filter(vec4<f32>(u_nu_from_nu(s.mu, s.mu_s, nu), u_mu_s, start_u_mu(s, ground), u_r));
     }
     return l;
 }
 
-fn start_combined(l: StartLookup, k: u32, red: f32, scat0: f32) -> Combined {
+fn start_combined(l: StartLookup, k: u32, red: f32, scat0: f32, p_r: f32) -> Combined {
     if (l.sliced) {
-        return combined_scattering_slice(l.slice, k, red, scat0);
+        return combined_scattering_slice(l.slice, k, red, scat0, p_r);
     }
-    return combined_scattering(l.table, k, red, scat0);
+    return combined_scattering(l.table, k, red, scat0, p_r);
 }
 
 fn start_mie_red(l: StartLookup) -> f32 {
     if (l.sliced) {
-        return sample_slice(l.slice, atm.groups).x;
+        return sample_slice(l.slice, 2u * atm.groups).x;
     }
     return sample_mie_red(l.table);
 }
@@ -436,6 +458,8 @@ fn shade(dir: vec3<f32>) -> vec3<f32> {
     }
     let pr = group_phase(0u, nu);
     let pm = group_phase(1u, nu);
+    // What multiple scattering is divided by (Sky::combined_scattering_sliced).
+    let p_r = max(pr, 1e-30);
     // geometry::ray_intersects_ground with the start's discriminant.
     let ground = s.mu < 0.0 && s.disc_ground >= 0.0;
     let f = start_lookup(s, nu, ground);
@@ -471,8 +495,8 @@ fn shade(dir: vec3<f32>) -> vec3<f32> {
             let a = sample_transmittance(f_t_ground, k);
             let b = sample_transmittance(f_t_camera, k);
             let t = select(vec4<f32>(0.0), min(a / b, vec4<f32>(1.0)), b > vec4<f32>(0.0));
-            let c = start_combined(f, k, red, scat0);
-            let c_p = combined_scattering(f_p, k, red_p, scat0_p);
+            let c = start_combined(f, k, red, scat0, p_r);
+            let c_p = combined_scattering(f_p, k, red_p, scat0_p, p_r);
             if (k == 0u) {
                 scat0 = c.scattering.x;
                 scat0_p = c_p.scattering.x;
@@ -497,7 +521,7 @@ fn shade(dir: vec3<f32>) -> vec3<f32> {
     }
     var scat0 = 0.0;
     for (var k = 0u; k < atm.groups; k++) {
-        let c = start_combined(f, k, red, scat0);
+        let c = start_combined(f, k, red, scat0, p_r);
         if (k == 0u) {
             scat0 = c.scattering.x;
         }
@@ -526,8 +550,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     frame_out[i] = out;
 }
 
-// The camera slice for this frame (Table4::slice at (u_μs, u_r) of the camera): one
-// invocation per (μ, ν) entry and channel group.
+// The camera slice for this frame (Sky::slice: Table4::slice of the single, multiple and
+// single Mie tables at (u_μs, u_r) of the camera): one invocation per (μ, ν) entry and
+// channel group.
 @compute @workgroup_size(64)
 fn camera_slice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = invocation_index(gid, nwg);
@@ -547,6 +572,8 @@ fn camera_slice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     let w = vec4<f32>(1.0 - lz.t, 1.0 - lz.t, lz.t, lz.t) * vec4<f32>(1.0 - ls.t, ls.t, 1.0 - ls.t, ls.t);
     let scattering = w.x * scattering_a[texels.x * g + k] + w.y * scattering_a[texels.y * g + k]
         + w.z * scattering_a[texels.z * g + k] + w.w * scattering_a[texels.w * g + k];
+    let multiple = w.x * multiple_table[texels.x * g + k] + w.y * multiple_table[texels.y * g + k]
+        + w.z * multiple_table[texels.z * g + k] + w.w * multiple_table[texels.w * g + k];
     var mie = vec4<f32>(0.0);
     if (frame.mie_layout == 0u) {
         mie = w.x * scattering_b[texels.x * g + k] + w.y * scattering_b[texels.y * g + k]
@@ -559,6 +586,7 @@ fn camera_slice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
         mie.x = w.x * scattering_b[texels.x * gm].x + w.y * scattering_b[texels.y * gm].x
             + w.z * scattering_b[texels.z * gm].x + w.w * scattering_b[texels.w * gm].x;
     }
-    slice_table[i * 2u * g + k] = scattering;
-    slice_table[i * 2u * g + g + k] = mie;
+    slice_table[i * 3u * g + k] = scattering;
+    slice_table[i * 3u * g + g + k] = multiple;
+    slice_table[i * 3u * g + 2u * g + k] = mie;
 }

@@ -1,12 +1,35 @@
-// Single scattering (Bruneton & Neyret 2008 eq. 7; Bruneton 2017 `ComputeSingleScattering`):
-// Rayleigh and Mie integrated apart without phase functions, 50 Simpson intervals along the
-// view ray. Also initialises the scattering sum with the Rayleigh part.
+// Single scattering (Bruneton & Neyret 2008 eq. 7; Bruneton 2017 `ComputeSingleScattering`;
+// lut::precompute::compute_single_scattering): Rayleigh and Mie integrated apart without
+// phase functions, 50 intervals along the view ray with the exponentially fitted Simpson
+// rule (Filon-type, functions.wgsl `exponential_simpson_weights`), pair of intervals by
+// pair. The Rayleigh part is also the final `Tables::scattering` (multiple scattering is
+// summed apart, multiple_scattering.wgsl).
 
 @group(0) @binding(7) var<storage, read_write> rayleigh_out: array<vec4<f32>>;
 @group(0) @binding(8) var<storage, read_write> mie_out: array<vec4<f32>>;
-@group(0) @binding(9) var<storage, read_write> scattering_sum: array<vec4<f32>>;
 
 const RAY_INTERVALS: u32 = 50u;
+
+// One ray sample: the transmittance from the ray origin, and the Rayleigh and Mie
+// integrands without it (β_s times the transmittance to the sun).
+struct SingleSample {
+    t: vec4<f32>,
+    g_r: vec4<f32>,
+    g_m: vec4<f32>,
+}
+
+fn single_sample(t: ScatteringTexel, d: f32, k: u32) -> SingleSample {
+    let rho_d = rho_at(t.r, t.rho, t.mu, d);
+    let r_d = radius_from_rho(rho_d);
+    let mu_s_d = clamp_cosine((t.r * t.mu_s + d * t.nu) / r_d);
+    let sun = transmittance_to_sun(r_d, rho_d, mu_s_d, k);
+    let altitude = altitude_of(rho_d, r_d);
+    var s: SingleSample;
+    s.t = transmittance(t.r, t.rho, t.mu, d, t.ground, k);
+    s.g_r = sun * group_scattering(0u, altitude, k);
+    s.g_m = sun * group_scattering(1u, altitude, k);
+    return s;
+}
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -29,20 +52,20 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let dx = ray_length / f32(RAY_INTERVALS);
     var acc_r = vec4<f32>(0.0);
     var acc_m = vec4<f32>(0.0);
-    for (var s = 0u; s <= RAY_INTERVALS; s++) {
-        let d = f32(s) * dx;
-        let rho_d = rho_at(t.r, t.rho, t.mu, d);
-        let r_d = radius_from_rho(rho_d);
-        let mu_s_d = clamp_cosine((t.r * t.mu_s + d * t.nu) / r_d);
-        let w = ray_weight(s);
-        let tr = w * transmittance(t.r, t.rho, t.mu, d, t.ground, k) * transmittance_to_sun(r_d, rho_d, mu_s_d, k);
-        let altitude = altitude_of(rho_d, r_d);
-        acc_r += tr * group_scattering(0u, altitude, k);
-        acc_m += tr * group_scattering(1u, altitude, k);
+    // Samples 2p, 2p + 1, 2p + 2 of pair p; the last is the next pair's first.
+    var s0 = single_sample(t, 0.0, k);
+    for (var p = 0u; p < RAY_INTERVALS / 2u; p++) {
+        let s1 = single_sample(t, f32(2u * p + 1u) * dx, k);
+        let s2 = single_sample(t, f32(2u * p + 2u) * dx, k);
+        let w = exponential_simpson_weights(s0.t, s1.t, s2.t);
+        acc_r += w.w0 * s0.g_r + w.w1 * s1.g_r + w.w2 * s2.g_r;
+        acc_m += w.w0 * s0.g_m + w.w1 * s1.g_m + w.w2 * s2.g_m;
+        s0 = s2;
     }
+    // Clamped at 0 as on the CPU: the fitted rule's end weight is negative for a pair with
+    // Δτ > 2.9, so a sum can round below zero.
     let e = solar_irradiance(k) * dx;
     let o = i * atm.groups + k;
-    rayleigh_out[o] = acc_r * e;
-    mie_out[o] = acc_m * e;
-    scattering_sum[o] = acc_r * e;
+    rayleigh_out[o] = max(acc_r * e, vec4<f32>(0.0));
+    mie_out[o] = max(acc_m * e, vec4<f32>(0.0));
 }

@@ -62,13 +62,19 @@ const PIXEL_BYTES: u64 = 16;
 /// Rows of a band are a multiple of this, so that every band's offset in the output buffer
 /// (rows × width × 16 bytes) is a multiple of 256, the largest storage-offset alignment.
 const BAND_ROW_ALIGN: usize = 16;
-/// Storage buffers the render pass binds: data, four tables, channel data, output, camera
-/// slice.
+/// Storage buffers the render pass binds: data, five tables, output, camera slice (the
+/// per-channel data is a uniform buffer, which keeps this within WebGPU's default of 8).
 const STORAGE_BUFFERS_NEEDED: u32 = 8;
 /// The most wavelengths the CPU renderer handles (its per-pixel buffers hold 64).
 const MAX_CHANNELS: usize = 64;
+/// vec4 in the per-channel uniform (`channel_data` in render.wgsl: array<vec4<f32>, 160>),
+/// room for [`MAX_CHANNELS`].
+const CHANNEL_DATA_VEC4: usize = MAX_CHANNELS / GROUP * CHANNEL_STRIDE;
+/// Values per camera-slice entry and channel group: single scattering, multiple scattering,
+/// single Mie (`slice_table` in render.wgsl).
+const SLICE_TABLES: usize = 3;
 
-/// A sky ready to render on the GPU: the atmosphere parameters, the four tables and the
+/// A sky ready to render on the GPU: the atmosphere parameters, the five tables and the
 /// per-channel constants (colour matrix, sun-disk radiance with limb darkening, red-only
 /// Mie ratios) in device buffers.
 pub struct GpuSky {
@@ -77,8 +83,11 @@ pub struct GpuSky {
     channel_data: wgpu::Buffer,
     transmittance: wgpu::Buffer,
     irradiance: wgpu::Buffer,
+    /// Single molecular scattering (`Tables::scattering`).
     scattering: wgpu::Buffer,
     single_mie: wgpu::Buffer,
+    /// Multiple scattering, radiance (`Tables::multiple`).
+    multiple: wgpu::Buffer,
     /// The camera slice of the scattering tables, rewritten by every frame (render.wgsl).
     slice: wgpu::Buffer,
     /// Single Mie layout: 0 all channels, 1 red only with one vec4 per texel, 2 red only in
@@ -99,6 +108,12 @@ impl std::fmt::Debug for GpuSky {
             .field("sizes", &self.sizes)
             .finish()
     }
+}
+
+/// Bytes of the camera slice: [single; multiple; single Mie] per (μ, ν) entry and channel
+/// group.
+fn slice_bytes(sizes: &TableSizes, groups: usize) -> u64 {
+    (sizes.scattering_mu * sizes.scattering_nu * SLICE_TABLES * groups * GROUP * 4) as u64
 }
 
 /// Channels padded to groups of four per texel, as the shaders index them.
@@ -133,6 +148,7 @@ impl GpuSky {
         let transmittance = pad_channels(&tables.transmittance.data, n, g);
         let irradiance = pad_channels(&tables.irradiance.data, n, g);
         let scattering = pad_channels(&tables.scattering.data, n, g);
+        let multiple = pad_channels(&tables.multiple.data, n, g);
         let single_mie = if red_only {
             pad_channels(&tables.single_mie.data, 1, 1)
         } else {
@@ -140,12 +156,12 @@ impl GpuSky {
         };
         let bytes = |v: &[f32]| (v.len() * 4) as u64;
         let sizes = tables.config.sizes;
-        let slice_bytes = (sizes.scattering_mu * sizes.scattering_nu * 2 * g * GROUP * 4) as u64;
         check_buffers(
             ctx,
             &[
                 ("scattering table", bytes(&scattering)),
-                ("camera slice", slice_bytes),
+                ("multiple scattering table", bytes(&multiple)),
+                ("camera slice", slice_bytes(&sizes, g)),
                 ("single Mie table", bytes(&single_mie)),
                 ("transmittance table", bytes(&transmittance)),
                 ("irradiance table", bytes(&irradiance)),
@@ -170,6 +186,7 @@ impl GpuSky {
                 irradiance: f("irradiance", &irradiance),
                 scattering: f("scattering", &scattering),
                 single_mie: f("single mie", &single_mie),
+                multiple: f("multiple scattering", &multiple),
                 row_sums: crate::lut::passes::storage(device, "unused", 16),
             };
             Ok(GpuSky::assemble(
@@ -194,8 +211,7 @@ impl GpuSky {
     ) -> Result<GpuSky, GpuError> {
         let n = model.channels();
         let s = config.sizes;
-        let slice_bytes = (s.scattering_mu * s.scattering_nu * 2 * groups(n) * GROUP * 4) as u64;
-        check_buffers(ctx, &[("camera slice", slice_bytes)])?;
+        check_buffers(ctx, &[("camera slice", slice_bytes(&s, groups(n)))])?;
         let buffers = precomputer.run_on_device(ctx, model, config)?;
         let mie_ratio = ScatteringGroups::new(model).mie_ratio();
         // The device keeps single Mie in full even when red-only: channel 0 of each texel.
@@ -226,7 +242,8 @@ impl GpuSky {
         // coefficients, red-only Mie ratio; lanes of channel k in group k/4.
         let wavelengths = model.wavelengths.nm();
         let colour = ColourMatrix::new(wavelengths);
-        let mut channel_data = vec![0.0f32; g * CHANNEL_STRIDE * 4];
+        // The uniform's full size (the shader declares a fixed-size array).
+        let mut channel_data = vec![0.0f32; CHANNEL_DATA_VEC4 * 4];
         for k in 0..n {
             let (group, lane) = (k / GROUP, k % GROUP);
             let mut set = |row: usize, v: f64| {
@@ -253,7 +270,6 @@ impl GpuSky {
             set(9, mie_ratio.get(k).copied().unwrap_or(0.0));
         }
         let device = ctx.device();
-        let slice_bytes = (sizes.scattering_mu * sizes.scattering_nu * 2 * g * GROUP * 4) as u64;
         GpuSky {
             atmosphere: buffers.atmosphere,
             data: buffers.data,
@@ -261,13 +277,14 @@ impl GpuSky {
                 device,
                 "channel data",
                 bytemuck::cast_slice(&channel_data),
-                wgpu::BufferUsages::STORAGE,
+                wgpu::BufferUsages::UNIFORM,
             ),
             transmittance: buffers.transmittance,
             irradiance: buffers.irradiance,
             scattering: buffers.scattering,
             single_mie: buffers.single_mie,
-            slice: crate::lut::passes::storage(device, "camera slice", slice_bytes),
+            multiple: buffers.multiple,
+            slice: crate::lut::passes::storage(device, "camera slice", slice_bytes(&sizes, g)),
             mie_layout,
             channels: n,
             radii: Radii {
@@ -347,8 +364,9 @@ impl GpuRenderer {
                     (4, Read),
                     (5, Read),
                     (6, Read),
+                    (7, Read),
                     (10, Uniform),
-                    (11, Read),
+                    (11, Uniform),
                     (12, Write),
                     (13, Write),
                 ],
@@ -626,6 +644,7 @@ impl GpuRenderer {
                     (4, whole(&sky.irradiance)),
                     (5, whole(&sky.scattering)),
                     (6, whole(&sky.single_mie)),
+                    (7, whole(&sky.multiple)),
                     (10, whole(&uniform)),
                     (11, whole(&sky.channel_data)),
                     (13, whole(&sky.slice)),

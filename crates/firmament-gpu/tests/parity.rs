@@ -12,8 +12,13 @@ use firmament_gpu::{GpuContext, GpuError};
 /// Texels below this fraction of the table maximum are not compared.
 const NEGLIGIBLE: f64 = 1e-4;
 /// Tolerance on the sky rays exactly at the horizon. KNOWN GAP (issue 5): with the `earth`
-/// preset the GPU is up to ~10 % below the CPU there in the blue (single Rayleigh, from
-/// z ≥ 8); every other texel is within 1 %. Not yet explained; tighten when found.
+/// preset the GPU is up to ~10 % below the CPU there in the blue (single Rayleigh 9.6 %,
+/// multiple scattering 8.4 %, both worst at z = 12; single Mie 0.7 %); every other texel is
+/// within 1 %. Not a quadrature difference (the exponentially fitted Simpson rule left it as it
+/// was, 9.3 % before): these rays look up the transmittance table at its horizon column,
+/// where in the blue neighbouring columns differ by orders of magnitude, so the lookup is
+/// ill-conditioned in μ: one f32 ulp of μ changes the CPU's own f64 transmittance along the
+/// z = 8, 12, 15 horizon rays by up to 2 %, 68 % and ×10. An f32 limit of that row.
 const HORIZON: f64 = 0.12;
 
 fn context() -> Option<&'static GpuContext> {
@@ -194,6 +199,22 @@ fn check_layout(cpu: &Tables, gpu: &Tables) {
         )
     );
     assert_eq!(cpu.single_mie.channels, gpu.single_mie.channels);
+    assert_eq!(
+        (
+            cpu.multiple.nr,
+            cpu.multiple.nmu,
+            cpu.multiple.nmu_s,
+            cpu.multiple.nnu,
+            cpu.multiple.channels
+        ),
+        (
+            gpu.multiple.nr,
+            gpu.multiple.nmu,
+            gpu.multiple.nmu_s,
+            gpu.multiple.nnu,
+            gpu.multiple.channels
+        )
+    );
     assert_eq!(cpu.mie_ratio, gpu.mie_ratio);
     assert_eq!(cpu.order_means.len(), gpu.order_means.len());
 }
@@ -247,8 +268,9 @@ fn transmittance_and_single_scattering_match_the_cpu() {
         1e-2,
         HORIZON,
     );
-    // Orders = 1: no indirect irradiance on either side.
+    // Orders = 1: no indirect irradiance and no multiple scattering on either side.
     assert!(gpu.irradiance.data.iter().all(|&v| v == 0.0));
+    assert!(gpu.multiple.data.iter().all(|&v| v == 0.0));
     check_order_means(&cpu, &gpu, 1e-2);
 }
 
@@ -277,9 +299,16 @@ fn all_orders_match_the_cpu() {
         1e-2,
     );
     assert_scattering_within(
-        "scattering (rayleigh + orders 2-4)",
+        "single rayleigh",
         &cpu.scattering,
         &gpu.scattering,
+        1e-2,
+        HORIZON,
+    );
+    assert_scattering_within(
+        "multiple (orders 2-4)",
+        &cpu.multiple,
+        &gpu.multiple,
         1e-2,
         HORIZON,
     );
@@ -323,9 +352,16 @@ fn channel_groups_and_red_only_mie_match_the_cpu() {
         1e-2,
     );
     assert_scattering_within(
-        "scattering",
+        "single molecular",
         &cpu.scattering,
         &gpu.scattering,
+        1e-2,
+        HORIZON,
+    );
+    assert_scattering_within(
+        "multiple (order 2)",
+        &cpu.multiple,
+        &gpu.multiple,
         1e-2,
         HORIZON,
     );

@@ -3,7 +3,8 @@
 //! scattering (Rayleigh and Mie apart), then for each order n ≥ 2 the scattering density ΔJ
 //! (the same spherical convolution in azimuth as the CPU: the incident field's cosine series
 //! convolved with the phase functions' harmonics), the indirect irradiance ΔE and the multiple
-//! scattering ΔS. All passes go into one command buffer; only the final tables come back.
+//! scattering ΔS, summed over the orders into its own table (`Tables::multiple`, radiance).
+//! All passes go into one command buffer; only the final tables come back.
 //!
 //! Tables live in storage buffers (not textures) with the CPU's texel order and the channels
 //! in groups of four (one vec4 per group): filtering is done in the shaders with exact f32
@@ -33,8 +34,11 @@ pub(crate) struct DeviceTables {
     pub data: wgpu::Buffer,
     pub transmittance: wgpu::Buffer,
     pub irradiance: wgpu::Buffer,
+    /// Single molecular scattering (`Tables::scattering`).
     pub scattering: wgpu::Buffer,
     pub single_mie: wgpu::Buffer,
+    /// Orders ≥ 2 summed, radiance (`Tables::multiple`; zeros for one order).
+    pub multiple: wgpu::Buffer,
     pub row_sums: wgpu::Buffer,
 }
 
@@ -115,7 +119,7 @@ impl Precomputer {
                     d,
                     "single_scattering",
                     include_str!("../../shaders/single_scattering.wgsl"),
-                    &[(3, Read), (7, Write), (8, Write), (9, Write)],
+                    &[(3, Read), (7, Write), (8, Write)],
                 ),
                 phase_kernels: Pass::new(
                     d,
@@ -184,6 +188,7 @@ impl Precomputer {
                 &tables.irradiance,
                 &tables.scattering,
                 &tables.single_mie,
+                &tables.multiple,
                 &tables.row_sums,
             ];
             let staging: Vec<wgpu::Buffer> = sources
@@ -203,8 +208,8 @@ impl Precomputer {
             Ok(staging)
         })?;
         let values = scoped(ctx, "reading the tables back", || read_back(ctx, &staging))?;
-        let [t_data, e_data, s_data, m_data, rows_data] =
-            <[Vec<f32>; 5]>::try_from(values).expect("five buffers");
+        let [t_data, e_data, s_data, m_data, multiple_data, rows_data] =
+            <[Vec<f32>; 6]>::try_from(values).expect("six buffers");
         let unpad = |v: &[f32], texels: usize| -> Vec<f32> {
             let mut out = Vec::with_capacity(texels * n);
             for t in 0..texels {
@@ -261,6 +266,7 @@ impl Precomputer {
             single_mie,
             order_means,
             mie_ratio: groups_info.mie_ratio(),
+            multiple: table4(unpad(&multiple_data, s_texels), n),
         })
     }
 
@@ -346,7 +352,9 @@ impl Precomputer {
             let irradiance = storage(device, "irradiance", bytes_e);
             let rayleigh = storage(device, "single rayleigh", bytes_s);
             let mie = storage(device, "single mie", bytes_s);
-            let scattering = storage(device, "scattering", bytes_s);
+            // Zero-initialised (wgpu clears new buffers): the sum over orders ≥ 2 starts
+            // empty and stays so for one order.
+            let multiple = storage(device, "multiple scattering", bytes_s);
             let row_sums = storage(device, "order sums", bytes_rows);
             let order_passes = orders >= 2;
             let (kernels, coefficients, density, delta_multiple) = if order_passes {
@@ -389,7 +397,7 @@ impl Precomputer {
                 let bg = self.single_scattering.bind(
                     device,
                     common(1),
-                    &[&transmittance, &rayleigh, &mie, &scattering],
+                    &[&transmittance, &rayleigh, &mie],
                 );
                 dispatch(
                     &mut cpass,
@@ -462,7 +470,7 @@ impl Precomputer {
                     let bg = self.multiple_scattering.bind(
                         device,
                         common(order),
-                        &[&transmittance, &density, &delta_multiple, &scattering],
+                        &[&transmittance, &density, &delta_multiple, &multiple],
                     );
                     dispatch(
                         &mut cpass,
@@ -486,8 +494,9 @@ impl Precomputer {
                 data,
                 transmittance,
                 irradiance,
-                scattering,
+                scattering: rayleigh,
                 single_mie: mie,
+                multiple,
                 row_sums,
             })
         })
