@@ -306,10 +306,13 @@ impl MuSPositions {
     pub fn filter(&self, mu_s: f64) -> (usize, usize, f64) {
         let k = self.table.len() - 1;
         let f = (mu_s.clamp(-1.0, 1.0) + 1.0) * 0.5 * k as f64;
-        let j = (f as usize).min(k - 1);
+        // 0 ≤ f ≤ k and 0 ≤ p ≤ n − 1, far below 2³¹: truncating through i32 gives the same
+        // index as through usize, with a cheaper conversion on x86-64.
+        let j = (f as i32 as usize).min(k - 1);
         let t = f - j as f64;
-        let p = self.table[j] + t * (self.table[j + 1] - self.table[j]);
-        let s0 = (p as usize).min(self.n - 1);
+        let (p0, p1) = (self.table[j], self.table[j + 1]);
+        let p = p0 + t * (p1 - p0);
+        let s0 = (p as i32 as usize).min(self.n - 1);
         (s0, (s0 + 1).min(self.n - 1), p - s0 as f64)
     }
 }
@@ -417,16 +420,72 @@ pub fn scattering_texel(
 ) -> (f64, f64, f64, f64, bool) {
     let i_nu = x / s.scattering_mu_s;
     let i_mu_s = x % s.scattering_mu_s;
-    let uvwz = [
+    let uvwz = texel_uvwz(s, i_nu, i_mu_s, y, z);
+    let (r, mu, mu_s, nu, ground) = scattering_r_mu_mu_s_nu(g, s, uvwz);
+    (r, mu, mu_s, clamp_nu(mu, mu_s, nu), ground)
+}
+
+/// The texture coordinates of a scattering texel's centre (the ν grid includes its ends).
+fn texel_uvwz(s: &TableSizes, i_nu: usize, i_mu_s: usize, y: usize, z: usize) -> [f64; 4] {
+    [
         i_nu as f64 / (s.scattering_nu - 1) as f64,
         (i_mu_s as f64 + 0.5) / s.scattering_mu_s as f64,
         (y as f64 + 0.5) / s.scattering_mu as f64,
         (z as f64 + 0.5) / s.scattering_r as f64,
-    ];
-    let (r, mu, mu_s, nu, ground) = scattering_r_mu_mu_s_nu(g, s, uvwz);
+    ]
+}
+
+/// ν clamped to the range that view and sun directions with these μ and μ_s allow.
+#[inline]
+fn clamp_nu(mu: f64, mu_s: f64, nu: f64) -> f64 {
     let spread = ((1.0 - mu * mu) * (1.0 - mu_s * mu_s)).max(0.0).sqrt();
-    let nu = nu.clamp(mu * mu_s - spread, mu * mu_s + spread);
-    (r, mu, mu_s, nu, ground)
+    nu.clamp(mu * mu_s - spread, mu * mu_s + spread)
+}
+
+/// [`scattering_texel`] for every texel of the tables, from its separable parts computed
+/// once: r per z, (μ, ground) per (z, y), μ_s per μ_s index (each a function of its own
+/// texture coordinate only) and ν from them and u_ν, so the values are the same.
+pub struct ScatteringGrid {
+    nmu: usize,
+    nmu_s: usize,
+    r: Vec<f64>,
+    mu: Vec<(f64, bool)>,
+    mu_s: Vec<f64>,
+    u_nu: Vec<f64>,
+}
+
+impl ScatteringGrid {
+    /// The grid of these sizes.
+    pub fn new(g: &Radii, s: &TableSizes) -> ScatteringGrid {
+        let at =
+            |i_nu, i_mu_s, y, z| scattering_r_mu_mu_s_nu(g, s, texel_uvwz(s, i_nu, i_mu_s, y, z));
+        let (nr, nmu) = (s.scattering_r, s.scattering_mu);
+        ScatteringGrid {
+            nmu,
+            nmu_s: s.scattering_mu_s,
+            r: (0..nr).map(|z| at(0, 0, 0, z).0).collect(),
+            mu: (0..nr * nmu)
+                .map(|i| {
+                    let (_, mu, _, _, ground) = at(0, 0, i % nmu, i / nmu);
+                    (mu, ground)
+                })
+                .collect(),
+            mu_s: (0..s.scattering_mu_s).map(|i| at(0, i, 0, 0).2).collect(),
+            u_nu: (0..s.scattering_nu)
+                .map(|i| texel_uvwz(s, i, 0, 0, 0)[0])
+                .collect(),
+        }
+    }
+
+    /// Same as [`scattering_texel`].
+    #[inline]
+    pub fn texel(&self, x: usize, y: usize, z: usize) -> (f64, f64, f64, f64, bool) {
+        let (mu, ground) = self.mu[z * self.nmu + y];
+        let mu_s = self.mu_s[x % self.nmu_s];
+        let nu = nu_from_u_nu(mu, mu_s, self.u_nu[x / self.nmu_s]);
+        let nu = clamp_nu(mu, mu_s, nu);
+        (self.r[z], mu, mu_s, nu, ground)
+    }
 }
 
 #[cfg(test)]
@@ -515,5 +574,19 @@ mod tests {
         assert!((texcoord_from_unit(0.0, 32) - 0.5 / 32.0).abs() < 1e-15);
         assert!((texcoord_from_unit(1.0, 32) - (1.0 - 0.5 / 32.0)).abs() < 1e-15);
         assert!((unit_from_texcoord(texcoord_from_unit(0.37, 7), 7) - 0.37).abs() < 1e-15);
+    }
+
+    #[test]
+    fn scattering_grid_is_scattering_texel() {
+        for s in [TableSizes::default(), TableSizes::small()] {
+            let grid = ScatteringGrid::new(&G, &s);
+            for z in 0..s.scattering_r {
+                for y in 0..s.scattering_mu {
+                    for x in 0..s.scattering_nu * s.scattering_mu_s {
+                        assert_eq!(grid.texel(x, y, z), scattering_texel(&G, &s, x, y, z));
+                    }
+                }
+            }
+        }
     }
 }

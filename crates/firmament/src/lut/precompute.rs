@@ -16,7 +16,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use rayon::prelude::*;
 
 use super::context::Lookup;
-use super::params::{self, Radii, TableSizes};
+use super::params::{self, Radii, ScatteringGrid, TableSizes};
 use super::table::{lerp_weights, Table2, Table4};
 use super::{MieStorage, TableConfig, Tables};
 use crate::atmosphere::Model;
@@ -45,6 +45,9 @@ const KERNEL_STEPS: usize = 96;
 /// Hemisphere sampling of the indirect irradiance (Bruneton 2017: 16 × 64).
 const IRRADIANCE_THETA: usize = 16;
 const IRRADIANCE_PHI: usize = 64;
+
+/// Most wavelengths the precomputation accepts (scratch arrays live on the stack).
+const MAX_CHANNELS: usize = 64;
 
 /// Progress callback: (stage description, fraction done of the whole precomputation).
 pub type Progress<'a> = &'a (dyn Fn(&str, f64) + Sync);
@@ -143,7 +146,7 @@ pub fn precompute(
 ) -> Result<Tables> {
     config.validate()?;
     let n = model.channels();
-    if n > 64 {
+    if n > MAX_CHANNELS {
         return Err(Error::invalid(
             "wavelengths",
             n,
@@ -163,6 +166,7 @@ pub fn precompute(
     let transmittance = compute_transmittance(model, &s);
     check_cancel(cancel)?;
     let lookup = Lookup::new(model, s, &transmittance);
+    let grid = ScatteringGrid::new(&lookup.radii, &s);
     let groups = Groups::new(model);
 
     report("direct irradiance");
@@ -170,13 +174,13 @@ pub fn precompute(
     let mut irradiance = Table2::new(s.irradiance_mu_s, s.irradiance_r, n);
 
     report("single scattering");
-    let (delta_rayleigh, delta_mie) = compute_single_scattering(model, &lookup, &groups);
+    let (delta_rayleigh, delta_mie) = compute_single_scattering(model, &lookup, &grid, &groups);
     check_cancel(cancel)?;
     let mut order_means = vec![table_mean_radiance(
         &delta_rayleigh,
         &delta_mie,
         &groups,
-        &lookup,
+        &grid,
     )];
     let mut multiple = Table4::new(
         s.scattering_r,
@@ -187,7 +191,7 @@ pub fn precompute(
     );
 
     if orders >= 2 {
-        let kernels = PhaseKernels::new(&lookup, &groups);
+        let kernels = PhaseKernels::new(&lookup, &grid, &groups);
         let mut delta_multiple = Table4::new(
             s.scattering_r,
             s.scattering_mu,
@@ -210,6 +214,7 @@ pub fn precompute(
             let density = compute_scattering_density(
                 model,
                 &lookup,
+                &grid,
                 &groups,
                 &kernels,
                 &previous,
@@ -220,7 +225,7 @@ pub fn precompute(
             delta_irradiance = compute_indirect_irradiance(model, &lookup, &previous);
             irradiance.add_assign(&delta_irradiance);
             report(&format!("multiple scattering, order {order}"));
-            delta_multiple = compute_multiple_scattering(model, &lookup, &density);
+            delta_multiple = compute_multiple_scattering(model, &lookup, &grid, &density);
             check_cancel(cancel)?;
             order_means.push(table_mean(&delta_multiple));
             multiple.add_assign(&delta_multiple);
@@ -278,15 +283,14 @@ fn table_mean_radiance(
     rayleigh: &Table4,
     mie: &Table4,
     groups: &Groups,
-    lookup: &Lookup,
+    grid: &ScatteringGrid,
 ) -> Vec<f64> {
     let n = rayleigh.channels;
     let mut sum = vec![0.0; n];
-    let s = &lookup.sizes;
-    for z in 0..s.scattering_r {
-        for y in 0..s.scattering_mu {
+    for z in 0..rayleigh.nr {
+        for y in 0..rayleigh.nmu {
             for x in 0..rayleigh.width() {
-                let (_, _, _, nu, _) = params::scattering_texel(&lookup.radii, s, x, y, z);
+                let (_, _, _, nu, _) = grid.texel(x, y, z);
                 let (pr, pm) = (groups.phase[0].eval(nu), groups.phase[1].eval(nu));
                 let i = rayleigh.index(x, y, z);
                 for k in 0..n {
@@ -519,8 +523,11 @@ impl SunRow {
         let (y0, y1, ty) = lerp_weights(v, s.transmittance_r);
         let n = t.channels;
         let w = t.width * n;
-        let row = (0..w)
-            .map(|i| (1.0 - ty) * t.data[y0 * w + i] as f64 + ty * t.data[y1 * w + i] as f64)
+        let (row0, row1) = (&t.data[y0 * w..][..w], &t.data[y1 * w..][..w]);
+        let row = row0
+            .iter()
+            .zip(row1)
+            .map(|(a, b)| (1.0 - ty) * *a as f64 + ty * *b as f64)
             .collect();
         let sin_h = g.bottom / r;
         SunRow {
@@ -533,12 +540,12 @@ impl SunRow {
         }
     }
 
-    /// Same as [`Lookup::transmittance_to_sun`] at this radius; false when zero.
+    /// The filter of [`Lookup::transmittance_to_sun`] at this radius; None when it is zero.
     #[inline]
-    fn transmittance_to_sun(&self, lookup: &Lookup, mu_s: f64, out: &mut [f64]) -> bool {
+    fn sun_filter(&self, lookup: &Lookup, mu_s: f64) -> Option<SunFilter> {
         let fraction = super::context::smoothstep(-self.eps, self.eps, mu_s - self.cos_h);
         if fraction <= 0.0 {
-            return false;
+            return None;
         }
         let g = &lookup.radii;
         let d = crate::geometry::distance_to_top_atmosphere_boundary(self.r, mu_s, g.top);
@@ -551,17 +558,32 @@ impl SunRow {
         };
         let width = lookup.sizes.transmittance_mu;
         let (x0, x1, tx) = lerp_weights(params::texcoord_from_unit(x_mu, width), width);
-        let n = out.len();
-        for k in 0..n {
-            out[k] = fraction * ((1.0 - tx) * self.row[x0 * n + k] + tx * self.row[x1 * n + k]);
-        }
-        true
+        Some(SunFilter {
+            fraction,
+            x0,
+            x1,
+            tx,
+        })
     }
+}
+
+/// Where and how much [`SunRow`] is filtered for one μ_s, and the visible solar fraction.
+#[derive(Clone, Copy)]
+struct SunFilter {
+    fraction: f64,
+    x0: usize,
+    x1: usize,
+    tx: f64,
 }
 
 /// Single scattering (paper eq. 7; Bruneton 2017 `ComputeSingleScattering`): Rayleigh and
 /// Mie integrated separately without phase functions.
-fn compute_single_scattering(model: &Model, lookup: &Lookup, groups: &Groups) -> (Table4, Table4) {
+fn compute_single_scattering(
+    model: &Model,
+    lookup: &Lookup,
+    grid: &ScatteringGrid,
+    groups: &Groups,
+) -> (Table4, Table4) {
     let s = lookup.sizes;
     let n = model.channels();
     let mut rayleigh = Table4::new(
@@ -581,7 +603,7 @@ fn compute_single_scattering(model: &Model, lookup: &Lookup, groups: &Groups) ->
         .enumerate()
         .for_each(|(row, (out_r, out_m))| {
             let (z, y) = (row / s.scattering_mu, row % s.scattering_mu);
-            let (r, mu, _, _, ground) = params::scattering_texel(&lookup.radii, &s, 0, y, z);
+            let (r, mu, _, _, ground) = grid.texel(0, y, z);
             let rays = RaySamples::new(lookup, r, mu, ground, n);
             // Group scattering coefficients at each sample.
             let count = rays.d.len();
@@ -594,15 +616,17 @@ fn compute_single_scattering(model: &Model, lookup: &Lookup, groups: &Groups) ->
             }
             let texels: Vec<(f64, f64)> = (0..width)
                 .map(|x| {
-                    let (_, _, mu_s, nu, _) = params::scattering_texel(&lookup.radii, &s, x, y, z);
+                    let (_, _, mu_s, nu, _) = grid.texel(x, y, z);
                     (mu_s, nu)
                 })
                 .collect();
             // Samples outer, texels inner: each sample's transmittance row stays in cache.
-            let mut t_sun = vec![0.0; n];
+            // Per sample, the sun filters of all texels first, then the taps (two short
+            // loops overlap better than one long dependent chain).
             let mut acc_r = vec![0.0; width * n];
             let mut acc_m = vec![0.0; width * n];
-            let mut tb = [vec![0.0; n], vec![0.0; n]];
+            let mut sun_filters = vec![None; width];
+            let mut tb = [[0.0; MAX_CHANNELS]; 2];
             for i in 0..count {
                 let sun_row = SunRow::new(lookup, rays.r[i]);
                 let (d_i, inv_r_i) = (rays.d[i], 1.0 / rays.r[i]);
@@ -611,18 +635,23 @@ fn compute_single_scattering(model: &Model, lookup: &Lookup, groups: &Groups) ->
                     tb[0][k] = t * beta[0][i * n + k];
                     tb[1][k] = t * beta[1][i * n + k];
                 }
-                for (x, &(mu_s, nu)) in texels.iter().enumerate() {
+                for (f, &(mu_s, nu)) in sun_filters.iter_mut().zip(&texels) {
                     let mu_s_d = ((r * mu_s + d_i * nu) * inv_r_i).clamp(-1.0, 1.0);
-                    if !sun_row.transmittance_to_sun(lookup, mu_s_d, &mut t_sun) {
-                        continue;
-                    }
-                    let (ar, am) = (
-                        &mut acc_r[x * n..(x + 1) * n],
-                        &mut acc_m[x * n..(x + 1) * n],
-                    );
+                    *f = sun_row.sun_filter(lookup, mu_s_d);
+                }
+                let (tb_r, tb_m) = (&tb[0][..n], &tb[1][..n]);
+                let row = &sun_row.row;
+                for ((ar, am), f) in acc_r
+                    .chunks_exact_mut(n)
+                    .zip(acc_m.chunks_exact_mut(n))
+                    .zip(&sun_filters)
+                {
+                    let Some(f) = f else { continue };
+                    let (t0, t1) = (&row[f.x0 * n..][..n], &row[f.x1 * n..][..n]);
                     for k in 0..n {
-                        ar[k] += tb[0][k] * t_sun[k];
-                        am[k] += tb[1][k] * t_sun[k];
+                        let t_sun = f.fraction * ((1.0 - f.tx) * t0[k] + f.tx * t1[k]);
+                        ar[k] += tb_r[k] * t_sun;
+                        am[k] += tb_m[k] * t_sun;
                     }
                 }
             }
@@ -682,55 +711,62 @@ impl Previous<'_> {
 }
 
 /// Azimuthal harmonics of each scattering group's phase function, for every table radius,
-/// view zenith (table μ) and incident zenith: b_m with P(Δφ) = Σ b_m cos(mΔφ).
+/// view zenith (table μ) and incident zenith: b_m with P(Δφ) = Σ b_m cos(mΔφ), times the
+/// solid angle of the incident zenith band's quadrature (dθ·sin θ_l).
 struct PhaseKernels {
     /// `[((z·nmu + y)·THETA + l)·2 + g]·HARMONICS + m`.
     b: Vec<f64>,
 }
 
 impl PhaseKernels {
-    fn new(lookup: &Lookup, groups: &Groups) -> PhaseKernels {
+    fn new(lookup: &Lookup, grid: &ScatteringGrid, groups: &Groups) -> PhaseKernels {
         let s = &lookup.sizes;
         let per_row = DENSITY_THETA * 2 * HARMONICS;
+        let dtheta = PI / DENSITY_THETA as f64;
+        // cos(Δφ_t) and cos(m·Δφ_t) on the trapezoid nodes, shared by every row.
+        let cos_t: Vec<f64> = (0..=KERNEL_STEPS)
+            .map(|t| (PI * t as f64 / KERNEL_STEPS as f64).cos())
+            .collect();
+        let cos_m: Vec<f64> = (0..=KERNEL_STEPS)
+            .flat_map(|t| {
+                let dphi = PI * t as f64 / KERNEL_STEPS as f64;
+                (0..HARMONICS).map(move |m| (m as f64 * dphi).cos())
+            })
+            .collect();
         let mut b = vec![0.0; s.scattering_r * s.scattering_mu * per_row];
         b.par_chunks_mut(per_row)
             .enumerate()
             .for_each(|(row, out)| {
                 let (z, y) = (row / s.scattering_mu, row % s.scattering_mu);
-                let (_, mu_v, _, _, _) = params::scattering_texel(&lookup.radii, s, 0, y, z);
+                let (_, mu_v, _, _, _) = grid.texel(0, y, z);
                 let sin_v = (1.0 - mu_v * mu_v).max(0.0).sqrt();
-                let mut cos_m = vec![0.0; (KERNEL_STEPS + 1) * HARMONICS];
-                for t in 0..=KERNEL_STEPS {
-                    let dphi = PI * t as f64 / KERNEL_STEPS as f64;
-                    for m in 0..HARMONICS {
-                        cos_m[t * HARMONICS + m] = (m as f64 * dphi).cos();
-                    }
-                }
                 for l in 0..DENSITY_THETA {
-                    let theta = (l as f64 + 0.5) * PI / DENSITY_THETA as f64;
+                    let theta = (l as f64 + 0.5) * dtheta;
                     let (sin_i, cos_i) = theta.sin_cos();
+                    let solid = dtheta * theta.sin();
                     for g in 0..2 {
                         if groups.members[g].is_empty() {
                             continue;
                         }
                         let o = &mut out[(l * 2 + g) * HARMONICS..(l * 2 + g + 1) * HARMONICS];
-                        for t in 0..=KERNEL_STEPS {
-                            let dphi = PI * t as f64 / KERNEL_STEPS as f64;
+                        for (t, &cos_dphi) in cos_t.iter().enumerate() {
                             let p = groups.phase[g]
-                                .eval((mu_v * cos_i + sin_v * sin_i * dphi.cos()).clamp(-1.0, 1.0));
+                                .eval((mu_v * cos_i + sin_v * sin_i * cos_dphi).clamp(-1.0, 1.0));
                             let w = if t == 0 || t == KERNEL_STEPS {
                                 0.5
                             } else {
                                 1.0
                             };
-                            for m in 0..HARMONICS {
-                                o[m] += w * p * cos_m[t * HARMONICS + m];
+                            let wp = w * p;
+                            for (o, c) in o.iter_mut().zip(&cos_m[t * HARMONICS..][..HARMONICS]) {
+                                *o += wp * c;
                             }
                         }
                         // Trapezoid over [0, π]: b_0 = (1/π)∫P, b_m = (2/π)∫P cos(mΔ).
                         let h = PI / KERNEL_STEPS as f64;
                         for m in 0..HARMONICS {
                             o[m] *= h / PI * if m == 0 { 1.0 } else { 2.0 };
+                            o[m] *= solid;
                         }
                     }
                 }
@@ -744,6 +780,7 @@ impl PhaseKernels {
 fn compute_scattering_density(
     model: &Model,
     lookup: &Lookup,
+    grid: &ScatteringGrid,
     groups: &Groups,
     kernels: &PhaseKernels,
     previous: &Previous,
@@ -764,11 +801,21 @@ fn compute_scattering_density(
     let dtheta = PI / DENSITY_THETA as f64;
     let dphi = 2.0 * PI / DENSITY_PHI as f64;
     let half_phi = DENSITY_PHI / 2;
+    // Cosine series of the even field: c_0 = (2/N)Σ_half, c_m = (4/N)Σ_half cos(mφ_j);
+    // `[j][m]`, so that a sample adds to all harmonics at once.
+    let cos_table: Vec<f64> = (0..half_phi)
+        .flat_map(|j| {
+            (0..HARMONICS).map(move |m| {
+                let scale = if m == 0 { 2.0 } else { 4.0 } / DENSITY_PHI as f64;
+                scale * (m as f64 * (j as f64 + 0.5) * dphi).cos()
+            })
+        })
+        .collect();
     out.data
         .par_chunks_mut(slab)
         .enumerate()
         .for_each(|(z, slab_out)| {
-            let (r, _, _, _, _) = params::scattering_texel(&g, &s, 0, 0, z);
+            let (r, _, _, _, _) = grid.texel(0, 0, z);
             let alt = r - g.bottom;
             let mut beta = [vec![0.0; n], vec![0.0; n]];
             for gi in 0..2 {
@@ -778,20 +825,14 @@ fn compute_scattering_density(
             let mut tmp = vec![0.0; n];
             let mut e_ground = vec![0.0; n];
             let mut t_ground = vec![0.0; n];
-            // coefficients[l][m][k]
-            let mut coeff = vec![0.0; DENSITY_THETA * HARMONICS * n];
-            let mut field = vec![0.0; half_phi * n];
+            // Coefficients `[l][k][m]`, harmonics innermost for the series and the
+            // convolution; convolved `[g][m][k]`, channels innermost for the evaluation.
+            let mut coeff = vec![0.0; DENSITY_THETA * n * HARMONICS];
             let mut k_acc = vec![0.0; 2 * HARMONICS * n];
-            // cos(m·φ_j) for the half-circle azimuths, with the series' scale folded in.
-            let cos_table: Vec<f64> = (0..HARMONICS)
-                .flat_map(|m| {
-                    let scale = if m == 0 { 2.0 } else { 4.0 } / DENSITY_PHI as f64;
-                    (0..half_phi).map(move |j| scale * (m as f64 * (j as f64 + 0.5) * dphi).cos())
-                })
-                .collect();
+            let mut j_out = [0.0f64; MAX_CHANNELS];
             let mut harmonic = [0.0f64; HARMONICS];
             for i_mu_s in 0..s.scattering_mu_s {
-                let (_, _, mu_s, _, _) = params::scattering_texel(&g, &s, i_mu_s, 0, z);
+                let (_, _, mu_s, _, _) = grid.texel(i_mu_s, 0, z);
                 let sin_s = (1.0 - mu_s * mu_s).max(0.0).sqrt();
                 coeff.iter_mut().for_each(|v| *v = 0.0);
                 for l in 0..DENSITY_THETA {
@@ -806,6 +847,7 @@ fn compute_scattering_density(
                     if ground {
                         lookup.transmittance(r, cos_i, d_ground, true, &mut t_ground);
                     }
+                    let c_l = &mut coeff[l * n * HARMONICS..(l + 1) * n * HARMONICS];
                     for j in 0..half_phi {
                         let phi = (j as f64 + 0.5) * dphi;
                         let (sin_p, cos_p) = phi.sin_cos();
@@ -837,45 +879,43 @@ fn compute_scattering_density(
                                     t_ground[k] * model.ground_albedo[k] / PI * e_ground[k];
                             }
                         }
-                        field[j * n..(j + 1) * n].copy_from_slice(&radiance);
-                    }
-                    // Cosine series of the even field: c_0 = (2/N)Σ_half, c_m = (4/N)Σ_half cos(mφ_j).
-                    for m in 0..HARMONICS {
-                        let c = &mut coeff[(l * HARMONICS + m) * n..(l * HARMONICS + m + 1) * n];
-                        for j in 0..half_phi {
-                            let w = cos_table[m * half_phi + j];
-                            for k in 0..n {
-                                c[k] += w * field[j * n + k];
+                        // The sample's share of every harmonic's coefficient.
+                        let w_j = &cos_table[j * HARMONICS..(j + 1) * HARMONICS];
+                        for (c, &v) in c_l.chunks_exact_mut(HARMONICS).zip(&radiance) {
+                            for (c, w) in c.iter_mut().zip(w_j) {
+                                *c += w * v;
                             }
                         }
                     }
                 }
-                // Convolve with the phase harmonics for every view zenith, then evaluate at ν.
+                // Convolve with the phase harmonics (solid angle included) for every view
+                // zenith, then evaluate at ν.
                 for y in 0..s.scattering_mu {
-                    k_acc.iter_mut().for_each(|v| *v = 0.0);
                     let kb =
                         &kernels.b[(z * s.scattering_mu + y) * DENSITY_THETA * 2 * HARMONICS..];
-                    for l in 0..DENSITY_THETA {
-                        let solid = dtheta * ((l as f64 + 0.5) * dtheta).sin();
-                        for gi in 0..2 {
-                            if groups.members[gi].is_empty() {
-                                continue;
-                            }
-                            for m in 0..HARMONICS {
-                                let b = kb[(l * 2 + gi) * HARMONICS + m] * solid;
-                                let c =
-                                    &coeff[(l * HARMONICS + m) * n..(l * HARMONICS + m + 1) * n];
-                                let acc = &mut k_acc
-                                    [(gi * HARMONICS + m) * n..(gi * HARMONICS + m + 1) * n];
-                                for k in 0..n {
-                                    acc[k] += b * c[k];
+                    for gi in 0..2 {
+                        if groups.members[gi].is_empty() {
+                            continue;
+                        }
+                        for k in 0..n {
+                            // All harmonics at once, summed over the incident zeniths (the
+                            // accumulator stays in registers).
+                            let mut acc = [0.0; HARMONICS];
+                            for l in 0..DENSITY_THETA {
+                                let b = &kb[(l * 2 + gi) * HARMONICS..][..HARMONICS];
+                                let c = &coeff[(l * n + k) * HARMONICS..][..HARMONICS];
+                                for ((a, b), c) in acc.iter_mut().zip(b).zip(c) {
+                                    *a += b * c;
                                 }
+                            }
+                            for (m, a) in acc.into_iter().enumerate() {
+                                k_acc[(gi * HARMONICS + m) * n + k] = a;
                             }
                         }
                     }
                     for i_nu in 0..s.scattering_nu {
                         let x = i_nu * s.scattering_mu_s + i_mu_s;
-                        let (_, mu_v, _, nu, _) = params::scattering_texel(&g, &s, x, y, z);
+                        let (_, mu_v, _, nu, _) = grid.texel(x, y, z);
                         let sin_v = (1.0 - mu_v * mu_v).max(0.0).sqrt();
                         let denom = sin_v * sin_s;
                         let cos_phi_v = if denom > 1e-12 {
@@ -893,22 +933,22 @@ fn compute_scattering_density(
                             c0 = c1;
                             c1 = c2;
                         }
-                        let mut j_out = [0.0f64; 64];
+                        let j = &mut j_out[..n];
+                        j.iter_mut().for_each(|v| *v = 0.0);
                         for gi in 0..2 {
                             if groups.members[gi].is_empty() {
                                 continue;
                             }
                             for (m, w) in harmonic.iter().enumerate() {
-                                let acc =
-                                    &k_acc[(gi * HARMONICS + m) * n..(gi * HARMONICS + m + 1) * n];
-                                for k in 0..n {
-                                    j_out[k] += w * acc[k] * beta[gi][k];
+                                let acc = &k_acc[(gi * HARMONICS + m) * n..][..n];
+                                for ((j, a), b) in j.iter_mut().zip(acc).zip(&beta[gi]) {
+                                    *j += w * a * b;
                                 }
                             }
                         }
                         let o = &mut slab_out[(y * width + x) * n..(y * width + x + 1) * n];
-                        for k in 0..n {
-                            o[k] = j_out[k] as f32;
+                        for (o, j) in o.iter_mut().zip(j.iter()) {
+                            *o = *j as f32;
                         }
                     }
                 }
@@ -962,7 +1002,12 @@ fn compute_indirect_irradiance(model: &Model, lookup: &Lookup, previous: &Previo
 /// Multiple scattering ΔS of order n from ΔJ (paper eq. 12 / Bruneton 2017
 /// `ComputeMultipleScattering`), per (r, μ) row: ray samples, their (μ, r) filter weights and
 /// transmittances are shared by every (μ_s, ν) texel.
-fn compute_multiple_scattering(model: &Model, lookup: &Lookup, density: &Table4) -> Table4 {
+fn compute_multiple_scattering(
+    model: &Model,
+    lookup: &Lookup,
+    grid: &ScatteringGrid,
+    density: &Table4,
+) -> Table4 {
     let s = lookup.sizes;
     let n = model.channels();
     let mut out = Table4::new(
@@ -981,71 +1026,87 @@ fn compute_multiple_scattering(model: &Model, lookup: &Lookup, density: &Table4)
         .enumerate()
         .for_each(|(row, o)| {
             let (z, y) = (row / s.scattering_mu, row % s.scattering_mu);
-            let (r, mu, _, _, ground) = params::scattering_texel(&g, &s, 0, y, z);
+            let (r, mu, _, _, ground) = grid.texel(0, y, z);
             let rays = RaySamples::new(lookup, r, mu, ground, n);
             let count = rays.d.len();
             // Each sample's (μ, r)-filtered row of ΔJ, so a texel's lookup is a bilinear
             // filter in (ν, μ_s) only.
             let row_len = density.row_len();
-            let mut blended = vec![0.0f64; count * row_len];
+            let mut blended = Vec::with_capacity(count * row_len);
             for i in 0..count {
                 let uvwz = params::scattering_uvwz(&g, &s, rays.r[i], rays.mu[i], 0.0, 0.0, ground);
                 let (y0, y1, ty) = lerp_weights(uvwz[2], s.scattering_mu);
                 let (z0, z1, tz) = lerp_weights(uvwz[3], s.scattering_r);
-                let b = &mut blended[i * row_len..(i + 1) * row_len];
-                for (yy, zz, w) in [
-                    (y0, z0, (1.0 - ty) * (1.0 - tz)),
-                    (y1, z0, ty * (1.0 - tz)),
-                    (y0, z1, (1.0 - ty) * tz),
-                    (y1, z1, ty * tz),
-                ] {
-                    if w == 0.0 {
-                        continue;
-                    }
-                    let start = density.index(0, yy, zz);
-                    for (o, v) in b.iter_mut().zip(&density.data[start..start + row_len]) {
-                        *o += w * *v as f64;
-                    }
-                }
+                let (w0, w1, w2, w3) = (
+                    (1.0 - ty) * (1.0 - tz),
+                    ty * (1.0 - tz),
+                    (1.0 - ty) * tz,
+                    ty * tz,
+                );
+                let source = |yy, zz| &density.data[density.index(0, yy, zz)..][..row_len];
+                let (j0, j1, j2, j3) = (
+                    source(y0, z0),
+                    source(y1, z0),
+                    source(y0, z1),
+                    source(y1, z1),
+                );
+                blended.extend(
+                    j0.iter()
+                        .zip(j1)
+                        .zip(j2)
+                        .zip(j3)
+                        .map(|(((v0, v1), v2), v3)| {
+                            w0 * *v0 as f64 + w1 * *v1 as f64 + w2 * *v2 as f64 + w3 * *v3 as f64
+                        }),
+                );
             }
             let nmu_s = s.scattering_mu_s;
-            let texels: Vec<(f64, f64)> = (0..width)
+            let nnu = s.scattering_nu;
+            // Per texel: r·μ_s and ν, once.
+            let texels: Vec<MultipleTexel> = (0..width)
                 .map(|x| {
-                    let (_, _, mu_s, nu, _) = params::scattering_texel(&g, &s, x, y, z);
-                    (mu_s, nu)
+                    let (_, _, mu_s, nu, _) = grid.texel(x, y, z);
+                    MultipleTexel {
+                        r_mu_s: r * mu_s,
+                        nu,
+                    }
                 })
                 .collect();
-            let nnu = s.scattering_nu;
-            // Samples outer, texels inner: each sample's filtered row stays in cache.
+            // Samples outer, texels inner: each sample's filtered row stays in cache. Per
+            // sample, the (μ_s, ν) filters of all texels first, then the taps: two short
+            // loops whose iterations overlap better than one long dependent chain.
             let mut acc = vec![0.0; width * n];
+            let mut filters = vec![TapFilter::default(); width];
             for i in 0..count {
                 let b = &blended[i * row_len..(i + 1) * row_len];
-                let t_i = &rays.tw[i * n..(i + 1) * n];
-                let (d_i, inv_r_i, wt) = (rays.d[i], 1.0 / rays.r[i], 1.0);
-                let mu_i = rays.mu[i];
-                for (x, &(mu_s, nu)) in texels.iter().enumerate() {
-                    let mu_s_i = ((r * mu_s + d_i * nu) * inv_r_i).clamp(-1.0, 1.0);
+                let (d_i, inv_r_i, mu_i) = (rays.d[i], 1.0 / rays.r[i], rays.mu[i]);
+                let wt_t = &rays.tw[i * n..(i + 1) * n];
+                for (f, t) in filters.iter_mut().zip(&texels) {
+                    // μ_s at the sample (ν is the same all along the ray); u_ν from the
+                    // sample's (μ, μ_s, ν).
+                    let mu_s_i = ((t.r_mu_s + d_i * t.nu) * inv_r_i).clamp(-1.0, 1.0);
                     let (s0, s1, ts) = mu_s_positions.filter(mu_s_i);
-                    let tex_x = params::u_nu(mu_i, mu_s_i, nu) * (nnu - 1) as f64;
-                    let nu0 = (tex_x as usize).min(nnu - 1);
+                    let tex_x = params::u_nu(mu_i, mu_s_i, t.nu) * (nnu - 1) as f64;
+                    let nu0 = (tex_x as i32 as usize).min(nnu - 1);
                     let nu1 = (nu0 + 1).min(nnu - 1);
-                    let (base0, base1, tnu) = (nu0 * nmu_s, nu1 * nmu_s, tex_x - nu0 as f64);
-                    let (a0, a1, a2, a3) = (
-                        (base0 + s0) * n,
-                        (base0 + s1) * n,
-                        (base1 + s0) * n,
-                        (base1 + s1) * n,
-                    );
-                    let (w0, w1, w2, w3) = (
-                        (1.0 - tnu) * (1.0 - ts),
-                        (1.0 - tnu) * ts,
-                        tnu * (1.0 - ts),
-                        tnu * ts,
-                    );
-                    let a = &mut acc[x * n..(x + 1) * n];
+                    let t_nu = tex_x - nu0 as f64;
+                    *f = TapFilter {
+                        a0: nu0 * nmu_s + s0,
+                        a1: nu0 * nmu_s + s1,
+                        a2: nu1 * nmu_s + s0,
+                        a3: nu1 * nmu_s + s1,
+                        w0: (1.0 - t_nu) * (1.0 - ts),
+                        w1: (1.0 - t_nu) * ts,
+                        w2: t_nu * (1.0 - ts),
+                        w3: t_nu * ts,
+                    };
+                }
+                let tap = |texel: usize| &b[texel * n..][..n];
+                for (a, f) in acc.chunks_exact_mut(n).zip(&filters) {
+                    let (b0, b1, b2, b3) = (tap(f.a0), tap(f.a1), tap(f.a2), tap(f.a3));
                     for k in 0..n {
-                        let j = w0 * b[a0 + k] + w1 * b[a1 + k] + w2 * b[a2 + k] + w3 * b[a3 + k];
-                        a[k] += wt * t_i[k] * j;
+                        let j = f.w0 * b0[k] + f.w1 * b1[k] + f.w2 * b2[k] + f.w3 * b3[k];
+                        a[k] += wt_t[k] * j;
                     }
                 }
             }
@@ -1054,4 +1115,25 @@ fn compute_multiple_scattering(model: &Model, lookup: &Lookup, density: &Table4)
             }
         });
     out
+}
+
+/// What [`compute_multiple_scattering`] needs of one texel of a row.
+struct MultipleTexel {
+    /// r·μ_s at the ray origin.
+    r_mu_s: f64,
+    nu: f64,
+}
+
+/// One texel's bilinear (ν, μ_s) filter at one ray sample: texel offsets in the row and
+/// weights.
+#[derive(Clone, Copy, Default)]
+struct TapFilter {
+    a0: usize,
+    a1: usize,
+    a2: usize,
+    a3: usize,
+    w0: f64,
+    w1: f64,
+    w2: f64,
+    w3: f64,
 }
