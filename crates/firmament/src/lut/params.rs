@@ -329,13 +329,15 @@ impl MuSPositions {
 #[inline]
 pub fn u_nu(mu: f64, mu_s: f64, nu: f64) -> f64 {
     let s = ((1.0 - mu * mu) * (1.0 - mu_s * mu_s)).max(0.0).sqrt();
-    if s <= 1e-12 {
-        // φ is undefined and every u_ν holds the same value.
-        return 1.0;
-    }
     // (1 − cos φ)/2 = sin²(φ/2).
     let x = ((mu * mu_s + s - nu) / (2.0 * s)).clamp(0.0, 1.0);
-    1.0 - x.sqrt()
+    // Where s ≈ 0, φ is undefined and every u_ν holds the same value. A select rather than
+    // an early return, so that loops over many texels vectorise.
+    if s <= 1e-12 {
+        1.0
+    } else {
+        1.0 - x.sqrt()
+    }
 }
 
 /// Inverse of [`u_nu`] at (μ, μ_s).

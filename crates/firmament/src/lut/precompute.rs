@@ -1073,20 +1073,26 @@ fn compute_multiple_scattering(
                 })
                 .collect();
             // Samples outer, texels inner: each sample's filtered row stays in cache. Per
-            // sample, the (μ_s, ν) filters of all texels first, then the taps: two short
-            // loops whose iterations overlap better than one long dependent chain.
+            // sample, short loops over all texels rather than one long dependent chain per
+            // texel: the sample's (μ_s, u_ν) (plain arithmetic, which vectorises), then the
+            // (ν, μ_s) filters (table lookups), then the taps.
             let mut acc = vec![0.0; width * n];
+            let mut mu_s_at = vec![0.0; width];
+            let mut tex_nu = vec![0.0; width];
             let mut filters = vec![TapFilter::default(); width];
             for i in 0..count {
                 let b = &blended[i * row_len..(i + 1) * row_len];
                 let (d_i, inv_r_i, mu_i) = (rays.d[i], 1.0 / rays.r[i], rays.mu[i]);
                 let wt_t = &rays.tw[i * n..(i + 1) * n];
-                for (f, t) in filters.iter_mut().zip(&texels) {
+                for ((m, x), t) in mu_s_at.iter_mut().zip(tex_nu.iter_mut()).zip(&texels) {
                     // μ_s at the sample (ν is the same all along the ray); u_ν from the
                     // sample's (μ, μ_s, ν).
                     let mu_s_i = ((t.r_mu_s + d_i * t.nu) * inv_r_i).clamp(-1.0, 1.0);
+                    *m = mu_s_i;
+                    *x = params::u_nu(mu_i, mu_s_i, t.nu) * (nnu - 1) as f64;
+                }
+                for ((f, &mu_s_i), &tex_x) in filters.iter_mut().zip(&mu_s_at).zip(&tex_nu) {
                     let (s0, s1, ts) = mu_s_positions.filter(mu_s_i);
-                    let tex_x = params::u_nu(mu_i, mu_s_i, t.nu) * (nnu - 1) as f64;
                     let nu0 = (tex_x as i32 as usize).min(nnu - 1);
                     let nu1 = (nu0 + 1).min(nnu - 1);
                     let t_nu = tex_x - nu0 as f64;
