@@ -30,7 +30,8 @@ use crate::{Error, Result};
 /// Segments of the 4-point Gauss–Legendre rule for the transmittance table.
 const TRANSMITTANCE_SEGMENTS: usize = 128;
 /// Intervals along view rays for single and multiple scattering (Bruneton 2017 uses 50
-/// trapezoids). We weight them by Simpson's rule: at this spacing a zenith ray takes
+/// trapezoids). We weight them by Simpson's rule (with the transmittance fitted as an
+/// exponential, see [`exponential_simpson_weights`]): at this spacing a zenith ray takes
 /// 1.2 km steps, one aerosol scale height, where the trapezoid overestimates an
 /// exponential integrand by 8 % and Simpson by 0.5 % (found by the reference path tracer).
 const RAY_INTERVALS: usize = 50;
@@ -388,11 +389,8 @@ struct RaySamples {
     d: Vec<f64>,
     r: Vec<f64>,
     mu: Vec<f64>,
-    /// Transmittance from the ray origin to each sample, `n` per sample.
-    t: Vec<f64>,
-    /// Quadrature weights (Simpson), in units of the step.
-    w: Vec<f64>,
-    /// Quadrature weight × transmittance per sample and channel.
+    /// Quadrature weight × transmittance from the ray origin, per sample and channel
+    /// (see [`exponential_simpson_weights`]).
     tw: Vec<f64>,
 }
 
@@ -407,26 +405,18 @@ impl RaySamples {
             d: Vec::with_capacity(count),
             r: Vec::with_capacity(count),
             mu: Vec::with_capacity(count),
-            t: vec![0.0; count * n],
-            w: Vec::with_capacity(count),
             tw: Vec::new(),
         };
+        let mut t = vec![0.0; count * n];
         for i in 0..count {
             let d = i as f64 * dx;
             let (r_d, mu_d) = crate::geometry::advance(r, mu, d, g.bottom, g.top);
             rs.d.push(d);
             rs.r.push(r_d);
             rs.mu.push(mu_d);
-            rs.w.push(if i == 0 || i == RAY_INTERVALS {
-                1.0 / 3.0
-            } else if i % 2 == 1 {
-                4.0 / 3.0
-            } else {
-                2.0 / 3.0
-            });
-            lookup.transmittance(r, mu, d, ground, &mut rs.t[i * n..(i + 1) * n]);
+            lookup.transmittance(r, mu, d, ground, &mut t[i * n..(i + 1) * n]);
         }
-        rs.tw = exponential_simpson_weights(&rs.t, n);
+        rs.tw = exponential_simpson_weights(&t, n);
         rs
     }
 }
