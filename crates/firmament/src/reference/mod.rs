@@ -68,8 +68,9 @@ pub struct ReferenceSettings {
     /// Whether the ground seen directly by a camera ray adds its reflected radiance
     /// (false: like `Sky::sky_radiance`; true: whole-scene images).
     pub include_ground: bool,
-    /// Gauss–Legendre segments (4 nodes each) per monotone piece of a sun ray for the
-    /// next-event transmittance.
+    /// Gauss–Legendre segments (4 nodes each) per smooth piece of a sun ray (between the
+    /// closest approach and the altitudes where a profile has a kink; half as many on the
+    /// pieces away from the lowest point) for the next-event transmittance.
     pub transmittance_segments: usize,
 }
 
@@ -81,7 +82,7 @@ impl Default for ReferenceSettings {
             max_bounces: 100,
             roulette_after: 5,
             include_ground: false,
-            transmittance_segments: 24,
+            transmittance_segments: 6,
         }
     }
 }
