@@ -605,6 +605,8 @@ fn smoothstep_safe(e0: f32, e1: f32, x: f32) -> f32 {
 // ---------------------------------------------------------------------------------------
 // Table lookups (lut/context.rs). Passes bind the tables they read at these slots.
 
+// Slot 3 holds the optical depth τ(r, μ) = −ln T to the top (Tables::optical_depth);
+// lookups interpolate τ and take e^{−τ}.
 @group(0) @binding(3) var<storage, read> transmittance_table: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read> delta_irradiance_table: array<vec4<f32>>;
 // Order 2: ΔS_Rayleigh and ΔS_Mie (single scattering); order ≥ 3: ΔS twice. Also ΔJ for the
@@ -612,15 +614,29 @@ fn smoothstep_safe(e0: f32, e1: f32, x: f32) -> f32 {
 @group(0) @binding(5) var<storage, read> scattering_a: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read> scattering_b: array<vec4<f32>>;
 
-// T(r, μ) to the top of the atmosphere (ray assumed not to hit the ground).
-fn transmittance_to_top(r: f32, rho: f32, mu: f32, k: u32) -> vec4<f32> {
+// The optical depth the table stands for T = 0 with (table::MAX_OPTICAL_DEPTH).
+const MAX_OPTICAL_DEPTH: f32 = 104.0;
+
+// τ(r, μ) to the top of the atmosphere (Lookup::optical_depth_to_top).
+fn optical_depth_to_top(r: f32, rho: f32, mu: f32, k: u32) -> vec4<f32> {
     let f = table2_filter(transmittance_uv(r, rho, mu), atm.transmittance_mu, atm.transmittance_r);
     return f.weight.x * transmittance_table[f.index.x + k] + f.weight.y * transmittance_table[f.index.y + k]
         + f.weight.z * transmittance_table[f.index.z + k] + f.weight.w * transmittance_table[f.index.w + k];
 }
 
-// Transmittance over d km from (r, μ), from ratios of table values; the reversed ray when
-// it hits the ground (Bruneton 2017 `GetTransmittance`).
+// T(r, μ) to the top of the atmosphere (ray assumed not to hit the ground).
+fn transmittance_to_top(r: f32, rho: f32, mu: f32, k: u32) -> vec4<f32> {
+    return exp(-optical_depth_to_top(r, rho, mu, k));
+}
+
+// e^{−(τ_a − τ_b)} for the optical depths to the top from a ray's two ends, 0 where the far
+// end's τ stands for T = 0 (Lookup::transmittance).
+fn transmittance_between(tau_a: vec4<f32>, tau_b: vec4<f32>) -> vec4<f32> {
+    return select(vec4<f32>(0.0), exp(-max(tau_a - tau_b, vec4<f32>(0.0))), tau_b < vec4<f32>(MAX_OPTICAL_DEPTH));
+}
+
+// Transmittance over d km from (r, μ), from differences of table optical depths; the
+// reversed ray when it hits the ground (Bruneton 2017 `GetTransmittance`).
 fn transmittance(r: f32, rho: f32, mu: f32, d: f32, ground: bool, k: u32) -> vec4<f32> {
     let rho_d = rho_at(r, rho, mu, d);
     let r_d = radius_from_rho(rho_d);
@@ -628,13 +644,13 @@ fn transmittance(r: f32, rho: f32, mu: f32, d: f32, ground: bool, k: u32) -> vec
     var a: vec4<f32>;
     var b: vec4<f32>;
     if (ground) {
-        a = transmittance_to_top(r_d, rho_d, -mu_d, k);
-        b = transmittance_to_top(r, rho, -mu, k);
+        a = optical_depth_to_top(r_d, rho_d, -mu_d, k);
+        b = optical_depth_to_top(r, rho, -mu, k);
     } else {
-        a = transmittance_to_top(r, rho, mu, k);
-        b = transmittance_to_top(r_d, rho_d, mu_d, k);
+        a = optical_depth_to_top(r, rho, mu, k);
+        b = optical_depth_to_top(r_d, rho_d, mu_d, k);
     }
-    return select(vec4<f32>(0.0), min(a / b, vec4<f32>(1.0)), b > vec4<f32>(0.0));
+    return transmittance_between(a, b);
 }
 
 // Visible fraction of the sun's disk above the planet (smoothstep in μ_s over ± the sun's

@@ -3,7 +3,7 @@
 // `GetSunAndSkyIrradiance`). Every function names the Rust function it mirrors.
 //
 // The tables are bound at the slots functions.wgsl declares for the precomputation passes:
-//   3 transmittance_table     T(r, μ) to the top
+//   3 transmittance_table     τ(r, μ) = −ln T to the top (Tables::optical_depth)
 //   4 delta_irradiance_table  the final indirect irradiance E(r, μ_s) (Tables::irradiance)
 //   5 scattering_a            single molecular scattering (Tables::scattering)
 //   6 scattering_b            single Mie (Tables::single_mie; see Frame.mie_layout)
@@ -238,9 +238,14 @@ fn distance_to_ground(s: ViewStart) -> f32 {
 // ---------------------------------------------------------------------------------------
 // Table lookups with their filters computed once per pixel and applied per channel group.
 
-fn sample_transmittance(f: Filter2, k: u32) -> vec4<f32> {
+// τ to the top at a filter (Lookup::optical_depth_to_top).
+fn sample_optical_depth(f: Filter2, k: u32) -> vec4<f32> {
     return f.weight.x * transmittance_table[f.index.x + k] + f.weight.y * transmittance_table[f.index.y + k]
         + f.weight.z * transmittance_table[f.index.z + k] + f.weight.w * transmittance_table[f.index.w + k];
+}
+
+fn sample_transmittance(f: Filter2, k: u32) -> vec4<f32> {
+    return exp(-sample_optical_depth(f, k));
 }
 
 // Lookup::transmittance_to_top's filter.
@@ -479,7 +484,7 @@ fn shade(dir: vec3<f32>) -> vec3<f32> {
         if (frame.mie_layout != 0u) {
             red_p = sample_mie_red(f_p);
         }
-        // Lookup::transmittance for a ground ray: T(R_g, −μ_p)/T(r, −μ).
+        // Lookup::transmittance for a ground ray: e^{−(τ(R_g, −μ_p) − τ(r, −μ))}.
         let f_t_ground = transmittance_filter(atm.bottom_radius, 0.0, -mu_p);
         let f_t_camera = transmittance_filter(s.r, s.rho, -s.mu);
         // Sky::sun_and_sky_irradiance with the normal p/|p| (sky occlusion factor 1).
@@ -492,9 +497,7 @@ fn shade(dir: vec3<f32>) -> vec3<f32> {
         var scat0 = 0.0;
         var scat0_p = 0.0;
         for (var k = 0u; k < atm.groups; k++) {
-            let a = sample_transmittance(f_t_ground, k);
-            let b = sample_transmittance(f_t_camera, k);
-            let t = select(vec4<f32>(0.0), min(a / b, vec4<f32>(1.0)), b > vec4<f32>(0.0));
+            let t = transmittance_between(sample_optical_depth(f_t_ground, k), sample_optical_depth(f_t_camera, k));
             let c = start_combined(f, k, red, scat0, p_r);
             let c_p = combined_scattering(f_p, k, red_p, scat0_p, p_r);
             if (k == 0u) {

@@ -1,5 +1,7 @@
-// Transmittance T(r, μ) to the top of the atmosphere (lut::precompute::compute_transmittance):
-// 4-point Gauss–Legendre on 128 segments of the ray, per channel group.
+// Optical depth τ(r, μ) to the top of the atmosphere (lut::precompute::compute_optical_depth;
+// the lookups interpolate τ and take e^{−τ}):
+// 4-point Gauss–Legendre on 128 segments of the ray, per channel group, capped at
+// MAX_OPTICAL_DEPTH (T = 0 in f32).
 
 @group(0) @binding(7) var<storage, read_write> transmittance_out: array<vec4<f32>>;
 
@@ -35,5 +37,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         }
         tau *= 0.5 * h;
     }
-    transmittance_out[i * atm.groups + k] = exp(-tau);
+    transmittance_out[i * atm.groups + k] = min(tau, vec4<f32>(MAX_OPTICAL_DEPTH));
 }

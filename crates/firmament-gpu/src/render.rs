@@ -81,6 +81,7 @@ pub struct GpuSky {
     atmosphere: wgpu::Buffer,
     data: wgpu::Buffer,
     channel_data: wgpu::Buffer,
+    /// Optical depth τ = −ln T to the top (`Tables::optical_depth`).
     transmittance: wgpu::Buffer,
     irradiance: wgpu::Buffer,
     /// Single molecular scattering (`Tables::scattering`).
@@ -145,7 +146,7 @@ impl GpuSky {
         }
         let g = groups(n);
         let red_only = tables.config.mie == MieStorage::RedOnly;
-        let transmittance = pad_channels(&tables.transmittance.data, n, g);
+        let transmittance = pad_channels(&tables.optical_depth.data, n, g);
         let irradiance = pad_channels(&tables.irradiance.data, n, g);
         let scattering = pad_channels(&tables.scattering.data, n, g);
         let multiple = pad_channels(&tables.multiple.data, n, g);

@@ -42,7 +42,7 @@ impl Sky {
         Lookup::new(
             &self.model,
             self.tables.config.sizes,
-            &self.tables.transmittance,
+            &self.tables.optical_depth,
         )
     }
 

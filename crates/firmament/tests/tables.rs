@@ -67,7 +67,8 @@ fn homogeneous_transmittance_is_exp_of_beta_times_distance() {
     .resolve(&Wavelengths::rgb())
     .unwrap();
     let s = TableSizes::default();
-    let t = lut::precompute::compute_transmittance(&model, &s);
+    let tau = lut::precompute::compute_optical_depth(&model, &s);
+    let t = tau.transmittance_of_optical_depth();
     let radii = params::Radii {
         bottom: RG,
         top: RT,
@@ -89,7 +90,7 @@ fn homogeneous_transmittance_is_exp_of_beta_times_distance() {
     }
     assert!(worst < 1e-5, "worst relative error {worst}");
     // Between texels, bilinear filtering stays close too.
-    let lookup = lut::Lookup::new(&model, s, &t);
+    let lookup = lut::Lookup::new(&model, s, &tau);
     let mut out = [0.0; 3];
     for &(r, mu) in &[
         (RG + 1234.0, 0.4321),
@@ -120,7 +121,7 @@ fn exponential_vertical_optical_depth_matches_closed_form() {
     .resolve(&Wavelengths::rgb())
     .unwrap();
     let s = TableSizes::default();
-    let t = lut::precompute::compute_transmittance(&model, &s);
+    let t = lut::precompute::compute_optical_depth(&model, &s);
     let radii = params::Radii {
         bottom: RG,
         top: RT,
@@ -133,7 +134,7 @@ fn exponential_vertical_optical_depth_matches_closed_form() {
         assert!((mu - 1.0).abs() < 1e-12);
         let h = r - RG;
         let tau = h_scale * beta * ((-h / h_scale).exp() - (-(RT - RG) / h_scale).exp());
-        let got = -(t.texel(0, y)[0] as f64).ln();
+        let got = t.texel(0, y)[0] as f64;
         assert!(
             (got - tau).abs() < 1e-6 + 1e-5 * tau,
             "h = {h}: {got} vs {tau}"
@@ -297,6 +298,7 @@ fn every_preset_precomputes_finite_non_negative_tables() {
             &t.single_mie.data,
             &t.irradiance.data,
             &t.transmittance.data,
+            &t.optical_depth.data,
             &t.multiple.data,
         ] {
             assert!(
@@ -365,6 +367,7 @@ fn table_files_round_trip_and_bad_files_are_refused() {
     let back = lut::file::from_bytes(&bytes, "x").unwrap();
     assert_eq!(back.scattering, t.scattering);
     assert_eq!(back.transmittance, t.transmittance);
+    assert_eq!(back.optical_depth, t.optical_depth);
     back.check_matches(&model, "x").unwrap();
     // Truncated.
     let err = lut::file::from_bytes(&bytes[..bytes.len() - 100], "x")

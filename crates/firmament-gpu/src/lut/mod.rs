@@ -32,6 +32,7 @@ const STORAGE_BUFFERS_NEEDED: u32 = 6;
 pub(crate) struct DeviceTables {
     pub atmosphere: wgpu::Buffer,
     pub data: wgpu::Buffer,
+    /// Optical depth τ = −ln T to the top (what the lookups read; `Tables::optical_depth`).
     pub transmittance: wgpu::Buffer,
     pub irradiance: wgpu::Buffer,
     /// Single molecular scattering (`Tables::scattering`).
@@ -217,7 +218,7 @@ impl Precomputer {
             }
             out
         };
-        let transmittance = Table2 {
+        let optical_depth = Table2 {
             width: s.transmittance_mu,
             height: s.transmittance_r,
             channels: n,
@@ -260,7 +261,8 @@ impl Precomputer {
             config: *config,
             wavelengths_nm: model.wavelengths.nm().to_vec(),
             atmosphere_hash: model.hash,
-            transmittance,
+            transmittance: optical_depth.transmittance_of_optical_depth(),
+            optical_depth,
             irradiance,
             scattering,
             single_mie,

@@ -3,25 +3,27 @@
 //! `GetTransmittance`, `GetTransmittanceToSun`), irradiance and scattering lookups.
 
 use super::params::{self, Radii, TableSizes};
-use super::table::{Table2, Table4};
+use super::table::{Table2, Table4, MAX_OPTICAL_DEPTH};
 use crate::atmosphere::Model;
 use crate::geometry::{distance_to_top_atmosphere_boundary, safe_sqrt};
 
-/// What a lookup needs: the model's radii, the sizes and the transmittance table.
+/// What a lookup needs: the model's radii, the sizes and the transmittance table (as
+/// optical depth: lookups interpolate τ = −ln T bilinearly, then take e^{−τ}).
 pub struct Lookup<'a> {
     /// Radii and μ_s,min.
     pub radii: Radii,
     /// Table sizes.
     pub sizes: TableSizes,
-    /// Transmittance to the top of the atmosphere, T(r, μ).
-    pub transmittance: &'a Table2,
+    /// Optical depth to the top of the atmosphere, τ(r, μ) = −ln T(r, μ)
+    /// ([`super::Tables::optical_depth`]).
+    pub optical_depth: &'a Table2,
     /// Sun angular radius (rad).
     pub sun_angular_radius: f64,
 }
 
 impl<'a> Lookup<'a> {
     /// Lookup context for a model.
-    pub fn new(model: &Model, sizes: TableSizes, transmittance: &'a Table2) -> Self {
+    pub fn new(model: &Model, sizes: TableSizes, optical_depth: &'a Table2) -> Self {
         Lookup {
             radii: Radii {
                 bottom: model.bottom_radius_m,
@@ -29,14 +31,24 @@ impl<'a> Lookup<'a> {
                 mu_s_min: model.mu_s_min,
             },
             sizes,
-            transmittance,
+            optical_depth,
             sun_angular_radius: model.sun_angular_radius_rad,
         }
     }
 
-    /// T(r, μ) to the top of the atmosphere (ray assumed not to hit the ground).
+    /// T(r, μ) to the top of the atmosphere (ray assumed not to hit the ground): e^{−τ} of
+    /// the bilinearly interpolated optical depth.
     #[inline]
     pub fn transmittance_to_top(&self, r: f64, mu: f64, out: &mut [f64]) {
+        self.optical_depth_to_top(r, mu, out);
+        for t in out.iter_mut() {
+            *t = (-*t).exp();
+        }
+    }
+
+    /// τ(r, μ) to the top of the atmosphere, bilinear in the optical-depth table.
+    #[inline]
+    pub fn optical_depth_to_top(&self, r: f64, mu: f64, out: &mut [f64]) {
         let (u, v) = params::transmittance_uv(
             &self.radii,
             r,
@@ -44,12 +56,13 @@ impl<'a> Lookup<'a> {
             self.sizes.transmittance_mu,
             self.sizes.transmittance_r,
         );
-        self.transmittance.sample_into(u, v, out);
+        self.optical_depth.sample_into(u, v, out);
     }
 
-    /// Transmittance over `d` metres from (r, μ), from ratios of table values; uses the
-    /// reversed ray when it hits the ground (Bruneton 2017 `GetTransmittance`).
-    #[inline]
+    /// Transmittance over `d` metres from (r, μ), from differences of table optical depths
+    /// (Bruneton 2017 `GetTransmittance` takes ratios of transmittances); uses the reversed
+    /// ray when it hits the ground. 0 where the far end's optical depth is the table's
+    /// stand-in for T = 0.
     pub fn transmittance(&self, r: f64, mu: f64, d: f64, ground: bool, out: &mut [f64]) {
         let g = &self.radii;
         let r_d = safe_sqrt(d * d + 2.0 * r * mu * d + r * r).clamp(g.bottom, g.top);
@@ -63,15 +76,15 @@ impl<'a> Lookup<'a> {
             unreachable!("at most 64 wavelengths")
         };
         if ground {
-            self.transmittance_to_top(r_d, -mu_d, a);
-            self.transmittance_to_top(r, -mu, b);
+            self.optical_depth_to_top(r_d, -mu_d, a);
+            self.optical_depth_to_top(r, -mu, b);
         } else {
-            self.transmittance_to_top(r, mu, a);
-            self.transmittance_to_top(r_d, mu_d, b);
+            self.optical_depth_to_top(r, mu, a);
+            self.optical_depth_to_top(r_d, mu_d, b);
         }
         for k in 0..n {
-            out[k] = if b[k] > 0.0 {
-                (a[k] / b[k]).min(1.0)
+            out[k] = if b[k] < MAX_OPTICAL_DEPTH as f64 {
+                (-(a[k] - b[k]).max(0.0)).exp()
             } else {
                 0.0
             };

@@ -1,12 +1,12 @@
-//! The table file format, version 2 (little-endian):
+//! The table file format, version 3 (little-endian):
 //!
 //! | bytes | content |
 //! |---|---|
 //! | 8 | magic `FIRMLUT\0` |
-//! | 4 | format version (u32, = 2; version 1 folded multiple scattering into `scattering` and is refused) |
+//! | 4 | format version (u32, = 3; version 1 folded multiple scattering into `scattering`, version 2 stored the transmittance instead of the optical depth; both are refused) |
 //! | 4 | header length L (u32) |
 //! | L | header, UTF-8 JSON: `config` (sizes, orders, mie storage), `wavelengths_nm`, `atmosphere_hash` (hex), `channels`, `order_means`, `mie_ratio` |
-//! | … | f32 arrays: transmittance, irradiance, scattering (single molecular), single Mie, multiple scattering, in that order, sizes from the header |
+//! | … | f32 arrays: optical depth to the top (τ = −ln T), irradiance, scattering (single molecular), single Mie, multiple scattering, in that order, sizes from the header |
 //! | 8 | FNV-1a 64 checksum of everything before it |
 //!
 //! A truncated, corrupt, wrong-version or mismatched file is refused, never used.
@@ -22,7 +22,7 @@ use crate::{Error, Result};
 
 const MAGIC: &[u8; 8] = b"FIRMLUT\0";
 /// Current format version.
-pub const VERSION: u32 = 2;
+pub const VERSION: u32 = 3;
 
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -46,7 +46,7 @@ pub fn to_bytes(t: &Tables) -> Vec<u8> {
         mie_ratio: t.mie_ratio.clone(),
     };
     let json = serde_json::to_vec(&header).expect("header serialises");
-    let floats = t.transmittance.data.len()
+    let floats = t.optical_depth.data.len()
         + t.irradiance.data.len()
         + t.scattering.data.len()
         + t.single_mie.data.len()
@@ -57,7 +57,7 @@ pub fn to_bytes(t: &Tables) -> Vec<u8> {
     out.extend_from_slice(&(json.len() as u32).to_le_bytes());
     out.extend_from_slice(&json);
     for data in [
-        &t.transmittance.data,
+        &t.optical_depth.data,
         &t.irradiance.data,
         &t.scattering.data,
         &t.single_mie.data,
@@ -140,7 +140,7 @@ pub fn from_bytes(bytes: &[u8], path: &str) -> Result<Tables> {
         offset += count * 4;
         v
     };
-    let transmittance = Table2 {
+    let optical_depth = Table2 {
         width: s.transmittance_mu,
         height: s.transmittance_r,
         channels: n,
@@ -176,7 +176,8 @@ pub fn from_bytes(bytes: &[u8], path: &str) -> Result<Tables> {
         config: header.config,
         wavelengths_nm: header.wavelengths_nm,
         atmosphere_hash: hash,
-        transmittance,
+        transmittance: optical_depth.transmittance_of_optical_depth(),
+        optical_depth,
         irradiance,
         scattering,
         single_mie,

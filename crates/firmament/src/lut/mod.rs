@@ -75,8 +75,13 @@ pub struct Tables {
     pub wavelengths_nm: Vec<f64>,
     /// Hash of the atmosphere and wavelengths ([`Model::hash`]).
     pub atmosphere_hash: u64,
-    /// T(r, μ) to the top of the atmosphere.
+    /// T(r, μ) to the top of the atmosphere, derived from `optical_depth`
+    /// ([`Table2::transmittance_of_optical_depth`]).
     pub transmittance: Table2,
+    /// τ(r, μ) = −ln T to the top of the atmosphere, capped at
+    /// [`table::MAX_OPTICAL_DEPTH`]: what the table files store and the transmittance
+    /// lookups interpolate.
+    pub optical_depth: Table2,
     /// Indirect (sky) ground irradiance E(r, μ_s), W·m⁻²·nm⁻¹.
     pub irradiance: Table2,
     /// Single scattering by the molecular group without its phase function

@@ -17,7 +17,7 @@ use rayon::prelude::*;
 
 use super::context::Lookup;
 use super::params::{self, Radii, ScatteringGrid, TableSizes};
-use super::table::{lerp_weights, Table2, Table4};
+use super::table::{lerp_weights, Table2, Table4, MAX_OPTICAL_DEPTH};
 use super::{MieStorage, TableConfig, Tables};
 use crate::atmosphere::Model;
 use crate::geometry::{
@@ -164,9 +164,10 @@ pub fn precompute(
     };
 
     report("transmittance");
-    let transmittance = compute_transmittance(model, &s);
+    let optical_depth = compute_optical_depth(model, &s);
+    let transmittance = optical_depth.transmittance_of_optical_depth();
     check_cancel(cancel)?;
-    let lookup = Lookup::new(model, s, &transmittance);
+    let lookup = Lookup::new(model, s, &optical_depth);
     let grid = ScatteringGrid::new(&lookup.radii, &s);
     let groups = Groups::new(model);
 
@@ -255,6 +256,7 @@ pub fn precompute(
         wavelengths_nm: model.wavelengths.nm().to_vec(),
         atmosphere_hash: model.hash,
         transmittance,
+        optical_depth,
         irradiance,
         scattering: delta_rayleigh,
         single_mie,
@@ -318,7 +320,7 @@ fn table_mean(t: &Table4) -> Vec<f64> {
 
 /// T(r, μ) to the top: 4-point Gauss–Legendre on the constituents' columns (exact optical
 /// depths per constituent, then the per-wavelength sum).
-pub fn compute_transmittance(model: &Model, s: &TableSizes) -> Table2 {
+pub fn compute_optical_depth(model: &Model, s: &TableSizes) -> Table2 {
     let n = model.channels();
     let radii = Radii {
         bottom: model.bottom_radius_m,
@@ -342,7 +344,7 @@ pub fn compute_transmittance(model: &Model, s: &TableSizes) -> Table2 {
                 model.columns_along_ray(r, mu, d, TRANSMITTANCE_SEGMENTS, &mut columns);
                 model.optical_depth_from_columns(&columns, &mut tau);
                 for k in 0..n {
-                    row[x * n + k] = (-tau[k]).exp() as f32;
+                    row[x * n + k] = tau[k].min(MAX_OPTICAL_DEPTH as f64) as f32;
                 }
             }
         });
@@ -492,7 +494,7 @@ fn lagrange_exponential_moments(a: f64) -> [f64; 3] {
     ]
 }
 
-/// The transmittance table filtered to one radius, for lookups towards the sun from one
+/// The optical-depth table filtered to one radius, for lookups towards the sun from one
 /// ray sample at many μ_s.
 struct SunRow {
     r: f64,
@@ -507,7 +509,7 @@ impl SunRow {
     fn new(lookup: &Lookup, r: f64) -> SunRow {
         let g = &lookup.radii;
         let s = &lookup.sizes;
-        let t = lookup.transmittance;
+        let t = lookup.optical_depth;
         let rho = crate::geometry::safe_sqrt(r * r - g.bottom * g.bottom);
         let v = params::texcoord_from_unit(rho / g.h(), s.transmittance_r);
         let (y0, y1, ty) = lerp_weights(v, s.transmittance_r);
@@ -639,7 +641,7 @@ fn compute_single_scattering(
                     let Some(f) = f else { continue };
                     let (t0, t1) = (&row[f.x0 * n..][..n], &row[f.x1 * n..][..n]);
                     for k in 0..n {
-                        let t_sun = f.fraction * ((1.0 - f.tx) * t0[k] + f.tx * t1[k]);
+                        let t_sun = f.fraction * (-((1.0 - f.tx) * t0[k] + f.tx * t1[k])).exp();
                         ar[k] += tb_r[k] * t_sun;
                         am[k] += tb_m[k] * t_sun;
                     }
