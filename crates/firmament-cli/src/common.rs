@@ -53,6 +53,10 @@ pub struct AtmosphereArgs {
     /// Store single Mie scattering for every wavelength (`separate`) or only the first (`red-only`, ratio rule).
     #[arg(long, default_value = "separate", value_name = "separate|red-only")]
     pub mie: String,
+    /// Without the geometric tail of the orders beyond --orders (by default added from the
+    /// ratio of the last two orders when --orders ≥ 3): the plain truncated sum.
+    #[arg(long = "no-order-tail", action = clap::ArgAction::SetFalse)]
+    pub order_tail: bool,
 }
 
 impl AtmosphereArgs {
@@ -91,6 +95,7 @@ impl AtmosphereArgs {
             sizes,
             orders: self.orders,
             mie,
+            order_tail: self.order_tail,
         };
         config.validate()?;
         Ok(config)

@@ -222,6 +222,7 @@ pub fn atmosphere_args(scene: &Scene, tables: Option<PathBuf>, table_size: &str)
         orders: 4,
         table_size: table_size.to_string(),
         mie: "separate".into(),
+        order_tail: true,
     }
 }
 

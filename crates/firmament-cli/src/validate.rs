@@ -74,6 +74,9 @@ pub struct ValidateArgs {
     /// reference (the first is the one checked against the thresholds).
     #[arg(long, default_value = "4", value_name = "N,...")]
     pub orders: String,
+    /// Tables without the geometric tail of the orders beyond --orders.
+    #[arg(long)]
+    pub no_order_tail: bool,
     /// Table sizes: default or small (default: default; --quick: small).
     #[arg(long, value_name = "default|small")]
     pub table_size: Option<String>,
@@ -485,6 +488,7 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
         orders,
         table_size: table_size.clone(),
         mie: "separate".into(),
+        order_tail: !args.no_order_tail,
     };
     for p in &presets {
         for &o in &orders {
@@ -502,8 +506,13 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
     println!(
         "firmament validate: table method vs Monte Carlo reference; relative errors over views \
          (sun disk excluded), reference's median relative standard error in brackets; tables \
-         {table_size}, orders {:?}, reference {}",
+         {table_size}, orders {:?}{}, reference {}",
         orders,
+        if args.no_order_tail {
+            " (no tail)"
+        } else {
+            " + geometric tail"
+        },
         match plan {
             SamplePlan::Fixed(n) => format!("{n} paths/λ"),
             SamplePlan::Adaptive { target, max } => format!(
@@ -700,6 +709,7 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
             "altitudes_m": altitudes,
             "sun_elevations_deg": elevations,
             "orders": orders,
+            "order_tail": !args.no_order_tail,
             "table_size": table_size,
             "wavelengths_nm": nm,
             "seed": args.seed,

@@ -231,6 +231,7 @@ fn transmittance_and_single_scattering_match_the_cpu() {
         sizes: TableSizes::small(),
         orders: 1,
         mie: MieStorage::Separate,
+        order_tail: true,
     };
     let Some((cpu, gpu)) = both(&model, &config) else {
         return;
@@ -257,6 +258,7 @@ fn all_orders_match_the_cpu() {
         sizes: TableSizes::small(),
         orders: 4,
         mie: MieStorage::Separate,
+        order_tail: true,
     };
     let Some((cpu, gpu)) = both(&model, &config) else {
         return;
@@ -269,13 +271,18 @@ fn all_orders_match_the_cpu() {
         1e-3,
     );
     assert_within(
-        "irradiance (orders 1-3)",
+        "irradiance (orders 1-3 + tail)",
         &cpu.irradiance.data,
         &gpu.irradiance.data,
         1e-2,
     );
     assert_scattering_within("single rayleigh", &cpu.scattering, &gpu.scattering, 1e-2);
-    assert_scattering_within("multiple (orders 2-4)", &cpu.multiple, &gpu.multiple, 1e-2);
+    assert_scattering_within(
+        "multiple (orders 2-4 + tail)",
+        &cpu.multiple,
+        &gpu.multiple,
+        1e-2,
+    );
     assert_scattering_within("single mie", &cpu.single_mie, &gpu.single_mie, 1e-2);
     check_order_means(&cpu, &gpu, 1e-2);
 }
@@ -292,6 +299,7 @@ fn channel_groups_and_red_only_mie_match_the_cpu() {
         sizes: TableSizes::small(),
         orders: 2,
         mie: MieStorage::RedOnly,
+        order_tail: true,
     };
     let Some((cpu, gpu)) = both(&model, &config) else {
         return;
@@ -338,6 +346,7 @@ fn tables_beyond_the_device_limits_are_refused() {
         sizes,
         orders: 4,
         mie: MieStorage::Separate,
+        order_tail: true,
     };
     config.validate().unwrap();
     match firmament_gpu::precompute(ctx, &model, &config) {
@@ -356,6 +365,7 @@ fn tables_beyond_the_device_limits_are_refused() {
         sizes: TableSizes::small(),
         orders: 1,
         mie: MieStorage::Separate,
+        order_tail: true,
     };
     firmament_gpu::precompute(ctx, &self::model("earth", Wavelengths::rgb()), &small).unwrap();
 }
@@ -368,6 +378,7 @@ fn what_the_cpu_refuses_the_gpu_refuses() {
         sizes: TableSizes::small(),
         orders: 0,
         mie: MieStorage::Separate,
+        order_tail: true,
     };
     let e = firmament_gpu::precompute(ctx, &model, &bad_orders).unwrap_err();
     assert!(
@@ -381,6 +392,7 @@ fn what_the_cpu_refuses_the_gpu_refuses() {
         },
         orders: 1,
         mie: MieStorage::Separate,
+        order_tail: true,
     };
     let e = firmament_gpu::precompute(ctx, &model, &odd_mu).unwrap_err();
     assert!(e.to_string().contains("scattering_mu"), "{e}");

@@ -65,6 +65,7 @@ fn sky(preset: &str, wavelengths: Wavelengths, orders: usize, mie: MieStorage) -
         sizes: TableSizes::small(),
         orders,
         mie,
+        order_tail: true,
     };
     let tables = Tables::compute(&model, &config).unwrap();
     Sky::new(model, tables).unwrap()
@@ -545,6 +546,7 @@ fn tables_kept_on_the_device_render_like_tables_read_back() {
         },
         orders: 2,
         mie: MieStorage::RedOnly,
+        order_tail: true,
     };
     let precomputer = firmament_gpu::lut::Precomputer::new(&gpu.ctx).unwrap();
     let on_device = GpuSky::precompute(&gpu.ctx, &precomputer, &model, &config).unwrap();

@@ -614,6 +614,7 @@ fn reference_agrees_with_table_method_for_earth_daylight() {
             sizes: TableSizes::small(),
             orders: 8,
             mie: MieStorage::Separate,
+            order_tail: true,
         },
     )
     .unwrap();

@@ -22,6 +22,7 @@ fn sky() -> &'static Sky {
                 sizes: TableSizes::small(),
                 orders: 4,
                 mie: MieStorage::Separate,
+                order_tail: true,
             },
         )
         .unwrap();

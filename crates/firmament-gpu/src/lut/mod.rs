@@ -54,6 +54,8 @@ pub struct Precomputer {
     indirect_irradiance: Pass,
     multiple_scattering: Pass,
     order_sums: Pass,
+    order_tail_factors: Pass,
+    order_tail: Pass,
 }
 
 /// Precompute every table for `model` on the GPU; the result has the CPU's layout
@@ -157,6 +159,18 @@ impl Precomputer {
                     "order_sums",
                     include_str!("../../shaders/order_sums.wgsl"),
                     &[(5, Read), (6, Read), (7, Write)],
+                ),
+                order_tail_factors: Pass::new(
+                    d,
+                    "order_tail_factors",
+                    include_str!("../../shaders/order_tail_factors.wgsl"),
+                    &[(5, Read), (7, Write)],
+                ),
+                order_tail: Pass::new(
+                    d,
+                    "order_tail",
+                    include_str!("../../shaders/order_tail.wgsl"),
+                    &[(4, Read), (5, Read), (6, Read), (7, Write), (8, Write)],
                 ),
             })
         })
@@ -488,6 +502,34 @@ impl Precomputer {
                         &[&delta_multiple, &delta_multiple, &row_sums],
                     );
                     dispatch(&mut cpass, &self.order_sums, &bg, rows, g, max_dim);
+                }
+                if config.order_tail && orders >= 3 {
+                    let factors = storage(device, "order tail factors", g as u64 * vec4);
+                    let bg = self.order_tail_factors.bind(
+                        device,
+                        common(orders),
+                        &[&row_sums, &factors],
+                    );
+                    dispatch(&mut cpass, &self.order_tail_factors, &bg, 1, g, max_dim);
+                    let bg = self.order_tail.bind(
+                        device,
+                        common(orders),
+                        &[
+                            &delta_irradiance,
+                            &delta_multiple,
+                            &factors,
+                            &multiple,
+                            &irradiance,
+                        ],
+                    );
+                    dispatch(
+                        &mut cpass,
+                        &self.order_tail,
+                        &bg,
+                        s_texels.max(e_texels),
+                        g,
+                        max_dim,
+                    );
                 }
             }
             ctx.queue().submit([encoder.finish()]);

@@ -39,6 +39,15 @@ pub struct TableConfig {
     pub orders: usize,
     /// Single Mie storage.
     pub mie: MieStorage,
+    /// Add the geometric tail of the orders beyond `orders` to the multiple scattering and
+    /// the irradiance ([`precompute::order_tail_factors`]; needs `orders` ≥ 3). Default
+    /// true: 4 orders with the tail are as accurate as 8 without.
+    #[serde(default = "default_true")]
+    pub order_tail: bool,
+}
+
+fn default_true() -> bool {
+    true
 }
 
 impl Default for TableConfig {
@@ -47,6 +56,7 @@ impl Default for TableConfig {
             sizes: TableSizes::default(),
             orders: 4,
             mie: MieStorage::Separate,
+            order_tail: true,
         }
     }
 }

@@ -1,0 +1,25 @@
+// Factors q/(1 − q) of the geometric tail of the orders beyond the last one, N
+// (lut::precompute::order_tail_factors): q = Σ ΔS_N / Σ ΔS_{N−1} per channel over the order
+// row sums (order_sums.wgsl, read at slot a), capped at 0.95; 0 where either sum is 0.
+// N is the pass order. One invocation per channel group.
+
+@group(0) @binding(7) var<storage, read_write> tail_factors: array<vec4<f32>>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    if (invocation_index(gid, nwg) > 0u) {
+        return;
+    }
+    let k = gid.z;
+    let rows = atm.scattering_r * atm.scattering_mu;
+    let n = pass_params.order;
+    var last = vec4<f32>(0.0);
+    var before = vec4<f32>(0.0);
+    for (var row = 0u; row < rows; row++) {
+        last += scattering_a[((n - 1u) * rows + row) * atm.groups + k];
+        before += scattering_a[((n - 2u) * rows + row) * atm.groups + k];
+    }
+    let valid = (before > vec4<f32>(0.0)) & (last > vec4<f32>(0.0));
+    let q = select(vec4<f32>(0.0), min(last / before, vec4<f32>(0.95)), valid);
+    tail_factors[k] = q / (1.0 - q);
+}
