@@ -56,8 +56,9 @@ pub struct ValidateArgs {
     /// Write every figure (per view and summaries) to this JSON file.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
-    /// Reduced set for CI: earth, altitude 0, sun elevations 30 and 10°, ~20 views, small
-    /// tables, 1 % target noise; fails when the daylight thresholds are broken.
+    /// Reduced set for CI: earth, altitudes 0 and 1 km (with views down to the ground), sun
+    /// elevations 30 and 10°, 23–35 views each, small tables, 1 % target noise; fails when
+    /// the daylight thresholds are broken.
     #[arg(long)]
     pub quick: bool,
     /// Fixed paths per wavelength and view (default: adaptive, see --target-stderr).
@@ -80,7 +81,7 @@ pub struct ValidateArgs {
     /// Table sizes: default or small (default: default; --quick: small).
     #[arg(long, value_name = "default|small")]
     pub table_size: Option<String>,
-    /// Observer altitudes (m), comma-separated (default: 0,1000,10000,100000).
+    /// Observer altitudes (m), comma-separated (default: 0,1000,10000,100000; --quick: 0,1000).
     #[arg(long, value_name = "M,...")]
     pub altitudes: Option<String>,
     /// Sun elevations (degrees), comma-separated (default: 90,60,30,10,5,2,0,-3,-6).
@@ -166,6 +167,10 @@ fn views(model: &Model, altitude_m: f64, sun: Vec3, quick: bool) -> (Vec<View>, 
         )
     };
     let mut elevations: Vec<f64> = above.to_vec();
+    if altitude_m > 0.0 && quick {
+        // Down towards the ground (the ground half of the tables), the horizon excluded.
+        elevations.extend([-3.0, -30.0, -60.0]);
+    }
     if altitude_m > 0.0 && !quick {
         let mut below = vec![-1.0, -3.0, -10.0, -30.0, -60.0];
         if let Some(g) = dip_deg(r, model.bottom_radius_m) {
@@ -434,7 +439,7 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
     };
     let altitudes: Vec<f64> = match &args.altitudes {
         Some(s) => parse_list("--altitudes", s, "altitudes in m separated by commas")?,
-        None if args.quick => vec![0.0],
+        None if args.quick => vec![0.0, 1000.0],
         None => vec![0.0, 1000.0, 10_000.0, 100_000.0],
     };
     for &a in &altitudes {

@@ -47,10 +47,11 @@ fn validate_quick_passes_and_writes_json() {
     assert_eq!(v["thresholds"]["median"], 0.02);
     assert_eq!(v["thresholds"]["p95"], 0.05);
     let configs = v["configurations"].as_array().unwrap();
-    assert_eq!(configs.len(), 2);
+    assert_eq!(configs.len(), 4);
     for c in configs {
         assert_eq!(c["preset"], "earth");
-        assert_eq!(c["altitude_m"], 0.0);
+        let altitude = c["altitude_m"].as_f64().unwrap();
+        assert!(altitude == 0.0 || altitude == 1000.0, "{altitude}");
         let views = c["views"].as_array().unwrap();
         assert!(views.len() >= 15, "{} views", views.len());
         for view in views {

@@ -364,9 +364,10 @@ fn scattering_u_mu(r: f32, rho: f32, mu: f32, ground: bool) -> f32 {
         let d = distance_to_bottom(r, rho, mu);
         let d_min = rho * rho / (r + atm.bottom_radius);
         let d_max = rho;
+        // x = √f of the distance fraction (params::ground_x_from_distance_fraction).
         var x = 0.0;
         if (d_max != d_min) {
-            x = clamp((d - d_min) / (d_max - d_min), 0.0, 1.0);
+            x = sqrt(clamp((d - d_min) / (d_max - d_min), 0.0, 1.0));
         }
         return 0.5 - 0.5 * texcoord_from_unit(x, half);
     }
@@ -404,7 +405,7 @@ fn scattering_texel(x: u32, y: u32, z: u32) -> ScatteringTexel {
         let x_mu = f32(half - 1u - y) / f32(half - 1u);
         let d_min = t.rho * t.rho / (t.r + atm.bottom_radius);
         let d_max = t.rho;
-        let d = d_min + (d_max - d_min) * x_mu;
+        let d = d_min + (d_max - d_min) * x_mu * x_mu;
         t.mu = -1.0;
         if (d != 0.0) {
             t.mu = clamp_cosine(-(t.rho * t.rho + d * d) / (2.0 * t.r * d));

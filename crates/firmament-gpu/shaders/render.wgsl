@@ -401,7 +401,7 @@ fn start_u_mu(s: ViewStart, ground: bool) -> f32 {
     let d_max = s.rho;
     var x = 0.0;
     if (d_max != d_min) {
-        x = clamp((d - d_min) / (d_max - d_min), 0.0, 1.0);
+        x = sqrt(clamp((d - d_min) / (d_max - d_min), 0.0, 1.0));
     }
     return 0.5 - 0.5 * texcoord_from_unit(x, atm.scattering_mu / 2u);
 }
