@@ -5,7 +5,8 @@
 //! the same quantity as `Sky::sky_radiance`) and evaluated with the precomputed tables; the
 //! relative errors of luminance (Y) and of each wavelength's radiance are summarised by
 //! their median, 95th percentile and maximum, next to the reference's own median relative
-//! standard error. See `docs/accuracy.md` for the set, the results and their analysis.
+//! standard error, the signed median (bias), and the root mean square with and without the
+//! reference's noise (√(⟨e²⟩ − ⟨σ²⟩): what remains is the table method's own error). See `docs/accuracy.md` for the set, the results and their analysis.
 //!
 //! View directions (azimuths relative to the sun; the sky is symmetric about the sun's
 //! vertical plane, so 0–180° covers it):
@@ -244,6 +245,12 @@ struct Summary {
     signed_median: f64,
     /// Median relative standard error of the reference.
     ref_stderr_median: f64,
+    /// Root mean square of the relative errors.
+    rms: f64,
+    /// The RMS with the reference's noise removed, √max(⟨e²⟩ − ⟨σ²⟩, 0): the error e of a
+    /// view is the table's own error plus the reference's relative noise σ (independent,
+    /// mean 0), so ⟨e²⟩ − ⟨σ²⟩ estimates the mean square of the table's own error.
+    rms_noise_removed: f64,
     count: usize,
 }
 
@@ -267,7 +274,11 @@ fn summarise(errors: &[f64], ref_stderr: &[f64]) -> Summary {
     let mut se = ref_stderr.to_vec();
     se.sort_by(f64::total_cmp);
     let n = abs.len();
+    let mean_sq = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64;
+    let (e2, s2) = (mean_sq(errors), mean_sq(ref_stderr));
     Summary {
+        rms: e2.sqrt(),
+        rms_noise_removed: (e2 - s2).max(0.0).sqrt(),
         median: median(&abs),
         p95: if n == 0 {
             f64::NAN
@@ -289,6 +300,8 @@ impl Summary {
             "max": self.max,
             "signed_median": self.signed_median,
             "reference_median_relative_stderr": self.ref_stderr_median,
+            "rms": self.rms,
+            "rms_noise_removed": self.rms_noise_removed,
             "count": self.count,
         })
     }
@@ -296,12 +309,14 @@ impl Summary {
     fn line(&self, label: &str) -> String {
         let pct = |v: f64| format!("{:6.2}%", 100.0 * v);
         format!(
-            "  {label:>8}  med {} p95 {} max {}  (ref se {})  bias {:+.2}%",
+            "  {label:>8}  med {} p95 {} max {}  (ref se {})  bias {:+.2}%  rms {} (noise removed {})",
             pct(self.median),
             pct(self.p95),
             pct(self.max),
             pct(self.ref_stderr_median),
-            100.0 * self.signed_median
+            100.0 * self.signed_median,
+            pct(self.rms).trim_start(),
+            pct(self.rms_noise_removed).trim_start()
         )
     }
 }

@@ -72,9 +72,12 @@ fn validate_quick_passes_and_writes_json() {
             "max",
             "signed_median",
             "reference_median_relative_stderr",
+            "rms",
+            "rms_noise_removed",
         ] {
             assert!(s[key].as_f64().is_some(), "missing {key}");
         }
+        assert!(s["rms_noise_removed"].as_f64() <= s["rms"].as_f64());
         assert_eq!(
             c["tables"][0]["summary"]["wavelengths"]
                 .as_array()
