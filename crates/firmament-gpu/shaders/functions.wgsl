@@ -531,7 +531,9 @@ struct Moments {
     m2: vec4<f32>,
 }
 
-fn lagrange_exponential_moments(a: vec4<f32>) -> Moments {
+// For a < 0 by the reflection s → 2 − s: M_j(a) = e^{−2a}·M_{2−j}(−a).
+fn lagrange_exponential_moments(a_signed: vec4<f32>) -> Moments {
+    let a = abs(a_signed);
     // I_m = ∫₀² s^m e^{−a·s} ds. Series Σ_k (−a)^k/k! · 2^{m+k+1}/(m+k+1), on lanes a < 1
     // (the others evaluate it at a = 1, unused).
     let a_series = min(a, vec4<f32>(1.0));
@@ -556,35 +558,50 @@ fn lagrange_exponential_moments(a: vec4<f32>) -> Moments {
     let i0 = select(c0, s0, series);
     let i1 = select(c1, s1, series);
     let i2 = select(c2, s2, series);
+    let p0 = 0.5 * (i2 - 3.0 * i1 + 2.0 * i0);
+    let p1 = 2.0 * i1 - i2;
+    let p2 = 0.5 * (i2 - i1);
+    let negative = a_signed < vec4<f32>(0.0);
+    let reflect = exp(select(vec4<f32>(0.0), 2.0 * a, negative));
     var m: Moments;
-    m.m0 = 0.5 * (i2 - 3.0 * i1 + 2.0 * i0);
-    m.m1 = 2.0 * i1 - i2;
-    m.m2 = 0.5 * (i2 - i1);
+    m.m0 = select(p0, reflect * p2, negative);
+    m.m1 = reflect * p1;
+    m.m2 = select(p2, reflect * p0, negative);
     return m;
 }
 
 // Weights (in units of the step) on the three samples of one pair of intervals, per lane,
-// from their transmittances (lut::precompute::exponential_simpson_weights, one pair):
-// a = ln(T_0/T_2)/2 (ln(T_0/T_1) when T_2 = 0, 0 when T_1 = 0 too) clamped to [0, 300],
-// weights T_0·M_0, T_1·e^a·M_1, T_2·e^{2a}·M_2; all 0 when T_0 ≤ 0. T_j·e^{j·a} is taken as
-// exp(ln T_j + j·a) (≈ T_0 when the fit goes through T_j): e^{2a} alone leaves f32 when
-// T_2 is below ~1e-38.
+// from their transmittances T and the fitted quantity F = β·T (lut::precompute::
+// exponential_simpson_weights, one pair): a = ln(F_0/F_2)/2 (ln(F_0/F_1) when F_2 = 0, 0
+// when F_1 = 0 too; from T the same way where F_0 = 0) clamped to [−30, 300], weights
+// T_0·M_0, T_1·e^a·M_1, T_2·e^{2a}·M_2; all 0 when T_0 ≤ 0. T_j·e^{j·a} is taken as
+// exp(ln T_j + j·a): e^{2a} alone leaves f32 when T_2 is below ~1e-38.
 struct PairWeights {
     w0: vec4<f32>,
     w1: vec4<f32>,
     w2: vec4<f32>,
 }
 
-fn exponential_simpson_weights(t0: vec4<f32>, t1: vec4<f32>, t2: vec4<f32>) -> PairWeights {
+// The decay rate per step through a pair's samples v (see exponential_simpson_weights).
+fn pair_rate(v0: vec4<f32>, v1: vec4<f32>, v2: vec4<f32>) -> vec4<f32> {
+    let zero = vec4<f32>(0.0);
+    let one = vec4<f32>(1.0);
+    let l0 = log(select(one, v0, v0 > zero));
+    let l1 = log(select(one, v1, v1 > zero));
+    let l2 = log(select(one, v2, v2 > zero));
+    return select(select(zero, l0 - l1, v1 > zero), 0.5 * (l0 - l2), v2 > zero);
+}
+
+fn exponential_simpson_weights(t0: vec4<f32>, t1: vec4<f32>, t2: vec4<f32>, f0: vec4<f32>, f1: vec4<f32>, f2: vec4<f32>) -> PairWeights {
     let zero = vec4<f32>(0.0);
     let one = vec4<f32>(1.0);
     let p0 = t0 > zero;
     let p1 = t1 > zero;
     let p2 = t2 > zero;
-    let l0 = log(select(one, t0, p0));
     let l1 = log(select(one, t1, p1));
     let l2 = log(select(one, t2, p2));
-    let a = clamp(select(select(zero, l0 - l1, p1), 0.5 * (l0 - l2), p2), zero, vec4<f32>(300.0));
+    let rate = select(pair_rate(t0, t1, t2), pair_rate(f0, f1, f2), f0 > zero);
+    let a = clamp(rate, vec4<f32>(-30.0), vec4<f32>(300.0));
     let m = lagrange_exponential_moments(a);
     var w: PairWeights;
     w.w0 = select(zero, t0 * m.m0, p0);

@@ -11,9 +11,11 @@
 
 const RAY_INTERVALS: u32 = 50u;
 
-// One ray sample: the transmittance from the ray origin and ΔJ there.
+// One ray sample: the transmittance from the ray origin, the total β_s·T (which the
+// quadrature's exponential fit follows: ΔJ is β_s times a smooth field) and ΔJ there.
 struct MultipleSample {
     t: vec4<f32>,
+    f: vec4<f32>,
     j: vec4<f32>,
 }
 
@@ -28,6 +30,8 @@ fn multiple_sample(t: ScatteringTexel, d: f32, k: u32) -> MultipleSample {
     let f = scattering_filter_rows(u_nu, u_mu_s, lerp_weights(uvwz.z, atm.scattering_mu), lerp_weights(uvwz.w, atm.scattering_r));
     var s: MultipleSample;
     s.t = transmittance(t.r, t.rho, t.mu, d, t.ground, k);
+    let altitude = altitude_of(rho_d, r_d);
+    s.f = (group_scattering(0u, altitude, k) + group_scattering(1u, altitude, k)) * s.t;
     s.j = sample_scattering_a(f, k);
     return s;
 }
@@ -57,7 +61,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     for (var p = 0u; p < RAY_INTERVALS / 2u; p++) {
         let s1 = multiple_sample(t, f32(2u * p + 1u) * dx, k);
         let s2 = multiple_sample(t, f32(2u * p + 2u) * dx, k);
-        let w = exponential_simpson_weights(s0.t, s1.t, s2.t);
+        let w = exponential_simpson_weights(s0.t, s1.t, s2.t, s0.f, s1.f, s2.f);
         acc += w.w0 * s0.j + w.w1 * s1.j + w.w2 * s2.j;
         s0 = s2;
     }

@@ -14,6 +14,9 @@ const RAY_INTERVALS: u32 = 50u;
 // integrands without it (β_s times the transmittance to the sun).
 struct SingleSample {
     t: vec4<f32>,
+    // Each group's β_s·T, which the quadrature's exponential fit follows.
+    f_r: vec4<f32>,
+    f_m: vec4<f32>,
     g_r: vec4<f32>,
     g_m: vec4<f32>,
 }
@@ -26,8 +29,12 @@ fn single_sample(t: ScatteringTexel, d: f32, k: u32) -> SingleSample {
     let altitude = altitude_of(rho_d, r_d);
     var s: SingleSample;
     s.t = transmittance(t.r, t.rho, t.mu, d, t.ground, k);
-    s.g_r = sun * group_scattering(0u, altitude, k);
-    s.g_m = sun * group_scattering(1u, altitude, k);
+    let beta_r = group_scattering(0u, altitude, k);
+    let beta_m = group_scattering(1u, altitude, k);
+    s.f_r = beta_r * s.t;
+    s.f_m = beta_m * s.t;
+    s.g_r = sun * beta_r;
+    s.g_m = sun * beta_m;
     return s;
 }
 
@@ -57,9 +64,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     for (var p = 0u; p < RAY_INTERVALS / 2u; p++) {
         let s1 = single_sample(t, f32(2u * p + 1u) * dx, k);
         let s2 = single_sample(t, f32(2u * p + 2u) * dx, k);
-        let w = exponential_simpson_weights(s0.t, s1.t, s2.t);
-        acc_r += w.w0 * s0.g_r + w.w1 * s1.g_r + w.w2 * s2.g_r;
-        acc_m += w.w0 * s0.g_m + w.w1 * s1.g_m + w.w2 * s2.g_m;
+        let w_r = exponential_simpson_weights(s0.t, s1.t, s2.t, s0.f_r, s1.f_r, s2.f_r);
+        let w_m = exponential_simpson_weights(s0.t, s1.t, s2.t, s0.f_m, s1.f_m, s2.f_m);
+        acc_r += w_r.w0 * s0.g_r + w_r.w1 * s1.g_r + w_r.w2 * s2.g_r;
+        acc_m += w_m.w0 * s0.g_m + w_m.w1 * s1.g_m + w_m.w2 * s2.g_m;
         s0 = s2;
     }
     // Clamped at 0 as on the CPU: the fitted rule's end weight is negative for a pair with
