@@ -63,6 +63,7 @@ impl<'a> Lookup<'a> {
     /// (Bruneton 2017 `GetTransmittance` takes ratios of transmittances); uses the reversed
     /// ray when it hits the ground. 0 where the far end's optical depth is the table's
     /// stand-in for T = 0.
+    #[inline]
     pub fn transmittance(&self, r: f64, mu: f64, d: f64, ground: bool, out: &mut [f64]) {
         let g = &self.radii;
         let r_d = safe_sqrt(d * d + 2.0 * r * mu * d + r * r).clamp(g.bottom, g.top);

@@ -294,9 +294,9 @@ fn mie_ratio(groups: &Groups, n: usize) -> Vec<f64> {
 /// 1/(1 − f_ms) is the isotropic, single-number form of the same series). None below 3
 /// orders (the single-scattering field is far from that shape). q is capped at 0.95.
 ///
-/// Measured (`validate`, earth, altitudes 0 and 1 km, sun 60° and 10°, 398 views,
-/// reference at 1 %): 4 orders + tail give a luminance bias of +0.36 % and 440 nm +0.25 %
-/// (4 orders alone: −1.00 %, −3.32 %; 8 orders alone: +0.43 %, +0.37 %).
+/// Measured when introduced (`validate`, earth, altitudes 0 and 1 km, sun 60° and 10°, 398
+/// views, reference at 1 %): 4 orders + tail give a luminance bias of +0.36 % and 440 nm
+/// +0.25 % (4 orders alone: −1.00 %, −3.32 %; 8 orders alone: +0.43 %, +0.37 %).
 pub fn order_tail_factors(order_means: &[Vec<f64>]) -> Option<Vec<f64>> {
     let n_orders = order_means.len();
     if n_orders < 3 {
@@ -364,8 +364,8 @@ fn table_mean(t: &Table4) -> Vec<f64> {
     sum.iter().map(|v| v / count).collect()
 }
 
-/// T(r, μ) to the top: 4-point Gauss–Legendre on the constituents' columns (exact optical
-/// depths per constituent, then the per-wavelength sum).
+/// τ(r, μ) to the top, capped at [`MAX_OPTICAL_DEPTH`]: 4-point Gauss–Legendre on the
+/// constituents' columns (exact optical depths per constituent, then the per-wavelength sum).
 pub fn compute_optical_depth(model: &Model, s: &TableSizes) -> Table2 {
     let n = model.channels();
     let radii = Radii {
