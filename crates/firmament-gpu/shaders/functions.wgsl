@@ -53,9 +53,6 @@ struct Atmosphere {
     phase1_c: f32,
     group0_present: u32,
     group1_present: u32,
-    // acos μ_s,min (rad), and where the μ_s of the scattering texel centres start in `data`.
-    mu_s_theta_max: f32,
-    mu_s_offset: u32,
 }
 
 // Which radiance field a pass reads (0: single scattering, phase functions applied at lookup;
@@ -330,22 +327,25 @@ fn irradiance_texel(x: u32, y: u32) -> vec3<f32> {
     return vec3<f32>(r, rho, clamp_cosine(2.0 * x_mu_s - 1.0));
 }
 
-// The non-linear μ_s coordinate in [0, 1] (params::x_mu_s): the mean of Bruneton's mapping
-// and one linear in the sun's zenith angle. Its inverse has no closed form: the texel
-// centres' μ_s come from the host (`texel_mu_s`).
+// The non-linear μ_s coordinate in [0, 1] (params::x_mu_s).
 fn x_mu_s(mu_s: f32) -> f32 {
     let d_min = atm.top_radius - atm.bottom_radius;
     let d_max = atm.h;
     let d = distance_to_top(atm.bottom_radius, 0.0, mu_s);
     let a = (d - d_min) / (d_max - d_min);
-    let bruneton = clamp(max(1.0 - a / atm.mu_s_big_a, 0.0) / (1.0 + a), 0.0, 1.0);
-    let angle = clamp((atm.mu_s_theta_max - acos(clamp_cosine(mu_s))) / atm.mu_s_theta_max, 0.0, 1.0);
-    return 0.5 * (bruneton + angle);
+    return clamp(max(1.0 - a / atm.mu_s_big_a, 0.0) / (1.0 + a), 0.0, 1.0);
 }
 
-// μ_s at the centre of scattering texel column i (params::mu_s_from_x(i/(n − 1))).
-fn texel_mu_s(i: u32) -> f32 {
-    return data[atm.mu_s_offset + i].x;
+fn mu_s_from_x(x: f32) -> f32 {
+    let d_min = atm.top_radius - atm.bottom_radius;
+    let d_max = atm.h;
+    let big_a = atm.mu_s_big_a;
+    let a = (big_a - x * big_a) / (1.0 + x * big_a);
+    let d = d_min + min(a, big_a) * (d_max - d_min);
+    if (d == 0.0) {
+        return 1.0;
+    }
+    return clamp_cosine((atm.h_sq - d * d) / (2.0 * atm.bottom_radius * d));
 }
 
 // (u_ν, u_μs, u_μ, u_r) of the scattering table (params::scattering_uvwz).
@@ -422,7 +422,7 @@ fn scattering_texel(x: u32, y: u32, z: u32) -> ScatteringTexel {
         }
         t.ground = false;
     }
-    t.mu_s = texel_mu_s(i_mu_s);
+    t.mu_s = mu_s_from_x(f32(i_mu_s) / f32(atm.scattering_mu_s - 1u));
     // ν from u_ν once μ and μ_s are known (params::scattering_r_mu_mu_s_nu).
     let nu = nu_from_u_nu(t.mu, t.mu_s, f32(i_nu) / f32(atm.scattering_nu - 1u));
     let spread = sqrt(max((1.0 - t.mu * t.mu) * (1.0 - t.mu_s * t.mu_s), 0.0));

@@ -180,19 +180,6 @@ pub fn pack(model: &Model, sizes: &TableSizes, groups_info: &ScatteringGroups) -
     }
     let phase0 = pack_phase(&groups_info.phase[0], &mut data);
     let phase1 = pack_phase(&groups_info.phase[1], &mut data);
-    // μ_s at the scattering texel centres (params::mu_s_from_x has no closed form).
-    let radii = firmament::lut::params::Radii {
-        bottom,
-        top,
-        mu_s_min: model.mu_s_min,
-    };
-    let mu_s_offset = data.len() / 4;
-    let n_mu_s = sizes.scattering_mu_s;
-    for i in 0..n_mu_s {
-        let x = i as f64 / (n_mu_s - 1) as f64;
-        let mu_s = firmament::lut::params::mu_s_from_x(&radii, x);
-        data.extend_from_slice(&[mu_s as f32, 0.0, 0.0, 0.0]);
-    }
 
     let f = |x: f64| (x as f32).to_bits();
     let u = |x: usize| x as u32;
@@ -224,8 +211,6 @@ pub fn pack(model: &Model, sizes: &TableSizes, groups_info: &ScatteringGroups) -
     uniform.extend_from_slice(&phase1);
     uniform.push(groups_info.present[0] as u32);
     uniform.push(groups_info.present[1] as u32);
-    uniform.push(f(model.mu_s_min.clamp(-1.0, 1.0).acos()));
-    uniform.push(u(mu_s_offset));
     while !uniform.len().is_multiple_of(4) {
         uniform.push(0);
     }
@@ -243,8 +228,8 @@ mod tests {
         let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
         let groups_info = ScatteringGroups::new(&model);
         let p = pack(&model, &TableSizes::small(), &groups_info);
-        // 38 fields of the WGSL `Atmosphere` struct, padded to 16 bytes.
-        assert_eq!(p.uniform.len(), 40);
+        // 36 fields of the WGSL `Atmosphere` struct.
+        assert_eq!(p.uniform.len(), 36);
         assert_eq!(p.data.len() % 4, 0);
         assert!(groups_info.present[0]);
     }

@@ -268,8 +268,6 @@ pub struct MuSMap {
     d_min: f64,
     inv_range: f64,
     big_a: f64,
-    /// acos μ_s,min: the largest sun zenith angle covered (rad).
-    theta_max: f64,
 }
 
 impl MuSMap {
@@ -284,7 +282,6 @@ impl MuSMap {
             d_min,
             inv_range: 1.0 / (d_max - d_min),
             big_a: (big_d - d_min) / (d_max - d_min),
-            theta_max: g.mu_s_min.clamp(-1.0, 1.0).acos(),
         }
     }
 
@@ -293,10 +290,7 @@ impl MuSMap {
     pub fn x(&self, mu_s: f64) -> f64 {
         let d = distance_to_top_atmosphere_boundary(self.bottom, mu_s, self.top);
         let a = (d - self.d_min) * self.inv_range;
-        let bruneton = ((1.0 - a / self.big_a).max(0.0) / (1.0 + a)).clamp(0.0, 1.0);
-        let angle =
-            ((self.theta_max - mu_s.clamp(-1.0, 1.0).acos()) / self.theta_max).clamp(0.0, 1.0);
-        0.5 * (bruneton + angle)
+        ((1.0 - a / self.big_a).max(0.0) / (1.0 + a)).clamp(0.0, 1.0)
     }
 }
 
@@ -369,40 +363,28 @@ pub fn nu_from_u_nu(mu: f64, mu_s: f64, u_nu: f64) -> f64 {
     clamp_cosine(mu * mu_s + s * (1.0 - 2.0 * x * x))
 }
 
-/// The non-linear μ_s coordinate in [0,1]: the mean of Bruneton 2017's mapping (from the
-/// distance to the top along the sun ray from the ground, with the configurable minimum
-/// sun elevation) and one linear in the sun's zenith angle over [0, acos μ_s,min].
-///
-/// Bruneton's mapping alone concentrates samples near the horizon and leaves none between
-/// 47.6° and 90° sun elevation (32 samples, μ_s,min = cos 102°): with the sun at 60° the
-/// sky read up to +8 % (anti-solar views at 60° elevation; 64 μ_s samples halved every
-/// error). The mean keeps half of Bruneton's density at the horizon and puts 7 of 32
-/// samples above 47.6°.
+/// The non-linear μ_s coordinate in [0,1] (Bruneton 2017): from the distance to the top
+/// along the sun ray from the ground, with the configurable minimum sun elevation.
 #[inline]
 pub fn x_mu_s(g: &Radii, mu_s: f64) -> f64 {
     MuSMap::new(g).x(mu_s)
 }
 
-/// Inverse of [`x_mu_s`] on [μ_s,min, 1], by bisection (x is increasing; used for the
-/// texel centres only, which the GPU reads from a table of these values).
+/// Inverse of [`x_mu_s`].
+#[inline]
 pub fn mu_s_from_x(g: &Radii, x: f64) -> f64 {
-    let map = MuSMap::new(g);
-    if x <= 0.0 {
-        return g.mu_s_min;
+    let h = g.h();
+    let d_min = g.top - g.bottom;
+    let d_max = h;
+    let big_d = distance_to_top_atmosphere_boundary(g.bottom, g.mu_s_min, g.top);
+    let big_a = (big_d - d_min) / (d_max - d_min);
+    let a = (big_a - x * big_a) / (1.0 + x * big_a);
+    let d = d_min + a.min(big_a) * (d_max - d_min);
+    if d == 0.0 {
+        1.0
+    } else {
+        clamp_cosine((h * h - d * d) / (2.0 * g.bottom * d))
     }
-    if x >= 1.0 {
-        return 1.0;
-    }
-    let (mut lo, mut hi) = (g.mu_s_min, 1.0);
-    for _ in 0..64 {
-        let mid = 0.5 * (lo + hi);
-        if map.x(mid) < x {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
 }
 
 /// Inverse of [`scattering_uvwz`]: (r, μ, μ_s, ν, ray hits ground).
