@@ -482,11 +482,12 @@ fn single_scattering_near_the_horizon_matches_brute_force_quadrature() {
 /// Single scattering along rays climbing out of a dense aerosol layer (hazy: aerosol
 /// optical depth ≈ 0.4 with a 1.5 km scale height), where a table ray step rises up to
 /// about one aerosol scale height: the rule exponentially fitted to the transmittance alone
-/// read +1.2 % at 15° elevation (blue); fitted to β·T, so that the scattering coefficient's
-/// own decay is followed too, +0.54 % (45° and 90°: within 0.35 % either way).
+/// read +1.2 % at 15° elevation (blue; measured with a μ_s mapping since reverted, the
+/// same −0.4 % from the rule itself); fitted to β·T, so that the scattering coefficient's
+/// own decay is followed too, +0.77 % (45° and 90°: within 0.3 % either way).
 #[test]
 fn single_scattering_out_of_a_dense_haze_matches_brute_force_quadrature() {
-    single_scattering_matches_brute_force("hazy", &[15.0, 45.0, 90.0], 0.007);
+    single_scattering_matches_brute_force("hazy", &[15.0, 45.0, 90.0], 0.009);
 }
 
 fn single_scattering_matches_brute_force(preset: &str, elevations: &[f64], tolerance: f64) {
