@@ -7,9 +7,10 @@ use std::time::{Duration, Instant};
 use anyhow::Result;
 use clap::ValueEnum;
 use firmament::atmosphere::Model;
-use firmament::lut::{TableConfig, Tables};
+use firmament::math::Vec3;
 use firmament::render::{Frame, RenderSettings};
-use firmament::sky::Sky;
+use firmament::scene::Scene;
+use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, Tables};
 use firmament_gpu::lut::Precomputer;
 use firmament_gpu::{GpuContext, GpuError, GpuRenderer, GpuSky};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -209,12 +210,12 @@ impl Gpu {
 
 impl AtmosphereArgs {
     /// Model and tables (read from --tables, or computed on `backend`), paired.
-    pub fn sky_on(&self, backend: &Backend, quiet: bool) -> Result<Sky> {
+    pub fn sky_on(&self, backend: &Backend, quiet: bool) -> Result<Bruneton4d> {
         match (backend, &self.tables) {
             (Backend::Gpu(gpu), None) => {
                 let model = self.model()?;
                 let tables = gpu.tables(&model, &self.table_config()?, quiet)?;
-                Ok(Sky::new(model, tables)?)
+                Ok(Bruneton4d::new(model, tables)?)
             }
             _ => self.sky(quiet),
         }
@@ -223,10 +224,12 @@ impl AtmosphereArgs {
 
 /// A sky ready to render on a backend.
 pub enum RenderSky<'a> {
-    Cpu(Box<Sky>),
+    Cpu(Box<Bruneton4d>),
     Gpu {
         gpu: &'a Gpu,
         sky: Box<GpuSky>,
+        /// The model the sky was computed for (lights are built from it).
+        sky_model: Box<firmament::atmosphere::Model>,
         renderer: Box<GpuRenderer>,
     },
 }
@@ -240,6 +243,7 @@ impl<'a> RenderSky<'a> {
             Backend::Gpu(gpu) => gpu,
         };
         let ctx = &gpu.ctx;
+        let sky_model = atmosphere.model()?;
         let sky = match &atmosphere.tables {
             Some(_) => {
                 let cpu_sky = atmosphere.sky(quiet)?;
@@ -277,6 +281,7 @@ impl<'a> RenderSky<'a> {
         Ok(RenderSky::Gpu {
             gpu,
             sky: Box::new(sky),
+            sky_model: Box::new(sky_model),
             renderer: Box::new(renderer),
         })
     }
@@ -289,14 +294,21 @@ impl<'a> RenderSky<'a> {
         }
     }
 
-    /// Render one frame: the CPU renderer with a progress bar, or the GPU renderer.
-    pub fn render(&self, settings: &RenderSettings, quiet: bool) -> Result<Frame> {
+    /// Render one frame of the clear sky under the sun in `sun` (its disk drawn when
+    /// `sun_disk`): the CPU renderer with a progress bar, or the GPU renderer.
+    pub fn render(
+        &self,
+        settings: &RenderSettings,
+        sun: Vec3,
+        sun_disk: bool,
+        quiet: bool,
+    ) -> Result<Frame> {
         match self {
             RenderSky::Cpu(sky) => {
                 let bar = crate::common::progress_bar(1000, quiet);
                 bar.set_message("rendering");
                 let frame = firmament::render::render(
-                    sky,
+                    &Scene::clear_sky(sky.as_ref(), sun, sun_disk),
                     settings,
                     &|f| bar.set_position((f * 1000.0) as u64),
                     Some(cancel_flag()),
@@ -304,10 +316,17 @@ impl<'a> RenderSky<'a> {
                 bar.finish_and_clear();
                 Ok(frame?)
             }
-            RenderSky::Gpu { gpu, sky, renderer } => {
+            RenderSky::Gpu {
+                gpu,
+                sky,
+                sky_model,
+                renderer,
+            } => {
                 let bar = spinner("rendering on the GPU", quiet);
+                let model = sky_model.as_ref();
+                let lights = [firmament::scene::Light::sun(model, sun, sun_disk)];
                 let frame = renderer
-                    .render(&gpu.ctx, sky, settings)
+                    .render(&gpu.ctx, sky, &lights, settings)
                     .map_err(|e| gpu_failure("rendering", e));
                 bar.finish_and_clear();
                 let frame = frame?;

@@ -142,18 +142,19 @@ fn cpu_precompute(
     result: &mut serde_json::Value,
     args: &BenchArgs,
     model: &firmament::atmosphere::Model,
-    config: &firmament::lut::TableConfig,
+    config: &firmament::sky::bruneton4d::TableConfig,
 ) -> Result<()> {
     let mut stages: Vec<(String, f64)> = Vec::new();
     let precompute = time_runs(args.runs, || {
-        let _ = firmament::lut::precompute::precompute(model, config, &|_, _| {}, None)?;
+        let _ =
+            firmament::sky::bruneton4d::precompute::precompute(model, config, &|_, _| {}, None)?;
         Ok(())
     })?;
     // Where the time goes: one more run with stage timestamps.
     {
         let last = std::sync::Mutex::new((Instant::now(), String::from("start")));
         let acc = std::sync::Mutex::new(Vec::<(String, f64)>::new());
-        firmament::lut::precompute::precompute(
+        firmament::sky::bruneton4d::precompute::precompute(
             model,
             config,
             &|stage, _| {
@@ -186,8 +187,12 @@ fn cpu_precompute(
         spectral_args.wavelengths = "spectral".into();
         let spectral_model = spectral_args.model()?;
         let times = time_runs(args.runs.min(3), || {
-            let _ =
-                firmament::lut::precompute::precompute(&spectral_model, config, &|_, _| {}, None)?;
+            let _ = firmament::sky::bruneton4d::precompute::precompute(
+                &spectral_model,
+                config,
+                &|_, _| {},
+                None,
+            )?;
             Ok(())
         })?;
         result["cpu_precompute_spectral_s"] = json!(median(times));

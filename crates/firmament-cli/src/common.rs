@@ -9,8 +9,9 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use clap::Args;
 use firmament::atmosphere::{Atmosphere, Model};
-use firmament::lut::{self, MieStorage, TableConfig, TableSizes, Tables};
-use firmament::sky::Sky;
+use firmament::sky::bruneton4d::{
+    self as lut, Bruneton4d, MieStorage, TableConfig, TableSizes, Tables,
+};
 use firmament::spectrum::Wavelengths;
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -102,7 +103,7 @@ impl AtmosphereArgs {
     }
 
     /// Model and tables (read from --tables, or computed), paired.
-    pub fn sky(&self, quiet: bool) -> Result<Sky> {
+    pub fn sky(&self, quiet: bool) -> Result<Bruneton4d> {
         let model = self.model()?;
         let tables = match &self.tables {
             Some(path) => {
@@ -112,7 +113,7 @@ impl AtmosphereArgs {
             }
             None => compute_tables(&model, &self.table_config()?, quiet)?,
         };
-        Ok(Sky::new(model, tables)?)
+        Ok(Bruneton4d::new(model, tables)?)
     }
 }
 

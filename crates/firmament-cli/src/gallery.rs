@@ -7,7 +7,8 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use firmament::render::{camera::orbit_fit_fov_deg, Camera, Projection, Scene};
+use firmament::scene::camera::orbit_fit_fov_deg;
+use firmament::scene::{Camera, Projection, SceneFile as Scene};
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
 use crate::render::{atmosphere_args, render_scene, write_outputs};

@@ -94,8 +94,13 @@ pub fn extend(
     let camera = render_bench::camera_1080p();
     let settings = render_bench::settings(&camera, 1920, 1080);
     step(&format!("1920×1080 frame, 1 + {runs} frames"));
+    let lights = [firmament::scene::Light::sun(
+        &model,
+        render_bench::sun(),
+        true,
+    )];
     let timing = renderer
-        .time_render(ctx, &sky, &settings, runs)
+        .time_render(ctx, &sky, &lights, &settings, runs)
         .map_err(|e| gpu_failure("timing frames", e))?;
     result["gpu_frame_1080p_perspective_s"] = json!(timing.seconds);
     result["gpu_frame_timing_method"] = json!(format!(
@@ -105,7 +110,7 @@ pub fn extend(
     step("1920×1080 frame with readback");
     let times = time_runs(runs, || {
         let frame = renderer
-            .render(ctx, &sky, &settings)
+            .render(ctx, &sky, &lights, &settings)
             .map_err(|e| gpu_failure("rendering", e))?;
         let _ = frame.to_srgb8(1e-4, firmament::render::ToneCurve::Aces);
         Ok(())

@@ -112,7 +112,7 @@ fn run(cli: Cli) -> Result<()> {
                 backend::Backend::Cpu => common::compute_tables(&model, &config, false)?,
                 backend::Backend::Gpu(gpu) => gpu.tables(&model, &config, false)?,
             };
-            firmament::lut::file::write(&tables, &out)?;
+            firmament::sky::bruneton4d::file::write(&tables, &out)?;
             eprintln!("wrote {}", out.display());
         }
         Command::Bench(args) => bench::run(&args)?,

@@ -2,7 +2,9 @@
 
 use anyhow::Result;
 use clap::Args;
-use firmament::geometry::direction_from_zenith_azimuth;
+use firmament::math::{direction_from_zenith_azimuth, Vec3};
+use firmament::scene::Light;
+use firmament::sky::{Shadow, SkyMethod};
 use firmament::spectrum::{spectrum_to_xyz, xyz_to_linear_srgb};
 use serde_json::json;
 
@@ -125,8 +127,8 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
     let nm = model.wavelengths.nm().to_vec();
     let n = nm.len();
 
-    let camera = [0.0, 0.0, model.bottom_radius_m + args.altitude_m];
-    let up = [0.0, 0.0, 1.0];
+    let camera = Vec3::new(0.0, 0.0, model.bottom_radius_m + args.altitude_m);
+    let up = Vec3::Z;
     let sun = direction_from_zenith_azimuth(
         args.sun_zenith_deg.to_radians(),
         args.sun_azimuth_deg.to_radians(),
@@ -135,10 +137,12 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
     let depths = model.optical_depths_vertical(args.altitude_m);
     let e_toa = model.solar_irradiance.clone();
     let mut sun_t = vec![0.0; n];
-    sky.transmittance_to_sun(camera, sun, &mut sun_t);
+    let light = Light::sun(model, sun, false);
+    let view = sky.view(camera, &light);
+    view.transmittance_to_light(camera, &mut sun_t);
     let (mut e_sun, mut e_sky) = (vec![0.0; n], vec![0.0; n]);
     if args.altitude_m <= model.height_m() {
-        sky.sun_and_sky_irradiance(camera, up, sun, &mut e_sun, &mut e_sky);
+        view.sun_and_sky_irradiance(camera, up, &mut e_sun, &mut e_sky);
     } else {
         // In space: the direct beam only (no sky below a horizontal surface facing up).
         let cos = sun[2].max(0.0);
@@ -152,7 +156,7 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
     for (i, &(z, a)) in views.iter().enumerate() {
         let dir = direction_from_zenith_azimuth(z.to_radians(), a.to_radians());
         let (mut radiance, mut t) = (vec![0.0; n], vec![0.0; n]);
-        sky.sky_radiance(camera, dir, 0.0, sun, &mut radiance, &mut t);
+        view.sky_radiance(dir, Shadow::None, &mut radiance, &mut t);
         let estimate = reference.as_ref().map(|settings| {
             let e = reference::sky_radiance_keyed(model, camera, dir, sun, settings, i as u64);
             radiance.copy_from_slice(&e.radiance);

@@ -6,15 +6,10 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use clap::Args;
 use firmament::atmosphere::Model;
-use firmament::geometry::{add_scaled, dot, length, ray_sphere, Vec3};
-use firmament::io::ImageRgbF32;
 use firmament::io::{self, ExrPrecision, OutputFormat};
 use firmament::reference::{self, ReferenceSettings};
-use firmament::render::ColourMatrix;
-use firmament::render::{
-    self, tonemap, Projection, RenderSettings, Scene, ShadeOptions, ToneCurve,
-};
-use firmament::sky::{disk_solid_angle_weighted, limb_darkening};
+use firmament::render::{self, tonemap, RenderSettings, ToneCurve};
+use firmament::scene::{sun_direction, Light, Projection, SceneFile as Scene};
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
 use crate::common::{cancel_flag, check_output_dir, progress_bar, AtmosphereArgs};
@@ -167,7 +162,7 @@ pub fn scene_from_args(args: &RenderArgs) -> Result<Scene> {
         && args.fov_deg.is_none()
         && args.scene.is_none()
     {
-        scene.camera.fov_deg = render::camera::orbit_fit_fov_deg(
+        scene.camera.fov_deg = firmament::scene::camera::orbit_fit_fov_deg(
             6_360_000.0 * 1.01,
             6_360_000.0 + scene.camera.altitude_m,
         );
@@ -232,13 +227,12 @@ pub fn render_scene(sky: &RenderSky, scene: &Scene, quiet: bool) -> Result<(rend
         camera: &scene.camera,
         width: scene.image.width,
         height: scene.image.height,
-        shade: ShadeOptions {
-            sun: render::sun_direction(scene.sun.zenith_deg, scene.sun.azimuth_deg),
-            sun_disk: scene.sun.disk,
-        },
         white_balance: scene.output.white_balance,
     };
-    let frame = sky.render(&settings, quiet).context("rendering")?;
+    let sun = sun_direction(scene.sun.zenith_deg, scene.sun.azimuth_deg);
+    let frame = sky
+        .render(&settings, sun, scene.sun.disk, quiet)
+        .context("rendering")?;
     let ev100 = scene
         .output
         .ev100
@@ -284,152 +278,51 @@ pub fn write_outputs(
     Ok(())
 }
 
-/// Render the scene with the Monte Carlo reference (ground included, sun disk added with the
-/// transmittance along the view); returns the frame and the EV100 used. Checks Ctrl-C
-/// between batches of pixels.
+/// Render the scene with the Monte Carlo reference (`reference::render_frame`); returns the
+/// frame and the EV100 used. Ctrl-C stops it between batches of pixels.
 pub fn render_scene_reference(
     model: &Model,
     scene: &Scene,
     samples: usize,
     quiet: bool,
 ) -> Result<(render::Frame, f64)> {
-    let (w, h) = (scene.image.width, scene.image.height);
-    if w == 0 || h == 0 || w > 32768 || h > 32768 {
-        anyhow::bail!("invalid image size {w}×{h} (accepted: 1 to 32768 pixels each)");
-    }
-    scene.camera.validate()?;
-    if scene.camera.projection == Projection::Cubemap && w != 6 * h {
-        anyhow::bail!(
-            "invalid value for `--width`: {w} (accepted: 6 × height ({}) for a cube map)",
-            6 * h
-        );
-    }
-    let settings = ReferenceSettings {
-        samples,
-        include_ground: true,
-        ..Default::default()
-    };
     if samples < 2 {
         anyhow::bail!("invalid value for `--samples`: {samples} (accepted: an integer ≥ 2)");
     }
-    settings.validate()?;
-    let sun = render::sun_direction(scene.sun.zenith_deg, scene.sun.azimuth_deg);
-    let mut pixels = Vec::new();
-    let mut rays = Vec::new();
-    for y in 0..h {
-        for x in 0..w {
-            if let Some(ray) =
-                scene
-                    .camera
-                    .ray(model.bottom_radius_m, w, h, x as f64 + 0.5, y as f64 + 0.5)
-            {
-                pixels.push(y * w + x);
-                rays.push((ray.origin, ray.dir));
-            }
-        }
-    }
-    let bar = progress_bar(rays.len() as u64, quiet);
-    bar.set_message(format!("reference, {samples} paths/λ"));
-    let cancel = cancel_flag();
-    let batch = (4 * w).clamp(256, 16_384);
-    let mut estimates = Vec::with_capacity(rays.len());
-    for (b, chunk) in rays.chunks(batch).enumerate() {
-        if cancel.load(std::sync::atomic::Ordering::Relaxed) {
-            bar.finish_and_clear();
-            anyhow::bail!("interrupted");
-        }
-        estimates.extend(reference::render_pixels_from(
-            model,
-            chunk,
-            (b * batch) as u64,
-            sun,
-            &settings,
-            &|| bar.inc(1),
-        ));
-    }
-    bar.finish_and_clear();
-    if cancel.load(std::sync::atomic::Ordering::Relaxed) {
-        anyhow::bail!("interrupted");
-    }
-    let colour = ColourMatrix::new(model.wavelengths.nm());
-    let balance = if scene.output.white_balance {
-        let c = colour.to_srgb(&model.solar_irradiance);
-        let y = colour.to_xyz(&model.solar_irradiance)[1];
-        c.map(|c| if c > 0.0 { y / c } else { 1.0 })
-    } else {
-        [1.0; 3]
+    let settings = RenderSettings {
+        camera: &scene.camera,
+        width: scene.image.width,
+        height: scene.image.height,
+        white_balance: scene.output.white_balance,
     };
-    let mut image = ImageRgbF32::new(w, h);
-    let mut mask = vec![false; w * h];
-    let mut stderr_sum = 0.0;
-    let mut stderr_count = 0usize;
-    for ((&p, &(origin, dir)), e) in pixels.iter().zip(&rays).zip(&estimates) {
-        let mut l = e.radiance.clone();
-        if scene.sun.disk {
-            add_sun_disk_reference(model, origin, dir, sun, &mut l);
-        }
-        let (y, se) = e.luminance(model.wavelengths.nm());
-        if y > 0.0 {
-            stderr_sum += se / y;
-            stderr_count += 1;
-        }
-        let c = colour.to_srgb(&l);
-        image.data[p] = [
-            (c[0] * balance[0]) as f32,
-            (c[1] * balance[1]) as f32,
-            (c[2] * balance[2]) as f32,
-        ];
-        mask[p] = true;
-    }
-    if !quiet && stderr_count > 0 {
+    let sun = Light::sun(
+        model,
+        sun_direction(scene.sun.zenith_deg, scene.sun.azimuth_deg),
+        scene.sun.disk,
+    );
+    let bar = progress_bar(1000, quiet);
+    bar.set_message(format!("reference, {samples} paths/λ"));
+    let result = reference::render_frame(
+        model,
+        &settings,
+        &sun,
+        &ReferenceSettings::with_samples(samples),
+        &|f| bar.set_position((f * 1000.0) as u64),
+        Some(cancel_flag()),
+    );
+    bar.finish_and_clear();
+    let (frame, mean_stderr) = result?;
+    if !quiet && mean_stderr > 0.0 {
         eprintln!(
             "reference: mean relative standard error of pixel luminance {:.2}% ({samples} paths/λ)",
-            100.0 * stderr_sum / stderr_count as f64
+            100.0 * mean_stderr
         );
     }
-    let frame = render::Frame { image, mask };
     let ev100 = scene
         .output
         .ev100
         .unwrap_or_else(|| tonemap::auto_ev100(frame.log_average_luminance()));
     Ok((frame, ev100))
-}
-
-/// Adds the limb-darkened solar disk when `dir` falls inside it and the ray does not hit the
-/// ground, attenuated by the transmittance along the view (as `render::add_sun_disk`, with
-/// the transmittance from the model's column integrals instead of the tables).
-fn add_sun_disk_reference(model: &Model, origin: Vec3, dir: Vec3, sun: Vec3, out: &mut [f64]) {
-    let alpha = model.sun_angular_radius_rad;
-    let cos_angle = dot(dir, sun).clamp(-1.0, 1.0);
-    if cos_angle <= alpha.cos() {
-        return;
-    }
-    if ray_sphere(origin, dir, model.bottom_radius_m).is_some_and(|(near, _)| near > 0.0) {
-        return;
-    }
-    let n = out.len();
-    let mut transmittance = vec![1.0; n];
-    if let Some((near, far)) = ray_sphere(origin, dir, model.top_radius_m) {
-        if far > 0.0 {
-            let start = near.max(0.0);
-            let p = add_scaled(origin, start, dir);
-            let r = length(p);
-            let mu = (dot(p, dir) / r).clamp(-1.0, 1.0);
-            let tau = model.optical_depth_along_ray(r, mu, far - start);
-            for k in 0..n {
-                transmittance[k] = (-tau[k]).exp();
-            }
-        }
-    }
-    let angle = cos_angle.acos();
-    let x = angle.sin() / alpha.sin();
-    let mu = (1.0 - x * x).max(0.0).sqrt();
-    for k in 0..n {
-        let lambda = model.wavelengths.nm()[k];
-        let centre = model.solar_irradiance[k]
-            / disk_solid_angle_weighted(alpha, model.limb_darkening, lambda);
-        out[k] += centre * limb_darkening(model.limb_darkening, mu, lambda) * transmittance[k];
-    }
 }
 
 /// Run `firmament render`.

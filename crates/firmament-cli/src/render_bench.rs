@@ -3,8 +3,10 @@
 use std::time::Instant;
 
 use anyhow::Result;
-use firmament::render::{self, Camera, Projection, RenderSettings, ShadeOptions};
-use firmament::sky::Sky;
+use firmament::math::Vec3;
+use firmament::render::{self, RenderSettings};
+use firmament::scene::{sun_direction, Camera, Projection, Scene};
+use firmament::sky::bruneton4d::Bruneton4d;
 use serde_json::json;
 
 use crate::bench::{median, BenchArgs};
@@ -27,27 +29,39 @@ pub fn camera_1080p() -> Camera {
     camera(Projection::Perspective, 1500.0, 20.0)
 }
 
-/// Settings of every benchmark frame: sun 60° from the zenith at azimuth 200°, disk drawn.
+/// Settings of every benchmark frame.
 pub fn settings(camera: &Camera, width: usize, height: usize) -> RenderSettings<'_> {
     RenderSettings {
         camera,
         width,
         height,
-        shade: ShadeOptions {
-            sun: render::sun_direction(60.0, 200.0),
-            sun_disk: true,
-        },
         white_balance: false,
     }
 }
 
+/// The sun of every benchmark frame: 60° from the zenith at azimuth 200°, disk drawn.
+pub fn sun() -> Vec3 {
+    sun_direction(60.0, 200.0)
+}
+
 /// Time one kind of frame.
-fn frame(sky: &Sky, camera: Camera, width: usize, height: usize, runs: usize) -> Result<f64> {
+fn frame(
+    sky: &Bruneton4d,
+    camera: Camera,
+    width: usize,
+    height: usize,
+    runs: usize,
+) -> Result<f64> {
     let settings = settings(&camera, width, height);
     let mut times = Vec::new();
     for _ in 0..runs.max(1) {
         let t = Instant::now();
-        let f = render::render(sky, &settings, &|_| {}, None)?;
+        let f = render::render(
+            &Scene::clear_sky(sky, sun(), true),
+            &settings,
+            &|_| {},
+            None,
+        )?;
         let _ = f.to_srgb8(1e-4, render::ToneCurve::Aces);
         times.push(t.elapsed().as_secs_f64());
     }

@@ -30,10 +30,13 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use clap::Args;
 use firmament::atmosphere::Model;
-use firmament::geometry::{cross, direction_from_zenith_azimuth, dot, normalize, ray_sphere, Vec3};
+use firmament::math::sphere::ray_sphere;
+use firmament::math::{direction_from_zenith_azimuth, Vec3};
 use firmament::reference::{self, RadianceEstimate, ReferenceSettings};
-use firmament::render::ColourMatrix;
-use firmament::sky::Sky;
+use firmament::scene::Light;
+use firmament::sky::bruneton4d::Bruneton4d;
+use firmament::sky::{Shadow, SkyMethod};
+use firmament::spectrum::ColourMatrix;
 use rayon::prelude::*;
 use serde_json::{json, Value};
 
@@ -121,7 +124,7 @@ struct View {
 }
 
 fn view_from_dir(dir: Vec3, sun: Vec3) -> View {
-    let dir = normalize(dir);
+    let dir = dir.normalize_or_zero();
     let elevation = dir[2].clamp(-1.0, 1.0).asin().to_degrees();
     // Sun at azimuth 0 (north = +y, east = +x).
     let azimuth = dir[0].atan2(dir[1]).to_degrees().abs();
@@ -132,7 +135,7 @@ fn view_from_dir(dir: Vec3, sun: Vec3) -> View {
         } else {
             azimuth
         },
-        sun_distance_deg: dot(dir, sun).clamp(-1.0, 1.0).acos().to_degrees(),
+        sun_distance_deg: dir.dot(sun).clamp(-1.0, 1.0).acos().to_degrees(),
         dir,
     }
 }
@@ -152,7 +155,7 @@ fn dip_deg(r: f64, radius: f64) -> Option<f64> {
 /// The documented view set (module documentation), or the reduced one of `--quick`.
 fn views(model: &Model, altitude_m: f64, sun: Vec3, quick: bool) -> (Vec<View>, usize) {
     let r = model.bottom_radius_m + altitude_m;
-    let camera = [0.0, 0.0, r];
+    let camera = Vec3::new(0.0, 0.0, r);
     let mut dirs: Vec<Vec3> = Vec::new();
     let (above, azimuths, rings): (&[f64], &[f64], &[f64]) = if quick {
         (
@@ -191,31 +194,25 @@ fn views(model: &Model, altitude_m: f64, sun: Vec3, quick: bool) -> (Vec<View>, 
             dirs.push(dir_from(e, a));
         }
     }
-    dirs.push([0.0, 0.0, 1.0]);
+    dirs.push(Vec3::Z);
     if altitude_m > 0.0 && !quick {
-        dirs.push([0.0, 0.0, -1.0]);
+        dirs.push(Vec3::NEG_Z);
     }
     // Rings around the sun: towards the zenith, sideways, towards the horizon.
-    let z = [0.0, 0.0, 1.0];
     let e1 = {
-        let d = dot(z, sun);
-        let v = [-d * sun[0], -d * sun[1], 1.0 - d * sun[2]];
-        if dot(v, v) < 1e-12 {
-            [0.0, 1.0, 0.0]
+        let v = Vec3::Z - Vec3::Z.dot(sun) * sun;
+        if v.dot(v) < 1e-12 {
+            Vec3::Y
         } else {
-            normalize(v)
+            v.normalize()
         }
     };
-    let e2 = cross(sun, e1);
+    let e2 = sun.cross(e1);
     for &d in rings {
         let (s, c) = d.to_radians().sin_cos();
         for phi in [0.0f64, 90.0, 180.0] {
             let (sp, cp) = phi.to_radians().sin_cos();
-            dirs.push(normalize([
-                c * sun[0] + s * (cp * e1[0] + sp * e2[0]),
-                c * sun[1] + s * (cp * e1[1] + sp * e2[1]),
-                c * sun[2] + s * (cp * e1[2] + sp * e2[2]),
-            ]));
+            dirs.push((c * sun + s * (cp * e1 + sp * e2)).normalize());
         }
     }
     let mut skipped = 0;
@@ -225,7 +222,7 @@ fn views(model: &Model, altitude_m: f64, sun: Vec3, quick: bool) -> (Vec<View>, 
         // Sun disk excluded; at the ground only views above the horizon; rays that miss
         // the atmosphere carry no light.
         let misses = !matches!(ray_sphere(camera, v.dir, model.top_radius_m), Some((_, far)) if far > 0.0)
-            || (r >= model.top_radius_m && dot(camera, v.dir) >= 0.0);
+            || (r >= model.top_radius_m && camera.dot(v.dir) >= 0.0);
         if v.sun_distance_deg < 1.0 || (altitude_m <= 0.0 && v.elevation_deg < 0.25) || misses {
             skipped += 1;
             continue;
@@ -542,7 +539,7 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
         }
     );
     for preset in &presets {
-        let skies: Vec<Sky> = orders
+        let skies: Vec<Bruneton4d> = orders
             .iter()
             .map(|&o| {
                 atmosphere_args(preset, o)
@@ -569,7 +566,7 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
             config_index += 1;
             let t0 = Instant::now();
             let sun = dir_from(elevation, 0.0);
-            let camera = [0.0, 0.0, model.bottom_radius_m + altitude];
+            let camera = Vec3::new(0.0, 0.0, model.bottom_radius_m + altitude);
             let interrupted = AtomicBool::new(false);
             let estimates: Vec<Option<RadianceEstimate>> = view_list
                 .par_iter()
@@ -605,8 +602,10 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
             for (oi, sky) in skies.iter().enumerate() {
                 let mut errors = Errors::new(n_ch);
                 let (mut l, mut t) = (vec![0.0; n_ch], vec![0.0; n_ch]);
+                let light = Light::sun(model, sun, false);
+                let view = sky.view(camera, &light);
                 for (vi, (v, e)) in view_list.iter().zip(&estimates).enumerate() {
-                    sky.sky_radiance(camera, v.dir, 0.0, sun, &mut l, &mut t);
+                    view.sky_radiance(v.dir, Shadow::None, &mut l, &mut t);
                     let (y_ref, y_se) = luminance_and_stderr(&colour, e);
                     let y_tab = colour.to_xyz(&l)[1];
                     let mut ch_err = vec![Value::Null; n_ch];

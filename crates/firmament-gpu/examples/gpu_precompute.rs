@@ -5,7 +5,7 @@
 use std::time::Instant;
 
 use firmament::atmosphere::Atmosphere;
-use firmament::lut::TableConfig;
+use firmament::sky::bruneton4d::TableConfig;
 use firmament::spectrum::Wavelengths;
 use firmament_gpu::lut::Precomputer;
 use firmament_gpu::GpuContext;

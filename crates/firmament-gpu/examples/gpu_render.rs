@@ -9,11 +9,9 @@
 use std::time::Instant;
 
 use firmament::atmosphere::Atmosphere;
-use firmament::lut::{TableConfig, Tables};
-use firmament::render::{
-    self, tonemap, Camera, Frame, Projection, RenderSettings, ShadeOptions, ToneCurve,
-};
-use firmament::sky::Sky;
+use firmament::render::{self, tonemap, Frame, RenderSettings, ToneCurve};
+use firmament::scene::{sun_direction, Camera, Projection, Scene};
+use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, Tables};
 use firmament::spectrum::Wavelengths;
 use firmament_gpu::{GpuContext, GpuRenderer, GpuSky};
 
@@ -44,7 +42,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "CPU tables (default sizes): {:.1} s",
         start.elapsed().as_secs_f64()
     );
-    let sky = Sky::new(model, tables)?;
+    let sky = Bruneton4d::new(model, tables)?;
 
     let ctx = GpuContext::new()?;
     println!(
@@ -78,14 +76,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         camera: &camera,
         width,
         height,
-        shade: ShadeOptions {
-            sun: render::sun_direction(60.0, 200.0),
-            sun_disk: true,
-        },
         white_balance: false,
     };
+    let scene = Scene::clear_sky(&sky, sun_direction(60.0, 200.0), true);
 
-    let timing = renderer.time_render(&ctx, &gpu_sky, &settings, 5)?;
+    let timing = renderer.time_render(&ctx, &gpu_sky, &scene.lights, &settings, 5)?;
     println!(
         "{width}×{height} render dispatch: median {:.2} ms over {} frames ({})",
         timing.seconds * 1e3,
@@ -93,13 +88,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         timing.method
     );
     let start = Instant::now();
-    let gpu = renderer.render(&ctx, &gpu_sky, &settings)?;
+    let gpu = renderer.render(&ctx, &gpu_sky, &scene.lights, &settings)?;
     println!(
         "{width}×{height} frame with readback: {:.2} ms",
         start.elapsed().as_secs_f64() * 1e3
     );
     let start = Instant::now();
-    let cpu = render::render(&sky, &settings, &|_| {}, None)?;
+    let cpu = render::render(&scene, &settings, &|_| {}, None)?;
     println!(
         "{width}×{height} CPU frame: {:.2} ms",
         start.elapsed().as_secs_f64() * 1e3

@@ -1,11 +1,11 @@
 //! firmament's wgpu backend: the precomputed tables of Bruneton & Neyret 2008 (as refined in
 //! Bruneton 2017) computed by compute shaders, in the same sizes and texel layout as the CPU
-//! path ([`firmament::lut`]), so the two compare texel by texel and share the table file
+//! path ([`firmament::sky::bruneton4d`]), so the two compare texel by texel and share the table file
 //! format.
 //!
 //! ```no_run
 //! use firmament::atmosphere::Atmosphere;
-//! use firmament::lut::TableConfig;
+//! use firmament::sky::bruneton4d::TableConfig;
 //! use firmament::spectrum::Wavelengths;
 //!
 //! let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
@@ -16,7 +16,7 @@
 //! ```
 //!
 //! Frames render on the GPU too ([`render`]): [`GpuSky`] holds the tables (uploaded from a
-//! CPU [`firmament::sky::Sky`], or precomputed and kept on the device with
+//! CPU [`firmament::sky::Bruneton4d`], or precomputed and kept on the device with
 //! [`GpuSky::precompute`]), [`GpuRenderer::render`] returns the CPU renderer's
 //! [`firmament::render::Frame`] for the same settings, and [`GpuRenderer::time_render`]
 //! times the dispatch alone.

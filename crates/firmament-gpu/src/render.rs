@@ -6,15 +6,15 @@
 //!
 //! ```no_run
 //! use firmament::atmosphere::Atmosphere;
-//! use firmament::lut::{TableConfig, Tables};
-//! use firmament::render::{sun_direction, Camera, Projection, RenderSettings, ShadeOptions};
-//! use firmament::sky::Sky;
+//! use firmament::render::RenderSettings;
+//! use firmament::scene::{sun_direction, Camera, Light, Projection};
+//! use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, Tables};
 //! use firmament::spectrum::Wavelengths;
 //! use firmament_gpu::{GpuContext, GpuRenderer, GpuSky};
 //!
 //! let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
 //! let tables = Tables::compute(&model, &TableConfig::default()).unwrap();
-//! let sky = Sky::new(model, tables).unwrap();
+//! let sky = Bruneton4d::new(model, tables).unwrap();
 //! let ctx = GpuContext::new().unwrap();
 //! let gpu_sky = GpuSky::from_sky(&ctx, &sky).unwrap();
 //! let renderer = GpuRenderer::new(&ctx).unwrap();
@@ -30,11 +30,11 @@
 //!     camera: &camera,
 //!     width: 512,
 //!     height: 512,
-//!     shade: ShadeOptions { sun: sun_direction(80.0, 250.0), sun_disk: true },
 //!     white_balance: false,
 //! };
-//! let frame = renderer.render(&ctx, &gpu_sky, &settings).unwrap();
-//! let timing = renderer.time_render(&ctx, &gpu_sky, &settings, 5).unwrap();
+//! let sun = [Light::sun(&sky.model, sun_direction(80.0, 250.0), true)];
+//! let frame = renderer.render(&ctx, &gpu_sky, &sun, &settings).unwrap();
+//! let timing = renderer.time_render(&ctx, &gpu_sky, &sun, &settings, 5).unwrap();
 //! println!("{:.2} ms ({})", timing.seconds * 1e3, timing.method);
 //! # let _ = frame;
 //! ```
@@ -42,13 +42,14 @@
 use std::time::Instant;
 
 use firmament::atmosphere::Model;
-use firmament::geometry::safe_sqrt;
 use firmament::io::ImageRgbF32;
-use firmament::lut::params::{scattering_uvwz, Radii};
-use firmament::lut::TableConfig;
-use firmament::lut::{MieStorage, TableSizes};
-use firmament::render::{white_balance, ColourMatrix, Frame, Projection, RenderSettings};
-use firmament::sky::{disk_solid_angle_weighted, limb_darkening_coefficients, Sky};
+use firmament::math::sphere::safe_sqrt;
+use firmament::render::{Frame, RenderSettings};
+use firmament::scene::light::{disk_solid_angle_weighted, limb_darkening_coefficients};
+use firmament::scene::{Light, Projection};
+use firmament::sky::bruneton4d::params::{scattering_uvwz, Radii};
+use firmament::sky::bruneton4d::{Bruneton4d, MieStorage, TableConfig, TableSizes};
+use firmament::spectrum::ColourMatrix;
 
 use crate::lut::atmosphere::{self, groups, ScatteringGroups, GROUP};
 use crate::lut::passes::{init, workgroups, Pass, Slot};
@@ -132,7 +133,7 @@ impl GpuSky {
     /// Upload `sky`'s tables (computed on the CPU or read from a file) and parameters.
     /// Refuses more wavelengths than the CPU renderer handles and tables larger than the
     /// device binds.
-    pub fn from_sky(ctx: &GpuContext, sky: &Sky) -> Result<GpuSky, GpuError> {
+    pub fn from_sky(ctx: &GpuContext, sky: &Bruneton4d) -> Result<GpuSky, GpuError> {
         let model = &sky.model;
         let tables = &sky.tables;
         let n = sky.channels();
@@ -148,7 +149,7 @@ impl GpuSky {
         let red_only = tables.config.mie == MieStorage::RedOnly;
         let transmittance = pad_channels(&tables.optical_depth.data, n, g);
         let irradiance = pad_channels(&tables.irradiance.data, n, g);
-        let scattering = pad_channels(&tables.scattering.data, n, g);
+        let scattering = pad_channels(&tables.single_rayleigh.data, n, g);
         let multiple = pad_channels(&tables.multiple.data, n, g);
         let single_mie = if red_only {
             pad_channels(&tables.single_mie.data, 1, 1)
@@ -295,7 +296,7 @@ impl GpuSky {
             },
             sizes,
             sun_angular_radius_rad: model.sun_angular_radius_rad,
-            balance: white_balance(model, &colour, true),
+            balance: colour.white_balance(&model.solar_irradiance, true),
         }
     }
 
@@ -397,9 +398,10 @@ impl GpuRenderer {
         &self,
         ctx: &GpuContext,
         sky: &GpuSky,
+        lights: &[Light],
         settings: &RenderSettings,
     ) -> Result<Frame, GpuError> {
-        let job = self.prepare(ctx, sky, settings)?;
+        let job = self.prepare(ctx, sky, lights, settings)?;
         let bytes = job.output.size();
         let staging = scoped(ctx, "frame rendering", || {
             let device = ctx.device();
@@ -442,11 +444,12 @@ impl GpuRenderer {
         &self,
         ctx: &GpuContext,
         sky: &GpuSky,
+        lights: &[Light],
         settings: &RenderSettings,
         frames: usize,
     ) -> Result<RenderTiming, GpuError> {
         let frames = frames.max(1);
-        let job = self.prepare(ctx, sky, settings)?;
+        let job = self.prepare(ctx, sky, lights, settings)?;
         let device = ctx.device();
         let timestamps = ctx.supports_timestamps();
         let wait = |during: &str| {
@@ -556,9 +559,13 @@ impl GpuRenderer {
         &self,
         ctx: &GpuContext,
         sky: &GpuSky,
+        lights: &[Light],
         settings: &RenderSettings,
     ) -> Result<Job, GpuError> {
         settings.validate()?;
+        let sun = lights.first().ok_or_else(|| {
+            firmament::Error::invalid("lights", "none", "at least one light (the sun)")
+        })?;
         let (w, h) = (settings.width, settings.height);
         let limits = ctx.limits();
         let adapter = ctx.adapter_name().to_string();
@@ -614,7 +621,7 @@ impl GpuRenderer {
             ));
         }
 
-        let constants = FrameConstants::new(sky, settings);
+        let constants = FrameConstants::new(sky, sun, settings);
         let device = ctx.device();
         scoped(ctx, "preparing the frame", || {
             let output = device.create_buffer(&wgpu::BufferDescriptor {
@@ -694,10 +701,10 @@ struct FrameConstants {
     inside: u32,
     sun_disk: u32,
     mie_layout: u32,
-    forward: [f64; 3],
-    right: [f64; 3],
-    up: [f64; 3],
-    sun: [f64; 3],
+    forward: firmament::math::Vec3,
+    right: firmament::math::Vec3,
+    up: firmament::math::Vec3,
+    sun: firmament::math::Vec3,
     sin_sun_radius: f64,
     balance: [f64; 3],
     camera_r_km: f64,
@@ -709,11 +716,11 @@ struct FrameConstants {
 }
 
 impl FrameConstants {
-    fn new(sky: &GpuSky, settings: &RenderSettings) -> FrameConstants {
+    fn new(sky: &GpuSky, light: &Light, settings: &RenderSettings) -> FrameConstants {
         let camera = settings.camera;
         let (bottom, top) = (sky.radii.bottom, sky.radii.top);
         let r = bottom + camera.altitude_m;
-        let sun = settings.shade.sun;
+        let sun = light.direction;
         let prepared = camera.prepare(bottom, settings.width, settings.height);
         let (forward, right, up) = prepared.basis();
         let inside = r <= top;
@@ -742,7 +749,7 @@ impl FrameConstants {
                 Projection::Orbit => 4,
             },
             inside: u32::from(inside),
-            sun_disk: u32::from(settings.shade.sun_disk),
+            sun_disk: u32::from(light.visible_disk),
             mie_layout: sky.mie_layout,
             forward,
             right,
@@ -766,7 +773,7 @@ impl FrameConstants {
     /// The uniform's words for the band of `rows` rows from `first_row`.
     fn words(&self, first_row: usize, rows: usize) -> Vec<u32> {
         let f = |x: f64| (x as f32).to_bits();
-        let v4 = |v: [f64; 3], w: f64| [f(v[0]), f(v[1]), f(v[2]), f(w)];
+        let v4 = |v: firmament::math::Vec3, w: f64| [f(v[0]), f(v[1]), f(v[2]), f(w)];
         let mut out = vec![
             self.width,
             self.height,
@@ -781,7 +788,7 @@ impl FrameConstants {
         out.extend(v4(self.right, 0.0));
         out.extend(v4(self.up, 0.0));
         out.extend(v4(self.sun, self.sin_sun_radius));
-        out.extend(v4(self.balance, 1.0));
+        out.extend(v4(firmament::math::Vec3::from_array(self.balance), 1.0));
         out.extend([
             f(self.camera_r_km),
             f(self.camera_rho_km),

@@ -5,7 +5,7 @@
 use std::sync::{Mutex, OnceLock};
 
 use firmament::atmosphere::{Atmosphere, Model};
-use firmament::lut::{MieStorage, Table4, TableConfig, TableSizes, Tables};
+use firmament::sky::bruneton4d::{MieStorage, Table4, TableConfig, TableSizes, Tables};
 use firmament::spectrum::Wavelengths;
 use firmament_gpu::{GpuContext, GpuError};
 
@@ -172,18 +172,18 @@ fn check_layout(cpu: &Tables, gpu: &Tables) {
     );
     assert_eq!(
         (
-            cpu.scattering.nr,
-            cpu.scattering.nmu,
-            cpu.scattering.nmu_s,
-            cpu.scattering.nnu,
-            cpu.scattering.channels
+            cpu.single_rayleigh.nr,
+            cpu.single_rayleigh.nmu,
+            cpu.single_rayleigh.nmu_s,
+            cpu.single_rayleigh.nnu,
+            cpu.single_rayleigh.channels
         ),
         (
-            gpu.scattering.nr,
-            gpu.scattering.nmu,
-            gpu.scattering.nmu_s,
-            gpu.scattering.nnu,
-            gpu.scattering.channels
+            gpu.single_rayleigh.nr,
+            gpu.single_rayleigh.nmu,
+            gpu.single_rayleigh.nmu_s,
+            gpu.single_rayleigh.nnu,
+            gpu.single_rayleigh.channels
         )
     );
     assert_eq!(cpu.single_mie.channels, gpu.single_mie.channels);
@@ -243,7 +243,12 @@ fn transmittance_and_single_scattering_match_the_cpu() {
         &gpu.transmittance.data,
         1e-3,
     );
-    assert_scattering_within("single rayleigh", &cpu.scattering, &gpu.scattering, 1e-2);
+    assert_scattering_within(
+        "single rayleigh",
+        &cpu.single_rayleigh,
+        &gpu.single_rayleigh,
+        1e-2,
+    );
     assert_scattering_within("single mie", &cpu.single_mie, &gpu.single_mie, 1e-2);
     // Orders = 1: no indirect irradiance and no multiple scattering on either side.
     assert!(gpu.irradiance.data.iter().all(|&v| v == 0.0));
@@ -276,7 +281,12 @@ fn all_orders_match_the_cpu() {
         &gpu.irradiance.data,
         1e-2,
     );
-    assert_scattering_within("single rayleigh", &cpu.scattering, &gpu.scattering, 1e-2);
+    assert_scattering_within(
+        "single rayleigh",
+        &cpu.single_rayleigh,
+        &gpu.single_rayleigh,
+        1e-2,
+    );
     assert_scattering_within(
         "multiple (orders 2-4 + tail)",
         &cpu.multiple,
@@ -317,7 +327,12 @@ fn channel_groups_and_red_only_mie_match_the_cpu() {
         &gpu.irradiance.data,
         1e-2,
     );
-    assert_scattering_within("single molecular", &cpu.scattering, &gpu.scattering, 1e-2);
+    assert_scattering_within(
+        "single molecular",
+        &cpu.single_rayleigh,
+        &gpu.single_rayleigh,
+        1e-2,
+    );
     assert_scattering_within("multiple (order 2)", &cpu.multiple, &gpu.multiple, 1e-2);
     assert_scattering_within(
         "single mie (red only)",

@@ -12,13 +12,11 @@
 use std::sync::{Mutex, OnceLock};
 
 use firmament::atmosphere::Atmosphere;
-use firmament::geometry::{cross, dot, length, Vec3};
-use firmament::lut::{MieStorage, TableConfig, TableSizes, Tables};
-use firmament::render::camera::orbit_fit_fov_deg;
-use firmament::render::{
-    render, sun_direction, Camera, Frame, Projection, RenderSettings, ShadeOptions,
-};
-use firmament::sky::Sky;
+use firmament::math::Vec3;
+use firmament::render::{render, Frame, RenderSettings};
+use firmament::scene::camera::orbit_fit_fov_deg;
+use firmament::scene::{sun_direction, Camera, Light, Projection, Scene};
+use firmament::sky::bruneton4d::{Bruneton4d, MieStorage, TableConfig, TableSizes, Tables};
 use firmament::spectrum::Wavelengths;
 use firmament_gpu::{GpuContext, GpuError, GpuRenderer, GpuSky};
 
@@ -56,7 +54,7 @@ fn serial() -> std::sync::MutexGuard<'static, ()> {
     LOCK.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-fn sky(preset: &str, wavelengths: Wavelengths, orders: usize, mie: MieStorage) -> Sky {
+fn sky(preset: &str, wavelengths: Wavelengths, orders: usize, mie: MieStorage) -> Bruneton4d {
     let model = Atmosphere::preset(preset)
         .unwrap()
         .resolve(&wavelengths)
@@ -68,12 +66,12 @@ fn sky(preset: &str, wavelengths: Wavelengths, orders: usize, mie: MieStorage) -
         order_tail: true,
     };
     let tables = Tables::compute(&model, &config).unwrap();
-    Sky::new(model, tables).unwrap()
+    Bruneton4d::new(model, tables).unwrap()
 }
 
 /// The earth preset in RGB with 4 orders, computed once for the RGB scenes.
-fn earth_rgb() -> &'static Sky {
-    static SKY: OnceLock<Sky> = OnceLock::new();
+fn earth_rgb() -> &'static Bruneton4d {
+    static SKY: OnceLock<Bruneton4d> = OnceLock::new();
     SKY.get_or_init(|| sky("earth", Wavelengths::rgb(), 4, MieStorage::Separate))
 }
 
@@ -93,7 +91,7 @@ fn luminance(p: &[f32; 3]) -> f64 {
 }
 
 fn angle(a: Vec3, b: Vec3) -> f64 {
-    length(cross(a, b)).atan2(dot(a, b))
+    a.cross(b).length().atan2(a.dot(b))
 }
 
 struct Parity {
@@ -104,18 +102,29 @@ struct Parity {
 }
 
 /// Render `settings` on both sides and compare as the file header says.
-fn compare(name: &str, sky: &Sky, settings: &RenderSettings) -> Option<Parity> {
+fn compare(
+    name: &str,
+    sky: &Bruneton4d,
+    settings: &RenderSettings,
+    sun: Vec3,
+    sun_disk: bool,
+) -> Option<Parity> {
     let gpu = gpu()?;
     let _guard = serial();
-    let cpu_frame = render(sky, settings, &|_| {}, None).unwrap();
+    let scene = Scene::clear_sky(sky, sun, sun_disk);
+    let cpu_frame = render(&scene, settings, &|_| {}, None).unwrap();
     let gpu_sky = GpuSky::from_sky(&gpu.ctx, sky).unwrap();
     let start = std::time::Instant::now();
-    let gpu_frame = gpu.renderer.render(&gpu.ctx, &gpu_sky, settings).unwrap();
+    let gpu_frame = gpu
+        .renderer
+        .render(&gpu.ctx, &gpu_sky, &scene.lights, settings)
+        .unwrap();
     let gpu_seconds = start.elapsed().as_secs_f64();
     Some(measure(
         name,
         sky,
         settings,
+        &scene.lights[0],
         &cpu_frame,
         &gpu_frame,
         gpu_seconds,
@@ -124,8 +133,9 @@ fn compare(name: &str, sky: &Sky, settings: &RenderSettings) -> Option<Parity> {
 
 fn measure(
     name: &str,
-    sky: &Sky,
+    sky: &Bruneton4d,
     settings: &RenderSettings,
+    sun: &Light,
     cpu: &Frame,
     gpu: &Frame,
     gpu_seconds: f64,
@@ -139,11 +149,10 @@ fn measure(
         .count();
     assert_eq!(mask_mismatches, 0, "{name}: projection masks differ");
     let prepared = settings.camera.prepare(sky.model.bottom_radius_m, w, h);
-    let sun = settings.shade.sun;
     let alpha = sky.model.sun_angular_radius_rad;
     // Whether pixel (x, y) lies within the footprint margin of the sun disk's edge.
     let near_disk_edge = |x: usize, y: usize| -> bool {
-        if !settings.shade.sun_disk {
+        if !sun.visible_disk {
             return false;
         }
         let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
@@ -155,7 +164,7 @@ fn measure(
             .filter_map(|(dx, dy)| prepared.ray(px + dx, py + dy))
             .map(|n| angle(n.dir, ray.dir))
             .fold(0.0, f64::max);
-        (angle(ray.dir, sun) - alpha).abs() < DISK_EDGE_FOOTPRINTS * footprint
+        (angle(ray.dir, sun.direction) - alpha).abs() < DISK_EDGE_FOOTPRINTS * footprint
     };
     let candidates: Vec<usize> = (0..w * h)
         .filter(|&i| cpu.mask[i] && !near_disk_edge(i % w, i / w))
@@ -235,8 +244,8 @@ fn assert_parity(name: &str, p: &Parity) {
     );
 }
 
-fn check(name: &str, sky: &Sky, settings: &RenderSettings) {
-    if let Some(p) = compare(name, sky, settings) {
+fn check(name: &str, sky: &Bruneton4d, settings: &RenderSettings, sun: Vec3, sun_disk: bool) {
+    if let Some(p) = compare(name, sky, settings, sun, sun_disk) {
         assert_parity(name, &p);
     }
 }
@@ -250,13 +259,15 @@ fn ground_level_perspective_at_noon_with_ground_and_sun() {
         camera: &cam,
         width: 160,
         height: 120,
-        shade: ShadeOptions {
-            sun: sun_direction(35.0, 135.0),
-            sun_disk: true,
-        },
         white_balance: false,
     };
-    check("noon perspective", earth_rgb(), &settings);
+    check(
+        "noon perspective",
+        earth_rgb(),
+        &settings,
+        sun_direction(35.0, 135.0),
+        true,
+    );
 }
 
 #[test]
@@ -268,13 +279,15 @@ fn telephoto_on_the_low_sun_shows_the_limb_darkened_disk() {
         camera: &cam,
         width: 64,
         height: 64,
-        shade: ShadeOptions {
-            sun: sun_direction(87.0, 250.0),
-            sun_disk: true,
-        },
         white_balance: true,
     };
-    check("sun disk telephoto", earth_rgb(), &settings);
+    check(
+        "sun disk telephoto",
+        earth_rgb(),
+        &settings,
+        sun_direction(87.0, 250.0),
+        true,
+    );
 }
 
 #[test]
@@ -284,13 +297,15 @@ fn sunset_fisheye() {
         camera: &cam,
         width: 128,
         height: 128,
-        shade: ShadeOptions {
-            sun: sun_direction(88.0, 270.0),
-            sun_disk: true,
-        },
         white_balance: false,
     };
-    check("sunset fisheye", earth_rgb(), &settings);
+    check(
+        "sunset fisheye",
+        earth_rgb(),
+        &settings,
+        sun_direction(88.0, 270.0),
+        true,
+    );
 }
 
 #[test]
@@ -302,13 +317,15 @@ fn twilight_from_the_ground_itself() {
         camera: &cam,
         width: 96,
         height: 96,
-        shade: ShadeOptions {
-            sun: sun_direction(96.0, 80.0),
-            sun_disk: true,
-        },
         white_balance: false,
     };
-    check("twilight fisheye at altitude 0", earth_rgb(), &settings);
+    check(
+        "twilight fisheye at altitude 0",
+        earth_rgb(),
+        &settings,
+        sun_direction(96.0, 80.0),
+        true,
+    );
 }
 
 #[test]
@@ -321,13 +338,15 @@ fn orbit_view_from_space() {
         camera: &cam,
         width: 128,
         height: 128,
-        shade: ShadeOptions {
-            sun: sun_direction(75.0, 90.0),
-            sun_disk: true,
-        },
         white_balance: false,
     };
-    check("orbit", earth_rgb(), &settings);
+    check(
+        "orbit",
+        earth_rgb(),
+        &settings,
+        sun_direction(75.0, 90.0),
+        true,
+    );
 }
 
 #[test]
@@ -338,13 +357,15 @@ fn low_orbit_perspective_at_the_limb() {
         camera: &cam,
         width: 96,
         height: 64,
-        shade: ShadeOptions {
-            sun: sun_direction(80.0, 60.0),
-            sun_disk: true,
-        },
         white_balance: false,
     };
-    check("low orbit limb", earth_rgb(), &settings);
+    check(
+        "low orbit limb",
+        earth_rgb(),
+        &settings,
+        sun_direction(80.0, 60.0),
+        true,
+    );
 }
 
 #[test]
@@ -355,13 +376,15 @@ fn spectral_equirect() {
         camera: &cam,
         width: 128,
         height: 64,
-        shade: ShadeOptions {
-            sun: sun_direction(60.0, 120.0),
-            sun_disk: true,
-        },
         white_balance: true,
     };
-    check("spectral equirect", &sky, &settings);
+    check(
+        "spectral equirect",
+        &sky,
+        &settings,
+        sun_direction(60.0, 120.0),
+        true,
+    );
 }
 
 #[test]
@@ -379,13 +402,15 @@ fn red_only_mie_cubemap_with_five_wavelengths() {
         camera: &cam,
         width: 6 * 24,
         height: 24,
-        shade: ShadeOptions {
-            sun: sun_direction(70.0, 30.0),
-            sun_disk: false,
-        },
         white_balance: false,
     };
-    check("red-only cubemap", &sky, &settings);
+    check(
+        "red-only cubemap",
+        &sky,
+        &settings,
+        sun_direction(70.0, 30.0),
+        false,
+    );
 }
 
 #[test]
@@ -400,18 +425,29 @@ fn bands_of_rows_give_the_same_frame() {
         camera: &cam,
         width: 40,
         height: 40,
-        shade: ShadeOptions {
-            sun: sun_direction(50.0, 10.0),
-            sun_disk: true,
-        },
         white_balance: false,
     };
     let gpu_sky = GpuSky::from_sky(&gpu.ctx, sky).unwrap();
-    let whole = gpu.renderer.render(&gpu.ctx, &gpu_sky, &settings).unwrap();
+    let whole = gpu
+        .renderer
+        .render(
+            &gpu.ctx,
+            &gpu_sky,
+            &[Light::sun(&sky.model, sun_direction(50.0, 10.0), true)],
+            &settings,
+        )
+        .unwrap();
     let banded = GpuRenderer::new(&gpu.ctx)
         .unwrap()
         .with_max_band_bytes(40 * 16 * 16);
-    let bands = banded.render(&gpu.ctx, &gpu_sky, &settings).unwrap();
+    let bands = banded
+        .render(
+            &gpu.ctx,
+            &gpu_sky,
+            &[Light::sun(&sky.model, sun_direction(50.0, 10.0), true)],
+            &settings,
+        )
+        .unwrap();
     assert_eq!(whole.mask, bands.mask);
     assert_eq!(whole.image.data, bands.image.data);
 }
@@ -429,14 +465,15 @@ fn oversized_frames_and_invalid_cameras_are_refused() {
             camera,
             width,
             height,
-            shade: ShadeOptions {
-                sun: sun_direction(30.0, 0.0),
-                sun_disk: true,
-            },
             white_balance: false,
         };
         gpu.renderer
-            .render(&gpu.ctx, &gpu_sky, &s)
+            .render(
+                &gpu.ctx,
+                &gpu_sky,
+                &[Light::sun(&sky.model, sun_direction(30.0, 0.0), true)],
+                &s,
+            )
             .map(|f| f.mask.iter().all(|&m| m))
     };
     // The largest frame the CPU accepts: 32768² pixels, 16 GiB of output.
@@ -459,14 +496,15 @@ fn oversized_frames_and_invalid_cameras_are_refused() {
         camera: &good,
         width: 64,
         height: 32,
-        shade: ShadeOptions {
-            sun: sun_direction(30.0, 0.0),
-            sun_disk: true,
-        },
         white_balance: false,
     };
     let e = capped
-        .render(&gpu.ctx, &gpu_sky, &s)
+        .render(
+            &gpu.ctx,
+            &gpu_sky,
+            &[Light::sun(&sky.model, sun_direction(30.0, 0.0), true)],
+            &s,
+        )
         .map(|_| ())
         .unwrap_err();
     eprintln!("{e}");
@@ -511,15 +549,21 @@ fn timing_reports_its_method() {
         camera: &cam,
         width: 64,
         height: 64,
-        shade: ShadeOptions {
-            sun: sun_direction(50.0, 10.0),
-            sun_disk: true,
-        },
         white_balance: false,
     };
     let t = gpu
         .renderer
-        .time_render(&gpu.ctx, &gpu_sky, &settings, 3)
+        .time_render(
+            &gpu.ctx,
+            &gpu_sky,
+            &[Light::sun(
+                &earth_rgb().model,
+                sun_direction(50.0, 10.0),
+                true,
+            )],
+            &settings,
+            3,
+        )
         .unwrap();
     eprintln!("64×64 fisheye: {:.3} ms ({})", t.seconds * 1e3, t.method);
     assert!(t.seconds > 0.0 && t.seconds.is_finite());
@@ -551,25 +595,23 @@ fn tables_kept_on_the_device_render_like_tables_read_back() {
     let precomputer = firmament_gpu::lut::Precomputer::new(&gpu.ctx).unwrap();
     let on_device = GpuSky::precompute(&gpu.ctx, &precomputer, &model, &config).unwrap();
     let tables = precomputer.run(&gpu.ctx, &model, &config).unwrap();
-    let read_back = GpuSky::from_sky(&gpu.ctx, &Sky::new(model, tables).unwrap()).unwrap();
+    let read_back =
+        GpuSky::from_sky(&gpu.ctx, &Bruneton4d::new(model.clone(), tables).unwrap()).unwrap();
     let cam = camera(Projection::Perspective, 300.0, 0.0, 5.0, 90.0);
     let settings = RenderSettings {
         camera: &cam,
         width: 48,
         height: 32,
-        shade: ShadeOptions {
-            sun: sun_direction(80.0, 10.0),
-            sun_disk: true,
-        },
         white_balance: true,
     };
+    let lights = [Light::sun(&model, sun_direction(80.0, 10.0), true)];
     let a = gpu
         .renderer
-        .render(&gpu.ctx, &on_device, &settings)
+        .render(&gpu.ctx, &on_device, &lights, &settings)
         .unwrap();
     let b = gpu
         .renderer
-        .render(&gpu.ctx, &read_back, &settings)
+        .render(&gpu.ctx, &read_back, &lights, &settings)
         .unwrap();
     assert_eq!(a.mask, b.mask);
     assert_eq!(a.image.data, b.image.data);

@@ -1,6 +1,6 @@
 //! Time the default precomputation (quick look; the benchmark proper is `firmament bench`).
 use firmament::atmosphere::Atmosphere;
-use firmament::lut::TableConfig;
+use firmament::sky::bruneton4d::TableConfig;
 use firmament::spectrum::Wavelengths;
 
 fn main() {
@@ -11,7 +11,7 @@ fn main() {
     };
     let model = Atmosphere::earth().resolve(&wl).unwrap();
     let t0 = std::time::Instant::now();
-    let tables = firmament::lut::precompute::precompute(
+    let tables = firmament::sky::bruneton4d::precompute::precompute(
         &model,
         &TableConfig::default(),
         &|s, f| eprintln!("{:7.3}s {:5.1}% {s}", t0.elapsed().as_secs_f64(), f * 100.0),

@@ -10,11 +10,12 @@ use std::f64::consts::PI;
 use std::time::Instant;
 
 use firmament::atmosphere::{Albedo, Atmosphere, LimbDarkening, Model, SolarSpectrum, Sun};
-use firmament::geometry::{direction_from_zenith_azimuth, Vec3};
-use firmament::lut::{MieStorage, TableConfig, TableSizes, Tables};
+use firmament::math::{direction_from_zenith_azimuth, Vec3};
 use firmament::medium::{Coefficient, Constituent, ConstituentKind, DensityProfile, PhaseFunction};
 use firmament::reference::{self, ReferenceSettings};
-use firmament::sky::Sky;
+use firmament::scene::Light;
+use firmament::sky::bruneton4d::{Bruneton4d, MieStorage, TableConfig, TableSizes, Tables};
+use firmament::sky::{Shadow, SkyMethod};
 use firmament::spectrum::Wavelengths;
 
 const R_PP: f64 = 1e12;
@@ -59,11 +60,11 @@ fn slab(tau: f64, omega: f64, phase: PhaseFunction, ground_albedo: f64) -> Model
 }
 
 fn ground() -> Vec3 {
-    [0.0, 0.0, R_PP]
+    Vec3::new(0.0, 0.0, R_PP)
 }
 
 fn top() -> Vec3 {
-    [0.0, 0.0, R_PP + H_PP]
+    Vec3::new(0.0, 0.0, R_PP + H_PP)
 }
 
 fn settings(samples: usize) -> ReferenceSettings {
@@ -198,8 +199,8 @@ fn reference_energy_is_conserved_without_absorption() {
     );
 
     let s = settings(60_000);
-    let up = reference::irradiance(&model, top(), [0.0, 0.0, -1.0], sun, &s);
-    let down = reference::irradiance(&model, ground(), [0.0, 0.0, 1.0], sun, &s);
+    let up = reference::irradiance(&model, top(), Vec3::new(0.0, 0.0, -1.0), sun, &s);
+    let down = reference::irradiance(&model, ground(), Vec3::new(0.0, 0.0, 1.0), sun, &s);
     let direct = e * mu_s * (-tau / mu_s).exp();
     let total = up.irradiance[0] + down.irradiance[0] + direct;
     let err = (up.stderr[0].powi(2) + down.stderr[0].powi(2)).sqrt();
@@ -254,7 +255,7 @@ fn reference_energy_is_conserved_without_absorption() {
 #[test]
 fn reference_matches_disort_hg_benchmark_van_de_hulst() {
     let model = slab(1.0, 1.0, PhaseFunction::HenyeyGreenstein { g: 0.75 }, 0.0);
-    let sun = [0.0, 0.0, 1.0];
+    let sun = Vec3::new(0.0, 0.0, 1.0);
     let s = settings(100_000);
     let start = Instant::now();
     // (DISORT umu, level, intensity) with umu > 0 up-welling (at the top, τ = 0) and
@@ -382,7 +383,7 @@ fn sun_at_elevation(deg: f64) -> Vec3 {
 #[test]
 fn reference_is_deterministic_given_a_seed() {
     let model = earth_rgb();
-    let camera = [0.0, 0.0, model.bottom_radius_m + 10.0];
+    let camera = Vec3::new(0.0, 0.0, model.bottom_radius_m + 10.0);
     let view = direction_from_zenith_azimuth(1.0, 2.0);
     let sun = sun_at_elevation(20.0);
     let s = ReferenceSettings {
@@ -395,7 +396,7 @@ fn reference_is_deterministic_given_a_seed() {
     assert_eq!(a, b);
     let pixels = reference::render_pixels(
         &model,
-        &[(camera, view), (camera, [0.0, 0.0, 1.0])],
+        &[(camera, view), (camera, Vec3::new(0.0, 0.0, 1.0))],
         sun,
         &s,
     );
@@ -423,11 +424,23 @@ fn reference_is_deterministic_given_a_seed() {
 fn reference_twilight_and_space_views_are_finite() {
     let model = earth_rgb();
     let rg = model.bottom_radius_m;
-    let camera = [0.0, 0.0, rg + 1.0];
+    let camera = Vec3::new(0.0, 0.0, rg + 1.0);
     let s = ReferenceSettings::with_samples(4000);
     let start = Instant::now();
-    let day = reference::sky_radiance(&model, camera, [0.0, 0.0, 1.0], sun_at_elevation(30.0), &s);
-    let dusk = reference::sky_radiance(&model, camera, [0.0, 0.0, 1.0], sun_at_elevation(-6.0), &s);
+    let day = reference::sky_radiance(
+        &model,
+        camera,
+        Vec3::new(0.0, 0.0, 1.0),
+        sun_at_elevation(30.0),
+        &s,
+    );
+    let dusk = reference::sky_radiance(
+        &model,
+        camera,
+        Vec3::new(0.0, 0.0, 1.0),
+        sun_at_elevation(-6.0),
+        &s,
+    );
     println!(
         "zenith radiance, sun 30°: {:?} ± {:?}",
         day.radiance, day.stderr
@@ -445,10 +458,10 @@ fn reference_twilight_and_space_views_are_finite() {
         );
     }
     // Camera 500 km up looking at the limb (tangent altitude 20 km), and straight up.
-    let camera = [0.0, 0.0, rg + 500_000.0];
+    let camera = Vec3::new(0.0, 0.0, rg + 500_000.0);
     let dep = ((rg + 20_000.0) / (rg + 500_000.0)).acos();
-    let limb = [dep.cos(), 0.0, -dep.sin()];
-    let sun = [1.0, 0.0, 0.0];
+    let limb = Vec3::new(dep.cos(), 0.0, -dep.sin());
+    let sun = Vec3::new(1.0, 0.0, 0.0);
     let l = reference::sky_radiance(&model, camera, limb, sun, &s);
     println!("limb from 500 km: {:?} ± {:?}", l.radiance, l.stderr);
     for k in 0..3 {
@@ -456,15 +469,15 @@ fn reference_twilight_and_space_views_are_finite() {
             l.radiance[k].is_finite() && l.radiance[k] > 0.0 && l.stderr[k] < 0.2 * l.radiance[k]
         );
     }
-    let up = reference::sky_radiance(&model, camera, [0.0, 0.0, 1.0], sun, &s);
+    let up = reference::sky_radiance(&model, camera, Vec3::new(0.0, 0.0, 1.0), sun, &s);
     assert_eq!(up.radiance, vec![0.0; 3]);
     // Far away (1e9 m), looking at the sunlit planet through the atmosphere, ground included.
-    let far = [0.0, 0.0, 1e9];
+    let far = Vec3::new(0.0, 0.0, 1e9);
     let g = reference::sky_radiance(
         &model,
         far,
-        [0.0, 0.0, -1.0],
-        [0.0, 0.0, 1.0],
+        Vec3::new(0.0, 0.0, -1.0),
+        Vec3::new(0.0, 0.0, 1.0),
         &ReferenceSettings {
             include_ground: true,
             ..s.clone()
@@ -501,7 +514,7 @@ fn reference_single_scattering_on_earth_matches_quadrature() {
         (10_000.0, -20.0, 120.0),
         (1.0, 2.0, 0.0),
     ] {
-        let camera = [0.0, 0.0, rg + alt];
+        let camera = Vec3::new(0.0, 0.0, rg + alt);
         let view = direction_from_zenith_azimuth(f64::to_radians(90.0 - elev), f64::to_radians(az));
         let want = single_scattering_quadrature(&model, camera, view, sun);
         let est = reference::sky_radiance(&model, camera, view, sun, &s);
@@ -526,7 +539,7 @@ fn reference_single_scattering_on_earth_matches_quadrature() {
 }
 
 fn single_scattering_quadrature(model: &Model, camera: Vec3, view: Vec3, sun: Vec3) -> Vec<f64> {
-    use firmament::geometry::{
+    use firmament::math::sphere::{
         distance_to_nearest_atmosphere_boundary, distance_to_top_atmosphere_boundary,
         ray_intersects_ground,
     };
@@ -542,7 +555,7 @@ fn single_scattering_quadrature(model: &Model, camera: Vec3, view: Vec3, sun: Ve
         rt,
         ray_intersects_ground(r0, mu0, rg),
     );
-    let nu = dot(view, sun);
+    let nu = view.dot(sun);
     let steps = 6000;
     let h = length / steps as f64;
     let mut tau = vec![0.0; n];
@@ -550,11 +563,7 @@ fn single_scattering_quadrature(model: &Model, camera: Vec3, view: Vec3, sun: Ve
     let mut ext = vec![0.0; n];
     let mut prev_ext = vec![0.0; n];
     let integrand_ext = |t: f64, ext: &mut [f64]| {
-        let p = [
-            camera[0] + t * view[0],
-            camera[1] + t * view[1],
-            camera[2] + t * view[2],
-        ];
+        let p = camera + t * view;
         model.extinction_into((dot(p, p).sqrt() - rg).max(0.0), ext);
     };
     integrand_ext(0.0, &mut prev_ext);
@@ -562,11 +571,7 @@ fn single_scattering_quadrature(model: &Model, camera: Vec3, view: Vec3, sun: Ve
         // Midpoint rule for the scattering integral, trapezoids for the optical depth.
         let tm = (i as f64 + 0.5) * h;
         integrand_ext(tm, &mut ext);
-        let p = [
-            camera[0] + tm * view[0],
-            camera[1] + tm * view[1],
-            camera[2] + tm * view[2],
-        ];
+        let p = camera + tm * view;
         let r = dot(p, p).sqrt();
         let mu_s = dot(p, sun) / r;
         let alt = r - rg;
@@ -619,8 +624,8 @@ fn reference_agrees_with_table_method_for_earth_daylight() {
     )
     .unwrap();
     println!("tables: {:.2} s", start.elapsed().as_secs_f64());
-    let sky = Sky::new(model.clone(), tables).unwrap();
-    let camera = [0.0, 0.0, model.bottom_radius_m + 1.0];
+    let sky = Bruneton4d::new(model.clone(), tables).unwrap();
+    let camera = Vec3::new(0.0, 0.0, model.bottom_radius_m + 1.0);
     let sun = sun_at_elevation(30.0);
     let s = ReferenceSettings::with_samples(12_000);
     let start = Instant::now();
@@ -635,7 +640,8 @@ fn reference_agrees_with_table_method_for_earth_daylight() {
         let est = reference::sky_radiance(&model, camera, view, sun, &s);
         let mut fast = [0.0; 3];
         let mut t = [0.0; 3];
-        sky.sky_radiance(camera, view, 0.0, sun, &mut fast, &mut t);
+        sky.view(camera, &Light::sun(&sky.model, sun, false))
+            .sky_radiance(view, Shadow::None, &mut fast, &mut t);
         for k in 0..3 {
             check(
                 &format!("elev {elev}° az {az}° λ {} nm", model.wavelengths.nm()[k]),
@@ -658,7 +664,7 @@ fn reference_agrees_with_table_method_for_earth_daylight() {
 #[test]
 fn reference_timing_earth_zenith_pixel() {
     let model = earth_rgb();
-    let camera = [0.0, 0.0, model.bottom_radius_m + 1.0];
+    let camera = Vec3::new(0.0, 0.0, model.bottom_radius_m + 1.0);
     let s = ReferenceSettings {
         samples: 8192,
         ..Default::default()
@@ -666,7 +672,7 @@ fn reference_timing_earth_zenith_pixel() {
     let start = Instant::now();
     let est = reference::render_pixels(
         &model,
-        &[(camera, [0.0, 0.0, 1.0])],
+        &[(camera, Vec3::new(0.0, 0.0, 1.0))],
         sun_at_elevation(30.0),
         &s,
     );

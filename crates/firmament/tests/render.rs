@@ -4,16 +4,16 @@
 use std::sync::OnceLock;
 
 use firmament::atmosphere::Atmosphere;
-use firmament::geometry::direction_from_zenith_azimuth;
-use firmament::lut::{MieStorage, TableConfig, TableSizes, Tables};
-use firmament::render::{
-    self, Camera, ColourMatrix, Projection, Ray, RenderSettings, ShadeOptions,
-};
-use firmament::sky::Sky;
-use firmament::spectrum::Wavelengths;
+use firmament::math::{direction_from_zenith_azimuth, Vec3};
+use firmament::render::{self, RenderSettings, ShadeScratch, Shader};
+use firmament::scene::camera::orbit_fit_fov_deg;
+use firmament::scene::{sun_direction, Camera, Light, Projection, Ray, Scene};
+use firmament::sky::bruneton4d::{Bruneton4d, MieStorage, TableConfig, TableSizes, Tables};
+use firmament::sky::SkyMethod;
+use firmament::spectrum::{ColourMatrix, Wavelengths};
 
-fn sky() -> &'static Sky {
-    static SKY: OnceLock<Sky> = OnceLock::new();
+fn sky() -> &'static Bruneton4d {
+    static SKY: OnceLock<Bruneton4d> = OnceLock::new();
     SKY.get_or_init(|| {
         let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
         let tables = Tables::compute(
@@ -26,7 +26,7 @@ fn sky() -> &'static Sky {
             },
         )
         .unwrap();
-        Sky::new(model, tables).unwrap()
+        Bruneton4d::new(model, tables).unwrap()
     })
 }
 
@@ -34,15 +34,14 @@ fn sky() -> &'static Sky {
 fn look(sun: (f64, f64), elevation: f64, azimuth: f64) -> [f64; 3] {
     let sky = sky();
     let ray = Ray {
-        origin: [0.0, 0.0, sky.model.bottom_radius_m + 2.0],
+        origin: Vec3::new(0.0, 0.0, sky.model.bottom_radius_m + 2.0),
         dir: direction_from_zenith_azimuth((90.0 - elevation).to_radians(), azimuth.to_radians()),
     };
-    let options = ShadeOptions {
-        sun: render::sun_direction(sun.0, sun.1),
-        sun_disk: false,
-    };
+    let scene = Scene::clear_sky(sky, sun_direction(sun.0, sun.1), false);
     let mut l = [0.0; 3];
-    render::shade(sky, &ray, &options, &mut l);
+    Shader::new(&scene, ray.origin)
+        .unwrap()
+        .shade(&ray, &mut ShadeScratch::default(), &mut l);
     ColourMatrix::new(sky.model.wavelengths.nm()).to_srgb(&l)
 }
 
@@ -110,7 +109,7 @@ fn from_orbit_the_planet_has_a_bright_limb_and_a_black_night_side() {
         heading_deg: 0.0,
         pitch_deg: 0.0,
         roll_deg: 0.0,
-        fov_deg: render::camera::orbit_fit_fov_deg(6_424_000.0, 36_360_000.0),
+        fov_deg: orbit_fit_fov_deg(6_424_000.0, 36_360_000.0),
     };
     // Sun on the horizon of the point below the camera, in the east: day on the right.
     let (w, h) = (160, 160);
@@ -118,13 +117,10 @@ fn from_orbit_the_planet_has_a_bright_limb_and_a_black_night_side() {
         camera: &camera,
         width: w,
         height: h,
-        shade: ShadeOptions {
-            sun: render::sun_direction(90.0, 90.0),
-            sun_disk: false,
-        },
         white_balance: false,
     };
-    let frame = render::render(sky, &settings, &|_| {}, None).unwrap();
+    let scene = Scene::clear_sky(sky, sun_direction(90.0, 90.0), false);
+    let frame = render::render(&scene, &settings, &|_| {}, None).unwrap();
     let y = |x: usize, row: usize| lum(frame.image.get(x, row).map(|v| v as f64));
     let row = h / 2;
     // Walk right along the middle row from the centre: lit ground, then the atmosphere's
@@ -150,10 +146,11 @@ fn from_orbit_the_planet_has_a_bright_limb_and_a_black_night_side() {
 #[test]
 fn sun_disk_integrates_to_the_solar_irradiance_times_transmittance() {
     let sky = sky();
-    let sun = [0.0, 0.0, 1.0];
-    let origin = [0.0, 0.0, sky.model.bottom_radius_m + 2.0];
+    let sun = Light::sun(&sky.model, Vec3::Z, true);
+    let origin = Vec3::new(0.0, 0.0, sky.model.bottom_radius_m + 2.0);
     let mut t = [0.0; 3];
-    sky.transmittance_to_sun(origin, sun, &mut t);
+    sky.view(origin, &sun)
+        .transmittance_to_light(origin, &mut t);
     let alpha = sky.model.sun_angular_radius_rad;
     // Integrate over a fine polar grid around the sun, out to 1.2 α.
     let (nr, nphi) = (400, 64);
@@ -164,13 +161,13 @@ fn sun_disk_integrates_to_the_solar_irradiance_times_transmittance() {
             theta.sin() * (1.2 * alpha / nr as f64) * (2.0 * std::f64::consts::PI / nphi as f64);
         for j in 0..nphi {
             let phi = j as f64 * 2.0 * std::f64::consts::PI / nphi as f64;
-            let dir = [
+            let dir = Vec3::new(
                 theta.sin() * phi.cos(),
                 theta.sin() * phi.sin(),
                 theta.cos(),
-            ];
+            );
             let mut l = [0.0; 3];
-            render::add_sun_disk(sky, dir, sun, &t, &mut l);
+            sun.add_disk_radiance(dir, &t, &mut l);
             for k in 0..3 {
                 e[k] += l[k] * d_omega;
             }
@@ -214,13 +211,10 @@ fn every_projection_renders_finite_pixels_and_hdr_files_read_back() {
             camera: &camera,
             width: w,
             height: h,
-            shade: ShadeOptions {
-                sun: render::sun_direction(40.0, 100.0),
-                sun_disk: true,
-            },
             white_balance: false,
         };
-        let frame = render::render(sky, &settings, &|_| {}, None).unwrap();
+        let scene = Scene::clear_sky(sky, sun_direction(40.0, 100.0), true);
+        let frame = render::render(&scene, &settings, &|_| {}, None).unwrap();
         assert!(
             frame
                 .image

@@ -1,8 +1,13 @@
 //! The precomputed tables against closed forms and independent quadratures.
 
 use firmament::atmosphere::Atmosphere;
-use firmament::geometry::{distance_to_top_atmosphere_boundary, safe_sqrt};
-use firmament::lut::{self, params, MieStorage, TableConfig, TableSizes, Tables};
+use firmament::math::sphere::{distance_to_top_atmosphere_boundary, safe_sqrt};
+use firmament::math::Vec3;
+use firmament::scene::Light;
+use firmament::sky::bruneton4d::{
+    self as lut, params, Bruneton4d, MieStorage, TableConfig, TableSizes, Tables,
+};
+use firmament::sky::{Shadow, SkyMethod};
 use firmament::spectrum::Wavelengths;
 
 const RG: f64 = 6_360_000.0;
@@ -203,7 +208,7 @@ fn single_scattering_matches_direct_quadrature_in_a_thin_homogeneous_atmosphere(
             sum += f(i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 };
         }
         let exact = sum * h / 3.0 * model.solar_irradiance[0];
-        let got = tables.scattering.data[tables.scattering.index(x, y, z)] as f64;
+        let got = tables.single_rayleigh.data[tables.single_rayleigh.index(x, y, z)] as f64;
         assert!(
             (got - exact).abs() / exact < 0.01,
             "texel ({x},{y},{z}) mu {mu} mu_s {mu_s}: {got} vs {exact}"
@@ -353,7 +358,7 @@ fn every_preset_precomputes_finite_non_negative_tables() {
             .unwrap();
         let t = Tables::compute(&model, &tiny(2)).unwrap();
         for table in [
-            &t.scattering.data,
+            &t.single_rayleigh.data,
             &t.single_mie.data,
             &t.irradiance.data,
             &t.transmittance.data,
@@ -366,7 +371,7 @@ fn every_preset_precomputes_finite_non_negative_tables() {
             );
         }
         assert!(
-            t.scattering.data.iter().any(|&v| v > 0.0),
+            t.single_rayleigh.data.iter().any(|&v| v > 0.0),
             "{name}: empty scattering"
         );
     }
@@ -388,14 +393,18 @@ fn red_only_mie_follows_the_ratio_rule() {
     )
     .unwrap();
     assert_eq!(red.single_mie.channels, 1);
-    let sky_full = firmament::sky::Sky::new(model.clone(), full).unwrap();
-    let sky_red = firmament::sky::Sky::new(model, red).unwrap();
-    let cam = [0.0, 0.0, RG + 10.0];
-    let sun = firmament::geometry::direction_from_zenith_azimuth(1.0, 0.0);
-    let view = firmament::geometry::direction_from_zenith_azimuth(1.2, 0.1);
+    let sky_full = Bruneton4d::new(model.clone(), full).unwrap();
+    let sky_red = Bruneton4d::new(model, red).unwrap();
+    let cam = Vec3::new(0.0, 0.0, RG + 10.0);
+    let sun = firmament::math::direction_from_zenith_azimuth(1.0, 0.0);
+    let view = firmament::math::direction_from_zenith_azimuth(1.2, 0.1);
     let (mut a, mut b, mut t) = ([0.0; 3], [0.0; 3], [0.0; 3]);
-    sky_full.sky_radiance(cam, view, 0.0, sun, &mut a, &mut t);
-    sky_red.sky_radiance(cam, view, 0.0, sun, &mut b, &mut t);
+    sky_full
+        .view(cam, &Light::sun(&sky_full.model, sun, false))
+        .sky_radiance(view, Shadow::None, &mut a, &mut t);
+    sky_red
+        .view(cam, &Light::sun(&sky_red.model, sun, false))
+        .sky_radiance(view, Shadow::None, &mut b, &mut t);
     for k in 0..3 {
         // The rule is an approximation (paper §4): a few per cent.
         assert!(
@@ -425,7 +434,7 @@ fn table_files_round_trip_and_bad_files_are_refused() {
     let t = Tables::compute(&model, &cfg).unwrap();
     let bytes = lut::file::to_bytes(&t);
     let back = lut::file::from_bytes(&bytes, "x").unwrap();
-    assert_eq!(back.scattering, t.scattering);
+    assert_eq!(back.single_rayleigh, t.single_rayleigh);
     assert_eq!(back.transmittance, t.transmittance);
     assert_eq!(back.optical_depth, t.optical_depth);
     back.check_matches(&model, "x").unwrap();
@@ -491,9 +500,7 @@ fn single_scattering_out_of_a_dense_haze_matches_brute_force_quadrature() {
 }
 
 fn single_scattering_matches_brute_force(preset: &str, elevations: &[f64], tolerance: f64) {
-    use firmament::geometry::{dot, Vec3};
-    use firmament::render::sun_direction;
-    use firmament::sky::Sky;
+    use firmament::scene::sun_direction;
     let model = Atmosphere::preset(preset)
         .unwrap()
         .resolve(&Wavelengths::rgb())
@@ -502,13 +509,13 @@ fn single_scattering_matches_brute_force(preset: &str, elevations: &[f64], toler
         orders: 1,
         ..Default::default()
     };
-    let sky = Sky::new(model.clone(), Tables::compute(&model, &config).unwrap()).unwrap();
+    let sky = Bruneton4d::new(model.clone(), Tables::compute(&model, &config).unwrap()).unwrap();
     let sun = sun_direction(30.0, 180.0);
     let r0 = model.bottom_radius_m + 1.0;
-    let camera: Vec3 = [0.0, 0.0, r0];
+    let camera: Vec3 = Vec3::new(0.0, 0.0, r0);
     for &elevation_deg in elevations {
         let view = sun_direction(90.0 - elevation_deg, 0.0);
-        let nu = dot(view, sun);
+        let nu = view.dot(sun);
         let length = distance_to_top_atmosphere_boundary(
             r0,
             elevation_deg.to_radians().sin(),
@@ -522,11 +529,11 @@ fn single_scattering_matches_brute_force(preset: &str, elevations: &[f64], toler
         while d < length {
             let h = if d < 200e3 { 10.0f64 } else { 200.0 }.min(length - d);
             let m = d + 0.5 * h;
-            let p = [view[0] * m, view[1] * m, r0 + view[2] * m];
+            let p = Vec3::new(view[0] * m, view[1] * m, r0 + view[2] * m);
             let rp = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
             let altitude = rp - model.bottom_radius_m;
             model.extinction_into(altitude, &mut extinction);
-            let mu_s = dot(p, sun) / rp;
+            let mu_s = p.dot(sun) / rp;
             let to_sun = distance_to_top_atmosphere_boundary(rp, mu_s, model.top_radius_m);
             let tau_sun = model.optical_depth_along_ray(rp, mu_s, to_sun);
             for k in 0..3 {
@@ -541,7 +548,8 @@ fn single_scattering_matches_brute_force(preset: &str, elevations: &[f64], toler
             d += h;
         }
         let (mut table, mut t) = (vec![0.0; 3], vec![0.0; 3]);
-        sky.sky_radiance(camera, view, 0.0, sun, &mut table, &mut t);
+        sky.view(camera, &Light::sun(&sky.model, sun, false))
+            .sky_radiance(view, Shadow::None, &mut table, &mut t);
         for k in 0..3 {
             let e = table[k] / brute[k] - 1.0;
             println!("{preset} elevation {elevation_deg}°, channel {k}: table/brute − 1 = {e:+.4}");

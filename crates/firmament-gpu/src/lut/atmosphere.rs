@@ -4,9 +4,9 @@
 //! in km⁻¹, computed in f64 and rounded once.
 
 use firmament::atmosphere::Model;
-use firmament::geometry::distance_to_top_atmosphere_boundary;
-use firmament::lut::TableSizes;
+use firmament::math::sphere::distance_to_top_atmosphere_boundary;
 use firmament::medium::{ConstituentKind, PhaseFunction};
+use firmament::sky::bruneton4d::TableSizes;
 
 /// Wavelengths per channel group (one vec4).
 pub const GROUP: usize = 4;

@@ -14,7 +14,7 @@ pub mod atmosphere;
 pub(crate) mod passes;
 
 use firmament::atmosphere::Model;
-use firmament::lut::{MieStorage, Table2, Table4, TableConfig, Tables};
+use firmament::sky::bruneton4d::{MieStorage, Table2, Table4, TableConfig, Tables};
 
 use crate::{GpuContext, GpuError};
 use atmosphere::{groups, ScatteringGroups, GROUP};
@@ -278,7 +278,7 @@ impl Precomputer {
             transmittance: optical_depth.transmittance_of_optical_depth(),
             optical_depth,
             irradiance,
-            scattering,
+            single_rayleigh: scattering,
             single_mie,
             order_means,
             mie_ratio: groups_info.mie_ratio(),

@@ -2,6 +2,7 @@
 //! shipped as embedded presets, validated field by field, and resolved for a wavelength
 //! grid into a [`Model`] that the tables, the renderer and the reference path tracer share.
 
+pub mod groups;
 pub mod model;
 pub mod presets;
 
@@ -9,6 +10,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+pub use groups::ScatteringGroups;
 pub use model::{Model, OpticalDepths};
 
 use crate::medium::{Constituent, ConstituentKind};

@@ -1,8 +1,11 @@
 //! An atmosphere resolved for a wavelength grid: plain per-wavelength arrays that the
 //! tables, the renderer and the reference path tracer read in their hot loops.
 
-use super::{interpolate_linear, Albedo, Atmosphere, LimbDarkening, SolarSpectrum};
-use crate::geometry;
+use super::{
+    interpolate_linear, Albedo, Atmosphere, LimbDarkening, ScatteringGroups, SolarSpectrum,
+};
+use crate::math::quadrature::GL4;
+use crate::math::sphere;
 use crate::medium::{ConstituentKind, ResolvedConstituent};
 use crate::spectrum::{self, Wavelengths};
 
@@ -29,6 +32,8 @@ pub struct Model {
     pub mu_s_min: f64,
     /// Constituents with per-wavelength coefficients at density 1.
     pub constituents: Vec<ResolvedConstituent>,
+    /// The constituents grouped as the tables store them (molecules, aerosols).
+    pub groups: ScatteringGroups,
     /// 64-bit FNV-1a hash of the parameters and the wavelengths (identifies table files).
     pub hash: u64,
 }
@@ -93,6 +98,7 @@ impl Model {
             sun_angular_radius_rad: atmosphere.sun.angular_radius_deg.to_radians(),
             limb_darkening: atmosphere.sun.limb_darkening,
             mu_s_min: (90.0 - atmosphere.min_sun_elevation_deg).to_radians().cos(),
+            groups: ScatteringGroups::new(&constituents, nm.len()),
             constituents,
             hash: 0,
         };
@@ -191,21 +197,13 @@ impl Model {
         if length_m <= 0.0 {
             return;
         }
-        const X: [f64; 4] = crate::medium::profile::GL4_NODES;
-        const W: [f64; 4] = crate::medium::profile::GL4_WEIGHTS;
-        let h = length_m / segments as f64;
-        for i in 0..segments {
-            let c = (i as f64 + 0.5) * h;
-            for k in 0..4 {
-                let d = c + 0.5 * h * X[k];
-                let radius = geometry::safe_sqrt(d * d + 2.0 * r * mu * d + r * r);
-                let alt = (radius - self.bottom_radius_m).max(0.0);
-                for (o, con) in out.iter_mut().zip(&self.constituents) {
-                    *o += W[k] * con.density.density(alt);
-                }
+        for (d, w) in GL4.composite(0.0, length_m, segments) {
+            let radius = sphere::safe_sqrt(d * d + 2.0 * r * mu * d + r * r);
+            let alt = (radius - self.bottom_radius_m).max(0.0);
+            for (o, con) in out.iter_mut().zip(&self.constituents) {
+                *o += w * con.density.density(alt);
             }
         }
-        out.iter_mut().for_each(|o| *o *= 0.5 * h);
     }
 
     /// Optical depth per wavelength from constituent columns (m), into `out`.

@@ -6,6 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::math::quadrature::GL4;
 use crate::{Error, Result};
 
 /// One layer of a density profile.
@@ -165,7 +166,7 @@ impl DensityProfile {
         edges.push(to_m);
         let mut sum = 0.0;
         for w in edges.windows(2) {
-            sum += gauss_legendre(|h| self.density(h), w[0], w[1], 64);
+            sum += GL4.integrate(w[0], w[1], 64, |h| self.density(h));
         }
         sum
     }
@@ -203,40 +204,6 @@ impl DensityProfile {
         }
         Ok(())
     }
-}
-
-/// 4-point Gauss–Legendre nodes on [−1, 1] (Abramowitz & Stegun 25.4.30).
-pub const GL4_NODES: [f64; 4] = [
-    -0.861_136_311_594_052_6,
-    -0.339_981_043_584_856_3,
-    0.339_981_043_584_856_3,
-    0.861_136_311_594_052_6,
-];
-/// 4-point Gauss–Legendre weights (Abramowitz & Stegun 25.4.30).
-pub const GL4_WEIGHTS: [f64; 4] = [
-    0.347_854_845_137_453_9,
-    0.652_145_154_862_546_1,
-    0.652_145_154_862_546_1,
-    0.347_854_845_137_453_9,
-];
-
-/// ∫_a^b f by `n`-point composite Gauss–Legendre (4 nodes per sub-interval).
-pub fn gauss_legendre(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
-    // 4-point Gauss–Legendre nodes and weights (Abramowitz & Stegun 25.4.30).
-    const X: [f64; 4] = crate::medium::profile::GL4_NODES;
-    const W: [f64; 4] = crate::medium::profile::GL4_WEIGHTS;
-    if b <= a {
-        return 0.0;
-    }
-    let h = (b - a) / n as f64;
-    let mut sum = 0.0;
-    for i in 0..n {
-        let c = a + (i as f64 + 0.5) * h;
-        for k in 0..4 {
-            sum += W[k] * f(c + 0.5 * h * X[k]);
-        }
-    }
-    sum * 0.5 * h
 }
 
 #[cfg(test)]

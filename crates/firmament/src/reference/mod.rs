@@ -14,12 +14,12 @@
 //! drawn on the sun disk (limb darkening as in the model) with a deterministically
 //! integrated transmittance (0 behind the planet). See [`tracer`] for the details.
 //!
-//! Meaning of the results (same as [`crate::sky::Sky::sky_radiance`]): the radiance that
+//! Meaning of the results (same as [`crate::sky::SkyView::sky_radiance`]): the radiance that
 //! reaches the camera along the view ray *after at least one scattering in the air*: the
 //! sun disk seen directly is excluded; light reflected by the ground and then scattered
 //! in the air is included (as in the tables' multiple scattering). With
 //! `include_ground = false` (default) a view ray that hits the ground returns only the light
-//! scattered in the air in front of the ground, like `Sky::sky_radiance`; with
+//! scattered in the air in front of the ground, like `SkyView::sky_radiance`; with
 //! `include_ground = true` the ground's own reflected radiance (sun + sky, attenuated to the
 //! camera) is added, which is what an image of the whole scene needs.
 //!
@@ -30,287 +30,43 @@
 //! Units: radiance W·m⁻²·sr⁻¹·nm⁻¹, irradiance W·m⁻²·nm⁻¹, positions planet-centred in
 //! metres, directions unit vectors (normalised here if they are not).
 
+mod render;
+mod results;
 pub mod rng;
+mod sampler;
+mod settings;
 pub mod tracer;
 
 use std::f64::consts::PI;
 
 use rayon::prelude::*;
-use serde::Serialize;
 
 use crate::atmosphere::Model;
-use crate::geometry::{dot, normalize, ray_sphere, Vec3};
-use crate::{Error, Result};
-use rng::Rng;
+use crate::math::sphere::ray_sphere;
+use crate::math::Vec3;
+pub use render::render_frame;
+pub use results::{FluxBudget, IrradianceEstimate, RadianceEstimate, Tally};
+use sampler::{estimate, Stats};
+pub use settings::ReferenceSettings;
 use tracer::{Channel, Frame, BUDGET_TALLIES};
-
-/// Samples per block: the unit of parallel work and of the fixed-order reduction.
-const BLOCK: usize = 256;
 
 /// Random-stream domains, so different estimators never share streams.
 const DOMAIN_RADIANCE: u64 = 0;
 const DOMAIN_IRRADIANCE: u64 = 0x1_0000_0000;
 const DOMAIN_BUDGET: u64 = 0x2_0000_0000;
 
-/// Settings of the reference path tracer.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct ReferenceSettings {
-    /// Paths per wavelength (per pixel). ≥ 2 (the standard error needs two).
-    pub samples: usize,
-    /// Seed of the random streams.
-    pub seed: u64,
-    /// Largest number of scattering and ground-reflection events on a path (1 = single
-    /// scattering only). Paths longer than this are cut, which biases the result low; with
-    /// Russian roulette only conservative, very thick media get near the default 100.
-    pub max_bounces: usize,
-    /// Events before Russian roulette starts (survival probability = the path weight).
-    pub roulette_after: usize,
-    /// Whether the ground seen directly by a camera ray adds its reflected radiance
-    /// (false: like `Sky::sky_radiance`; true: whole-scene images).
-    pub include_ground: bool,
-    /// Gauss–Legendre segments (4 nodes each) per smooth piece of a sun ray (between the
-    /// closest approach and the altitudes where a profile has a kink; half as many on the
-    /// pieces away from the lowest point) for the next-event transmittance.
-    pub transmittance_segments: usize,
-}
-
-impl Default for ReferenceSettings {
-    fn default() -> Self {
-        ReferenceSettings {
-            samples: 4096,
-            seed: 0,
-            max_bounces: 100,
-            roulette_after: 5,
-            include_ground: false,
-            transmittance_segments: 6,
-        }
-    }
-}
-
-impl ReferenceSettings {
-    /// Defaults with `samples` paths per wavelength.
-    pub fn with_samples(samples: usize) -> Self {
-        ReferenceSettings {
-            samples,
-            ..Default::default()
-        }
-    }
-
-    /// Check the numbers (the error names the field).
-    pub fn validate(&self) -> Result<()> {
-        if self.samples < 2 {
-            return Err(Error::invalid("samples", self.samples, "an integer ≥ 2"));
-        }
-        if self.max_bounces < 1 {
-            return Err(Error::invalid(
-                "max_bounces",
-                self.max_bounces,
-                "an integer ≥ 1",
-            ));
-        }
-        if self.transmittance_segments < 1 {
-            return Err(Error::invalid(
-                "transmittance_segments",
-                self.transmittance_segments,
-                "an integer ≥ 1",
-            ));
-        }
-        Ok(())
-    }
-}
-
-/// A Monte Carlo estimate of a spectral radiance.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct RadianceEstimate {
-    /// Mean radiance per wavelength (W·m⁻²·sr⁻¹·nm⁻¹).
-    pub radiance: Vec<f64>,
-    /// Standard error of each mean (same unit).
-    pub stderr: Vec<f64>,
-    /// Paths per wavelength.
-    pub samples: usize,
-}
-
-/// A Monte Carlo estimate of a spectral irradiance (diffuse: the direct sun beam excluded).
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct IrradianceEstimate {
-    /// Mean irradiance per wavelength (W·m⁻²·nm⁻¹).
-    pub irradiance: Vec<f64>,
-    /// Standard error of each mean.
-    pub stderr: Vec<f64>,
-    /// Paths per wavelength.
-    pub samples: usize,
-}
-
-/// A value per wavelength with its standard error.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Tally {
-    /// Mean per wavelength.
-    pub value: Vec<f64>,
-    /// Standard error per wavelength.
-    pub stderr: Vec<f64>,
-}
-
-/// Where the power of a collimated beam entering the top of the atmosphere goes, as
-/// fractions of that power, per wavelength (photons traced from the sun side).
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct FluxBudget {
-    /// Leaves through the top of the atmosphere.
-    pub reflected: Tally,
-    /// Absorbed by the ground.
-    pub ground_absorbed: Tally,
-    /// Absorbed in the air.
-    pub medium_absorbed: Tally,
-    /// Arrives at the ground without any scattering or reflection (direct beam).
-    pub ground_direct: Tally,
-    /// Arrives at the ground after at least one scattering or reflection.
-    pub ground_diffuse: Tally,
-    /// Carried by paths cut at `max_bounces` (bias).
-    pub truncated: Tally,
-    /// Photons per wavelength.
-    pub samples: usize,
-}
-
-impl RadianceEstimate {
-    /// Luminance (cd/m²) and its standard error (channels are independent).
-    pub fn luminance(&self, wavelengths_nm: &[f64]) -> (f64, f64) {
-        linear_functional(wavelengths_nm, &self.radiance, &self.stderr)
-    }
-
-    /// Largest relative standard error over the wavelengths (0 where the radiance is 0).
-    pub fn max_relative_stderr(&self) -> f64 {
-        self.radiance
-            .iter()
-            .zip(&self.stderr)
-            .map(|(v, e)| if *v > 0.0 { e / v } else { 0.0 })
-            .fold(0.0, f64::max)
-    }
-}
-
-/// Y of a spectrum and its standard error, from the CIE weights of each channel (the
-/// conversion is linear).
-fn linear_functional(wavelengths_nm: &[f64], values: &[f64], stderr: &[f64]) -> (f64, f64) {
-    let y = crate::spectrum::luminance_from_spectrum(wavelengths_nm, values);
-    let mut var = 0.0;
-    let mut unit = vec![0.0; values.len()];
-    for k in 0..values.len() {
-        unit[k] = 1.0;
-        let wk = crate::spectrum::luminance_from_spectrum(wavelengths_nm, &unit);
-        unit[k] = 0.0;
-        var += (wk * stderr[k]).powi(2);
-    }
-    (y, var.sqrt())
-}
-
-/// Running mean and variance (Welford; merged with Chan et al.'s formula).
-#[derive(Clone, Copy, Debug, Default)]
-struct Stats {
-    n: f64,
-    mean: f64,
-    m2: f64,
-}
-
-impl Stats {
-    #[inline]
-    fn push(&mut self, x: f64) {
-        self.n += 1.0;
-        let delta = x - self.mean;
-        self.mean += delta / self.n;
-        self.m2 += delta * (x - self.mean);
-    }
-
-    fn merge(self, o: Stats) -> Stats {
-        if self.n == 0.0 {
-            return o;
-        }
-        if o.n == 0.0 {
-            return self;
-        }
-        let n = self.n + o.n;
-        let delta = o.mean - self.mean;
-        Stats {
-            n,
-            mean: self.mean + delta * o.n / n,
-            m2: self.m2 + o.m2 + delta * delta * self.n * o.n / n,
-        }
-    }
-
-    fn stderr(&self) -> f64 {
-        if self.n < 2.0 {
-            f64::INFINITY
-        } else {
-            (self.m2 / (self.n - 1.0) / self.n).max(0.0).sqrt()
-        }
-    }
-}
-
-/// Runs `f` for `settings.samples` samples per wavelength; returns per-wavelength stats of
-/// each of the M tallies. Blocks of samples are run in parallel when `parallel`, and always
-/// reduced in the same order.
-fn estimate<const M: usize, F>(
-    model: &Model,
-    settings: &ReferenceSettings,
-    key: u64,
-    parallel: bool,
-    f: F,
-) -> Vec<[Stats; M]>
-where
-    F: Fn(&Channel, &mut Rng, &mut tracer::Scratch) -> [f64; M] + Sync,
-{
-    let n_ch = model.channels();
-    let samples = settings.samples;
-    let blocks = samples.div_ceil(BLOCK).max(1);
-    let channels: Vec<Channel> = (0..n_ch)
-        .map(|k| Channel::new(model, k, settings))
-        .collect();
-    let run = |job: usize| -> [Stats; M] {
-        let (k, blk) = (job / blocks, job % blocks);
-        let ch = &channels[k];
-        let mut scratch = ch.scratch();
-        let mut stats = [Stats::default(); M];
-        for i in blk * BLOCK..((blk + 1) * BLOCK).min(samples) {
-            let mut rng = Rng::for_key(settings.seed, key, k as u64, i as u64);
-            let v = f(ch, &mut rng, &mut scratch);
-            for m in 0..M {
-                stats[m].push(v[m]);
-            }
-        }
-        stats
-    };
-    let per_block: Vec<[Stats; M]> = if parallel {
-        (0..n_ch * blocks).into_par_iter().map(run).collect()
-    } else {
-        (0..n_ch * blocks).map(run).collect()
-    };
-    (0..n_ch)
-        .map(|k| {
-            let mut acc = [Stats::default(); M];
-            for blk in 0..blocks {
-                for m in 0..M {
-                    acc[m] = acc[m].merge(per_block[k * blocks + blk][m]);
-                }
-            }
-            acc
-        })
-        .collect()
-}
-
 /// Where a ray starts inside the atmosphere: the camera itself, or where the ray enters
 /// the atmosphere from space; None if it misses.
 fn ray_start(model: &Model, camera: Vec3, view: Vec3) -> Option<Vec3> {
     let top = model.top_radius_m;
-    if dot(camera, camera) <= top * top {
+    if camera.dot(camera) <= top * top {
         return Some(camera);
     }
     let (near, far) = ray_sphere(camera, view, top)?;
     if far <= 0.0 {
         return None;
     }
-    let t = near.max(0.0);
-    Some([
-        camera[0] + t * view[0],
-        camera[1] + t * view[1],
-        camera[2] + t * view[2],
-    ])
+    Some(camera + near.max(0.0) * view)
 }
 
 fn radiance_pixel(
@@ -323,8 +79,8 @@ fn radiance_pixel(
     parallel: bool,
 ) -> RadianceEstimate {
     let n = model.channels();
-    let view = normalize(view);
-    let sun = normalize(sun);
+    let view = view.normalize_or_zero();
+    let sun = sun.normalize_or_zero();
     let Some(start) = ray_start(model, camera, view) else {
         return RadianceEstimate {
             radiance: vec![0.0; n],
@@ -442,8 +198,8 @@ pub fn irradiance(
     sun: Vec3,
     settings: &ReferenceSettings,
 ) -> IrradianceEstimate {
-    let normal = normalize(normal);
-    let sun = normalize(sun);
+    let normal = normal.normalize_or_zero();
+    let sun = sun.normalize_or_zero();
     let stats =
         estimate::<1, _>(
             model,
@@ -490,8 +246,8 @@ pub fn flux_budget(
     settings: &ReferenceSettings,
 ) -> FluxBudget {
     let n = model.channels();
-    let sun = normalize(sun);
-    let d = [-sun[0], -sun[1], -sun[2]];
+    let sun = sun.normalize_or_zero();
+    let d = -sun;
     let start = ray_start(model, entry, d);
     let stats: Vec<[Stats; BUDGET_TALLIES]> = match start {
         Some(start) => {

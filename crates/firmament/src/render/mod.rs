@@ -1,215 +1,32 @@
-//! Images: cameras, per-pixel shading of the paper's eq. 16 (sky, ground lit by sun and sky,
-//! aerial perspective, sun disk with limb darkening), spectral to colour, exposure and tone
-//! mapping.
+//! Images: the render loop over a [`Scene`], per-pixel shading of the paper's eq. 16 (sky,
+//! surfaces lit by the lights and the sky, aerial perspective, light shafts, the lights'
+//! disks, volumes), spectral to colour ([`frame`]), exposure and tone mapping
+//! ([`tonemap`]).
+//!
+//! The loop knows only the seams: it asks the sky method for one view per light, the
+//! surfaces for the nearest hit and for the shadows they cast, the volumes for their medium,
+//! the lights for their disks. A second surface or light needs no change here.
 
-pub mod camera;
-pub mod scene;
+pub mod frame;
 pub mod tonemap;
+mod volumes;
 
 use std::f64::consts::PI;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 
-pub use camera::{Camera, Projection, Ray};
-pub use scene::Scene;
+pub use frame::Frame;
 pub use tonemap::ToneCurve;
 
-use crate::atmosphere::Model;
-use crate::geometry::{
-    add_scaled, direction_from_zenith_azimuth, dot, normalize, ray_sphere, Vec3,
-};
 use crate::io::ImageRgbF32;
-use crate::sky::{limb_darkening, Sky, SkySlice};
-use crate::spectrum::{spectrum_to_xyz, xyz_to_linear_srgb};
+use crate::scene::surface::lit_intervals;
+use crate::scene::{Camera, Projection, Ray, Scene};
+use crate::sky::{Shadow, SkyView};
+use crate::spectrum::{ColourMatrix, MAX_CHANNELS};
 use crate::{Error, Result};
 
-/// What to draw besides the atmosphere.
-#[derive(Clone, Debug)]
-pub struct ShadeOptions {
-    /// Unit vector towards the sun (world frame).
-    pub sun: Vec3,
-    /// Draw the solar disk.
-    pub sun_disk: bool,
-}
-
-/// Sun direction from zenith and azimuth (degrees; azimuth clockwise from north).
-pub fn sun_direction(zenith_deg: f64, azimuth_deg: f64) -> Vec3 {
-    direction_from_zenith_azimuth(zenith_deg.to_radians(), azimuth_deg.to_radians())
-}
-
-/// Spectral → colour: XYZ = M·L for the model's samples (the spectrum is linearly
-/// interpolated between samples, so the map is linear), then linear sRGB. Rows: X, Y, Z.
-pub struct ColourMatrix {
-    xyz: Vec<[f64; 3]>,
-}
-
-impl ColourMatrix {
-    /// For these wavelengths.
-    pub fn new(wavelengths_nm: &[f64]) -> ColourMatrix {
-        let n = wavelengths_nm.len();
-        let xyz = (0..n)
-            .map(|k| {
-                let mut e = vec![0.0; n];
-                e[k] = 1.0;
-                spectrum_to_xyz(wavelengths_nm, &e)
-            })
-            .collect();
-        ColourMatrix { xyz }
-    }
-
-    /// CIE XYZ (Y in cd/m² for radiance in W·m⁻²·sr⁻¹·nm⁻¹).
-    #[inline]
-    pub fn to_xyz(&self, l: &[f64]) -> [f64; 3] {
-        let mut o = [0.0; 3];
-        for (v, m) in l.iter().zip(&self.xyz) {
-            o[0] += v * m[0];
-            o[1] += v * m[1];
-            o[2] += v * m[2];
-        }
-        o
-    }
-
-    /// Linear sRGB with Y in cd/m².
-    #[inline]
-    pub fn to_srgb(&self, l: &[f64]) -> [f64; 3] {
-        xyz_to_linear_srgb(self.to_xyz(l))
-    }
-}
-
-/// Spectral radiance (W·m⁻²·sr⁻¹·nm⁻¹) arriving along a primary ray: the ground (a
-/// Lambertian sphere lit by sun and sky) seen through aerial perspective, or the sky and
-/// the sun's disk (paper eq. 16).
-pub fn shade(sky: &Sky, ray: &Ray, options: &ShadeOptions, out: &mut [f64]) {
-    shade_sliced(sky, None, ray, options, out)
-}
-
-/// The [`SkySlice`] for rays from `origin` (None when it is outside the atmosphere).
-pub fn camera_slice(sky: &Sky, origin: Vec3, sun: Vec3) -> Option<SkySlice> {
-    let r = crate::geometry::length(origin);
-    (r <= sky.model.top_radius_m).then(|| sky.slice(r, (dot(origin, sun) / r).clamp(-1.0, 1.0)))
-}
-
-/// [`shade`] with a camera slice (see [`Sky::slice`]).
-pub fn shade_sliced(
-    sky: &Sky,
-    slice: Option<&SkySlice>,
-    ray: &Ray,
-    options: &ShadeOptions,
-    out: &mut [f64],
-) {
-    let n = sky.channels();
-    let model = &sky.model;
-    let mut t = [0.0f64; 64];
-    let t = &mut t[..n];
-    let hit =
-        ray_sphere(ray.origin, ray.dir, model.bottom_radius_m).filter(|&(near, _)| near > 0.0);
-    if let Some((near, _)) = hit {
-        let p = add_scaled(ray.origin, near, ray.dir);
-        let normal = normalize(p);
-        let mut buf = [[0.0f64; 64]; 2];
-        let [e_sun, e_sky] = &mut buf;
-        let (e_sun, e_sky) = (&mut e_sun[..n], &mut e_sky[..n]);
-        sky.sun_and_sky_irradiance(p, normal, options.sun, e_sun, e_sky);
-        sky.sky_radiance_to_point_sliced(slice, ray.origin, p, 0.0, options.sun, out, t);
-        for k in 0..n {
-            out[k] += model.ground_albedo[k] / PI * (e_sun[k] + e_sky[k]) * t[k];
-        }
-    } else {
-        let in_disk =
-            options.sun_disk && dot(ray.dir, options.sun) > model.sun_angular_radius_rad.cos();
-        if in_disk {
-            sky.sky_radiance_sliced(slice, ray.origin, ray.dir, 0.0, options.sun, out, t);
-            add_sun_disk(sky, ray.dir, options.sun, t, out);
-        } else {
-            sky.sky_radiance_sliced(slice, ray.origin, ray.dir, 0.0, options.sun, out, &mut []);
-        }
-    }
-}
-
-/// Adds the solar disk's radiance (limb-darkened, attenuated by `transmittance`) when `dir`
-/// falls inside it.
-pub fn add_sun_disk(sky: &Sky, dir: Vec3, sun: Vec3, transmittance: &[f64], out: &mut [f64]) {
-    let model = &sky.model;
-    let alpha = model.sun_angular_radius_rad;
-    let cos_angle = dot(dir, sun).clamp(-1.0, 1.0);
-    if cos_angle <= alpha.cos() {
-        return;
-    }
-    let angle = cos_angle.acos();
-    let x = angle.sin() / alpha.sin();
-    let mu = (1.0 - x * x).max(0.0).sqrt();
-    let mut centre = [0.0f64; 64];
-    sky.solar_radiance_centre(&mut centre[..out.len()]);
-    for k in 0..out.len() {
-        let lambda = model.wavelengths.nm()[k];
-        out[k] += centre[k] * limb_darkening(model.limb_darkening, mu, lambda) * transmittance[k];
-    }
-}
-
-/// A rendered frame: linear sRGB (Rec. 709 primaries, D65) scaled so that Y is the
-/// luminance in cd/m²; pixels outside the projection are NaN-free zeros with `mask` false.
-pub struct Frame {
-    /// Linear colour, Y in cd/m².
-    pub image: ImageRgbF32,
-    /// Whether each pixel is inside the projection.
-    pub mask: Vec<bool>,
-}
-
-impl Frame {
-    /// Log-average luminance over the pixels inside the projection (cd/m²), leaving out
-    /// black space (below 10⁻⁶ of the brightest pixel) so a planet seen from orbit is
-    /// exposed for itself.
-    pub fn log_average_luminance(&self) -> f64 {
-        let lum = |p: &[f32; 3]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
-        let max = self.image.data.iter().map(lum).fold(0.0, f64::max);
-        let floor = (max * 1e-6).max(1e-6);
-        let mut sum = 0.0;
-        let mut count = 0usize;
-        for (p, &m) in self.image.data.iter().zip(&self.mask) {
-            let y = lum(p);
-            if m && y > floor {
-                sum += y.ln();
-                count += 1;
-            }
-        }
-        if count == 0 {
-            return 1.0;
-        }
-        (sum / count as f64).exp()
-    }
-
-    /// Tone-mapped 8-bit sRGB: exposure scale × luminance-scaled colour, then the curve, then
-    /// the sRGB transfer function.
-    pub fn to_srgb8(&self, exposure: f64, curve: ToneCurve) -> Vec<[u8; 3]> {
-        // A 2¹⁶-entry table of the 8-bit code of each tone-mapped value in [0, 1]: the code
-        // whose interval contains it (binary search on the 255 decision levels, the decoded
-        // mid-points), then one lookup per channel.
-        let levels: Vec<f32> = (0..255)
-            .map(|i| srgb_decode((i as f64 + 0.5) / 255.0) as f32)
-            .collect();
-        let table: Vec<u8> = (0..=65535u32)
-            .map(|i| levels.partition_point(|&l| l <= i as f32 / 65535.0) as u8)
-            .collect();
-        let encode = |v: f64| table[(v.clamp(0.0, 1.0) * 65535.0 + 0.5) as usize];
-        self.image
-            .data
-            .par_iter()
-            .map(|p| p.map(|v| encode(curve.apply(v as f64 * exposure))))
-            .collect()
-    }
-}
-
-/// The sRGB transfer function's inverse (IEC 61966-2-1).
-fn srgb_decode(e: f64) -> f64 {
-    if e <= 0.04045 {
-        e / 12.92
-    } else {
-        ((e + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// Render settings.
+/// What to render: the camera and the image.
 pub struct RenderSettings<'a> {
     /// Camera.
     pub camera: &'a Camera,
@@ -217,8 +34,6 @@ pub struct RenderSettings<'a> {
     pub width: usize,
     /// Image height (pixels).
     pub height: usize,
-    /// Sun and disk.
-    pub shade: ShadeOptions,
     /// Divide colours by the top-of-atmosphere sun's colour (white sun); off keeps the
     /// physical colour of the standard D65 white.
     pub white_balance: bool,
@@ -248,36 +63,137 @@ impl RenderSettings<'_> {
     }
 }
 
-/// Per-channel factors applied to linear sRGB: with `enabled`, those that make the
-/// top-of-atmosphere sun white at its own luminance; `[1, 1, 1]` otherwise.
-pub fn white_balance(model: &Model, colour: &ColourMatrix, enabled: bool) -> [f64; 3] {
-    if !enabled {
-        return [1.0; 3];
-    }
-    let sun = colour.to_srgb(&model.solar_irradiance);
-    let y = colour.to_xyz(&model.solar_irradiance)[1];
-    sun.map(|c| if c > 0.0 { y / c } else { 1.0 })
+/// A scene prepared for one frame from one observer: the sky method's view of each light.
+pub struct Shader<'s> {
+    scene: &'s Scene<'s>,
+    views: Vec<Box<dyn SkyView + 's>>,
+    channels: usize,
 }
 
-/// Render a frame on the CPU, rows in parallel. `progress` receives the fraction done.
+/// Per-thread scratch space of [`Shader::shade`] (no allocation per pixel).
+#[derive(Default)]
+pub struct ShadeScratch {
+    shadowed: Vec<(f64, f64)>,
+    lit: Vec<(f64, f64)>,
+}
+
+impl<'s> Shader<'s> {
+    /// The views of `scene`'s sky method from `observer`, one per light.
+    pub fn new(scene: &'s Scene<'s>, observer: crate::math::Vec3) -> Result<Shader<'s>> {
+        let channels = scene.sky.model().channels();
+        crate::spectrum::check_channels(channels, "rendering")?;
+        let views = scene
+            .lights
+            .iter()
+            .map(|light| scene.sky.view(observer, light))
+            .collect();
+        Ok(Shader {
+            scene,
+            views,
+            channels,
+        })
+    }
+
+    /// Spectral radiance (W·m⁻²·sr⁻¹·nm⁻¹) arriving at the observer along `ray` (from the
+    /// observer): the nearest surface lit by the lights (in the shadows the other surfaces
+    /// cast) and the sky, seen through aerial perspective, or the sky and the lights'
+    /// disks; light shafts where surfaces shadow the air; volumes in front (paper eq. 16).
+    pub fn shade(&self, ray: &Ray, scratch: &mut ShadeScratch, out: &mut [f64]) {
+        let n = self.channels;
+        let scene = self.scene;
+        out[..n].iter_mut().for_each(|v| *v = 0.0);
+        let mut buf = [[0.0f64; MAX_CHANNELS]; 5];
+        let [l, t, albedo, direct, sky] = &mut buf;
+        let (l, t) = (&mut l[..n], &mut t[..n]);
+        let hit = scene.nearest_hit(ray, f64::INFINITY);
+        let end = hit.map_or(f64::INFINITY, |(_, h)| h.distance_m);
+        match hit {
+            Some((i, hit)) => {
+                let (albedo, direct, sky) = (&mut albedo[..n], &mut direct[..n], &mut sky[..n]);
+                scene.surfaces[i].albedo(&hit, albedo);
+                for view in &self.views {
+                    let (shadow, lit_at_end) = self.shadow(ray, view.light(), end, scratch);
+                    view.sun_and_sky_irradiance(hit.position, hit.normal, direct, sky);
+                    if !lit_at_end {
+                        direct.iter_mut().for_each(|v| *v = 0.0);
+                    }
+                    view.sky_radiance_to_point(hit.position, shadow, l, t);
+                    for k in 0..n {
+                        out[k] += l[k];
+                        out[k] += albedo[k] / PI * (direct[k] + sky[k]) * t[k];
+                    }
+                }
+            }
+            None => {
+                let disks = scene
+                    .lights
+                    .iter()
+                    .any(|light| light.visible_disk && light.in_disk(ray.dir));
+                for (j, view) in self.views.iter().enumerate() {
+                    let (shadow, _) = self.shadow(ray, view.light(), end, scratch);
+                    // The transmittance along the ray (the same for every light) only for a
+                    // disk in view.
+                    let t = if disks && j == 0 {
+                        &mut t[..]
+                    } else {
+                        &mut [][..]
+                    };
+                    view.sky_radiance(ray.dir, shadow, l, t);
+                    for k in 0..n {
+                        out[k] += l[k];
+                    }
+                }
+                if disks {
+                    for light in scene.lights.iter().filter(|light| light.visible_disk) {
+                        light.add_disk_radiance(ray.dir, t, &mut out[..n]);
+                    }
+                }
+            }
+        }
+        if !scene.volumes.is_empty() {
+            volumes::composite(scene, &self.views, ray, end, &mut out[..n]);
+        }
+    }
+
+    /// The parts of `ray` up to `end` that `light` reaches, and whether it reaches `end`.
+    fn shadow<'b>(
+        &self,
+        ray: &Ray,
+        light: &crate::scene::Light,
+        end: f64,
+        scratch: &'b mut ShadeScratch,
+    ) -> (Shadow<'b>, bool) {
+        scratch.shadowed.clear();
+        self.scene
+            .shadowed_intervals(ray, light.direction, end, &mut scratch.shadowed);
+        if scratch.shadowed.is_empty() {
+            return (Shadow::None, true);
+        }
+        scratch.lit.clear();
+        lit_intervals(&mut scratch.shadowed, end, &mut scratch.lit);
+        let lit_at_end = scratch.lit.last().is_some_and(|&(_, b)| b >= end);
+        (Shadow::Lit(&scratch.lit), lit_at_end)
+    }
+}
+
+/// Render a frame of `scene` on the CPU, rows in parallel. `progress` receives the fraction
+/// done; `cancel` stops it between rows.
 pub fn render(
-    sky: &Sky,
+    scene: &Scene,
     settings: &RenderSettings,
     progress: &(dyn Fn(f64) + Sync),
     cancel: Option<&AtomicBool>,
 ) -> Result<Frame> {
     settings.validate()?;
     let (w, h) = (settings.width, settings.height);
-    let n = sky.channels();
-    let colour = ColourMatrix::new(sky.model.wavelengths.nm());
-    let balance = white_balance(&sky.model, &colour, settings.white_balance);
-    let origin = [
-        0.0,
-        0.0,
-        sky.model.bottom_radius_m + settings.camera.altitude_m,
-    ];
-    let slice = camera_slice(sky, origin, settings.shade.sun);
-    let prepared = settings.camera.prepare(sky.model.bottom_radius_m, w, h);
+    let model = scene.sky.model();
+    let colour = ColourMatrix::new(model.wavelengths.nm());
+    let balance = colour.white_balance(&model.solar_irradiance, settings.white_balance);
+    let prepared = settings.camera.prepare(model.bottom_radius_m, w, h);
+    let observer =
+        crate::math::Vec3::new(0.0, 0.0, model.bottom_radius_m + settings.camera.altitude_m);
+    let shader = Shader::new(scene, observer)?;
+    let n = shader.channels;
     let mut image = ImageRgbF32::new(w, h);
     let mut mask = vec![false; w * h];
     let done = AtomicUsize::new(0);
@@ -292,13 +208,14 @@ pub fn render(
                 interrupted.store(true, Ordering::Relaxed);
                 return;
             }
-            let mut l = [0.0f64; 64];
+            let mut scratch = ShadeScratch::default();
+            let mut l = [0.0f64; MAX_CHANNELS];
             let l = &mut l[..n];
             for x in 0..w {
                 let Some(ray) = prepared.ray(x as f64 + 0.5, y as f64 + 0.5) else {
                     continue;
                 };
-                shade_sliced(sky, slice.as_ref(), &ray, &settings.shade, l);
+                shader.shade(&ray, &mut scratch, l);
                 let c = colour.to_srgb(l);
                 row[x] = [
                     (c[0] * balance[0]) as f32,
@@ -316,28 +233,4 @@ pub fn render(
         return Err(Error::Interrupted);
     }
     Ok(Frame { image, mask })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn fast_srgb_encoding_equals_the_transfer_function() {
-        let levels: Vec<f32> = (0..255)
-            .map(|i| srgb_decode((i as f64 + 0.5) / 255.0) as f32)
-            .collect();
-        let mut mismatches = 0;
-        for i in 0..=100_000 {
-            let v = i as f32 / 100_000.0;
-            let fast = levels.partition_point(|&l| l <= v) as u8;
-            let exact = crate::io::encode_srgb(v);
-            // Ties at a decision level may round either way in f32.
-            if fast != exact {
-                mismatches += 1;
-                assert!((fast as i32 - exact as i32).abs() <= 1);
-            }
-        }
-        assert!(mismatches < 20, "{mismatches}");
-    }
 }

@@ -3,7 +3,7 @@
 //! horizon into rays that hit the ground and rays that do not, a non-linear `u_μs` with a
 //! minimum sun elevation, and a linear `u_ν`. All in f64; (r, μ) as in [`crate::geometry`].
 
-use crate::geometry::{clamp_cosine, distance_to_top_atmosphere_boundary, safe_sqrt};
+use crate::math::sphere::{clamp_cosine, distance_to_top_atmosphere_boundary, safe_sqrt};
 
 /// Table sizes. Defaults from Bruneton 2017 / SPEC §3.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -536,10 +536,10 @@ mod tests {
     fn scattering_mapping_round_trips_and_splits_at_the_horizon() {
         let s = TableSizes::default();
         for &r in &[6_360_100.0, 6_362_000.0, 6_380_000.0, 6_419_000.0] {
-            let mu_h = crate::geometry::horizon_mu(r, G.bottom);
+            let mu_h = crate::math::sphere::horizon_mu(r, G.bottom);
             for &mu in &[-0.9, mu_h - 1e-3, mu_h + 1e-3, 0.2, 0.95] {
                 for &mu_s in &[-0.15, 0.0, 0.3, 0.9] {
-                    let ground = crate::geometry::ray_intersects_ground(r, mu, G.bottom);
+                    let ground = crate::math::sphere::ray_intersects_ground(r, mu, G.bottom);
                     // A direction that exists: azimuth 72.5° from the sun (cos φ = 0.3).
                     let spread = ((1.0 - mu * mu) * (1.0 - mu_s * mu_s)).sqrt();
                     let nu = mu * mu_s + 0.3 * spread;

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::camera::{Camera, Projection};
-use super::tonemap::ToneCurve;
+use crate::render::tonemap::ToneCurve;
 use crate::{Error, Result};
 
 /// Which atmosphere.
@@ -84,10 +84,10 @@ fn default_files() -> Vec<PathBuf> {
     ]
 }
 
-/// A whole scene.
+/// A whole scene file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Scene {
+pub struct SceneFile {
     /// Atmosphere.
     pub atmosphere: SceneAtmosphere,
     /// Camera.
@@ -100,11 +100,11 @@ pub struct Scene {
     pub output: SceneOutput,
 }
 
-impl Default for Scene {
+impl Default for SceneFile {
     /// Late afternoon from a hill 1.5 km up, looking west-south-west towards the low sun
     /// over the planet's curved horizon.
     fn default() -> Self {
-        Scene {
+        SceneFile {
             atmosphere: SceneAtmosphere {
                 preset: default_preset(),
                 file: None,
@@ -137,14 +137,14 @@ impl Default for Scene {
     }
 }
 
-impl Scene {
+impl SceneFile {
     /// Parse a scene file; relative paths are resolved against its directory.
-    pub fn from_file(path: &Path) -> Result<Scene> {
+    pub fn from_file(path: &Path) -> Result<SceneFile> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::File {
             path: path.display().to_string(),
             reason: e.to_string(),
         })?;
-        let mut scene: Scene = toml::from_str(&text)
+        let mut scene: SceneFile = toml::from_str(&text)
             .map_err(|e| Error::Toml(format!("scene {}: {e}", path.display())))?;
         if let (Some(f), Some(dir)) = (&scene.atmosphere.file, path.parent()) {
             if f.is_relative() {

@@ -2,6 +2,8 @@
 //! (naming after Bruneton 2017, `functions.glsl`). `r` is the distance to the planet centre
 //! in metres, `mu` the cosine of the ray's zenith angle at that point.
 
+use super::Vec3;
+
 /// `sqrt(max(x, 0))`: rounding can make exact-zero discriminants slightly negative.
 #[inline]
 pub fn safe_sqrt(x: f64) -> f64 {
@@ -69,70 +71,17 @@ pub fn horizon_mu(r: f64, bottom_m: f64) -> f64 {
     -safe_sqrt(1.0 - rho * rho)
 }
 
-/// A 3-vector in metres or unit directions.
-pub type Vec3 = [f64; 3];
-
-/// Dot product.
-#[inline]
-pub fn dot(a: Vec3, b: Vec3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-/// Length.
-#[inline]
-pub fn length(a: Vec3) -> f64 {
-    dot(a, a).sqrt()
-}
-
-/// a + s·b.
-#[inline]
-pub fn add_scaled(a: Vec3, s: f64, b: Vec3) -> Vec3 {
-    [a[0] + s * b[0], a[1] + s * b[1], a[2] + s * b[2]]
-}
-
-/// Unit vector; zero stays zero.
-#[inline]
-pub fn normalize(a: Vec3) -> Vec3 {
-    let l = length(a);
-    if l > 0.0 {
-        [a[0] / l, a[1] / l, a[2] / l]
-    } else {
-        a
-    }
-}
-
-/// Cross product.
-#[inline]
-pub fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
 /// Distances (near, far) along unit `dir` from `origin` to a sphere of `radius` centred at
 /// the origin, or None if the line misses it. `near` may be negative (origin inside).
 pub fn ray_sphere(origin: Vec3, dir: Vec3, radius: f64) -> Option<(f64, f64)> {
-    let b = dot(origin, dir);
-    let c = dot(origin, origin) - radius * radius;
+    let b = origin.dot(dir);
+    let c = origin.dot(origin) - radius * radius;
     let disc = b * b - c;
     if disc < 0.0 {
         return None;
     }
     let s = disc.sqrt();
     Some((-b - s, -b + s))
-}
-
-/// Unit direction from a zenith angle and an azimuth (radians) in the local frame
-/// x = east, y = north, z = up, azimuth clockwise from north (towards east).
-pub fn direction_from_zenith_azimuth(zenith_rad: f64, azimuth_rad: f64) -> Vec3 {
-    let s = zenith_rad.sin();
-    [
-        s * azimuth_rad.sin(),
-        s * azimuth_rad.cos(),
-        zenith_rad.cos(),
-    ]
 }
 
 #[cfg(test)]

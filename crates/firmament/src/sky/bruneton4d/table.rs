@@ -3,6 +3,8 @@
 //! table the packing of Bruneton 2017 (ν and μ_s share the x axis; two 3D fetches and a
 //! manual lerp along ν), so CPU and GPU tables compare texel by texel.
 
+use super::params::TableSizes;
+
 /// Linear-filter weights for texture coordinate `u` over `n` texels: (i0, i1, t).
 #[inline]
 pub fn lerp_weights(u: f64, n: usize) -> (usize, usize, f64) {
@@ -131,6 +133,17 @@ pub struct Table4 {
 }
 
 impl Table4 {
+    /// A zero-filled scattering table of these sizes.
+    pub fn for_sizes(sizes: &TableSizes, channels: usize) -> Self {
+        Table4::new(
+            sizes.scattering_r,
+            sizes.scattering_mu,
+            sizes.scattering_mu_s,
+            sizes.scattering_nu,
+            channels,
+        )
+    }
+
     /// Zero-filled table.
     pub fn new(nr: usize, nmu: usize, nmu_s: usize, nnu: usize, channels: usize) -> Self {
         Table4 {

@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::{add_scaled, cross, normalize, Vec3};
+use crate::math::{direction_from_zenith_azimuth, Vec3};
 use crate::{Error, Result};
 
 /// The kind of projection.
@@ -144,7 +144,7 @@ impl Camera {
         px: f64,
         py: f64,
     ) -> Option<Ray> {
-        let origin = [0.0, 0.0, bottom_radius_m + self.altitude_m];
+        let origin = Vec3::new(0.0, 0.0, bottom_radius_m + self.altitude_m);
         // Normalised device coordinates, x right, y up, in [-1, 1].
         let (u, v) = (
             2.0 * px / width as f64 - 1.0,
@@ -170,14 +170,14 @@ impl Camera {
                 let zenith = rho * PI / 2.0;
                 // Looking up with north at the top of the image: east is on the left.
                 let azimuth = (-x).atan2(y);
-                crate::geometry::direction_from_zenith_azimuth(zenith, azimuth)
+                direction_from_zenith_azimuth(zenith, azimuth)
             }
             Projection::Equirect => {
                 // Column: azimuth from −180° (south, left edge) through 0° (north, centre)
                 // to 180°; row: elevation +90° (top) to −90° (bottom).
                 let azimuth = u * PI;
                 let elevation = v * PI / 2.0;
-                crate::geometry::direction_from_zenith_azimuth(PI / 2.0 - elevation, azimuth)
+                direction_from_zenith_azimuth(PI / 2.0 - elevation, azimuth)
             }
             Projection::Cubemap => {
                 let face_w = width as f64 / 6.0;
@@ -189,7 +189,7 @@ impl Camera {
         };
         Some(Ray {
             origin,
-            dir: normalize(local),
+            dir: local.normalize_or_zero(),
         })
     }
 
@@ -197,23 +197,15 @@ impl Camera {
     pub fn basis(&self) -> (Vec3, Vec3, Vec3) {
         let h = self.heading_deg.to_radians();
         let p = self.pitch_deg.to_radians();
-        let forward = [h.sin() * p.cos(), h.cos() * p.cos(), p.sin()];
+        let forward = Vec3::new(h.sin() * p.cos(), h.cos() * p.cos(), p.sin());
         // Right is horizontal, clockwise from forward; degenerate at ±90° pitch, where the
         // heading gives the image's up direction instead.
-        let right0 = [h.cos(), -h.sin(), 0.0];
-        let up0 = cross(right0, forward);
+        let right0 = Vec3::new(h.cos(), -h.sin(), 0.0);
+        let up0 = right0.cross(forward);
         let r = self.roll_deg.to_radians();
-        let right = add_scaled(
-            [
-                right0[0] * r.cos(),
-                right0[1] * r.cos(),
-                right0[2] * r.cos(),
-            ],
-            -r.sin(),
-            up0,
-        );
-        let up = cross(right, forward);
-        (forward, normalize(right), normalize(up))
+        let right = right0 * r.cos() + -r.sin() * up0;
+        let up = right.cross(forward);
+        (forward, right.normalize_or_zero(), up.normalize_or_zero())
     }
 }
 
@@ -251,14 +243,10 @@ impl PreparedCamera {
                 let (w, h) = (self.width as f64, self.height as f64);
                 let (u, v) = (2.0 * px / w - 1.0, 1.0 - 2.0 * py / h);
                 let t = self.tan_half_fov;
-                let d = add_scaled(
-                    add_scaled(self.forward, u * t * w / h, self.right),
-                    v * t,
-                    self.up,
-                );
+                let d = self.forward + (u * t * w / h) * self.right + (v * t) * self.up;
                 Some(Ray {
-                    origin: [0.0, 0.0, self.bottom_radius_m + self.camera.altitude_m],
-                    dir: normalize(d),
+                    origin: Vec3::new(0.0, 0.0, self.bottom_radius_m + self.camera.altitude_m),
+                    dir: d.normalize_or_zero(),
                 })
             }
             _ => self
@@ -282,11 +270,11 @@ pub fn orbit_fit_fov_deg(radius_m: f64, distance_m: f64) -> f64 {
 /// zenith at the top; the +Z and −Z faces have north at the top.
 pub fn cube_direction(face: usize, u: f64, v: f64) -> Vec3 {
     match face {
-        0 => [1.0, -u, v],  // +X east: right is south (−y)
-        1 => [-1.0, u, v],  // −X west: right is north
-        2 => [u, 1.0, v],   // +Y north: right is east
-        3 => [-u, -1.0, v], // −Y south: right is west
-        4 => [-u, v, 1.0],  // +Z up, north at the top: right is west
-        _ => [u, v, -1.0],  // −Z down, north at the top: right is east
+        0 => Vec3::new(1.0, -u, v),  // +X east: right is south (−y)
+        1 => Vec3::new(-1.0, u, v),  // −X west: right is north
+        2 => Vec3::new(u, 1.0, v),   // +Y north: right is east
+        3 => Vec3::new(-u, -1.0, v), // −Y south: right is west
+        4 => Vec3::new(-u, v, 1.0),  // +Z up, north at the top: right is west
+        _ => Vec3::new(u, v, -1.0),  // −Z down, north at the top: right is east
     }
 }

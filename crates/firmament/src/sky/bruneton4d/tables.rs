@@ -1,19 +1,10 @@
-//! Precomputed tables of Bruneton & Neyret 2008 (as refined in Bruneton 2017): their
-//! parameterisations ([`params`]), storage and filtering ([`table`]), the precomputation
-//! ([`precompute`]) and the versioned file format ([`file`]).
-
-pub mod context;
-pub mod file;
-pub mod params;
-pub mod precompute;
-pub mod table;
+//! The precomputed tables of one atmosphere and what to precompute ([`TableConfig`]).
 
 use serde::{Deserialize, Serialize};
 
-pub use context::Lookup;
-pub use params::TableSizes;
-pub use table::{Table2, Table4};
-
+use super::params::TableSizes;
+use super::precompute;
+use super::table::{Table2, Table4};
 use crate::atmosphere::Model;
 use crate::{Error, Result};
 
@@ -94,10 +85,11 @@ pub struct Tables {
     pub optical_depth: Table2,
     /// Indirect (sky) ground irradiance E(r, μ_s), W·m⁻²·nm⁻¹.
     pub irradiance: Table2,
-    /// Single scattering by the molecular group without its phase function
+    /// Single scattering by the molecular (Rayleigh) group without its phase function
     /// (W·m⁻²·sr⁻¹·nm⁻¹ per unit phase).
-    pub scattering: Table4,
-    /// Single Mie scattering without phase function (full or first channel only).
+    pub single_rayleigh: Table4,
+    /// Single scattering by the aerosol (Mie) group without its phase function (every
+    /// channel, or the first only: [`MieStorage`]).
     pub single_mie: Table4,
     /// Mean radiance of each scattering order over the table texels, per channel (order 1
     /// first): to see that orders decrease.
@@ -105,7 +97,7 @@ pub struct Tables {
     /// Ratio rule factors (β_R[0]/β_M[0])·(β_M[k]/β_R[k]) for [`MieStorage::RedOnly`].
     pub mie_ratio: Vec<f64>,
     /// Multiple scattering, orders 2 to N summed, as radiance (W·m⁻²·sr⁻¹·nm⁻¹). Bruneton
-    /// 2017 folds it into `scattering` divided by the molecular phase function; kept apart,
+    /// 2017 folds it into the single Rayleigh table divided by the molecular phase function; kept apart,
     /// its interpolation in μ_s does not mix the phase function's values at different ν
     /// (that mix read the anti-solar sky near the horizon +8 % high under a high sun).
     pub multiple: Table4,

@@ -5,7 +5,9 @@
 use super::params::{self, Radii, TableSizes};
 use super::table::{Table2, Table4, MAX_OPTICAL_DEPTH};
 use crate::atmosphere::Model;
-use crate::geometry::{distance_to_top_atmosphere_boundary, safe_sqrt};
+use crate::math::smoothstep;
+use crate::math::sphere::{distance_to_top_atmosphere_boundary, safe_sqrt};
+use crate::spectrum::MAX_CHANNELS;
 
 /// What a lookup needs: the model's radii, the sizes and the transmittance table (as
 /// optical depth: lookups interpolate τ = −ln T bilinearly, then take e^{−τ}).
@@ -17,7 +19,8 @@ pub struct Lookup<'a> {
     /// Optical depth to the top of the atmosphere, τ(r, μ) = −ln T(r, μ)
     /// ([`super::Tables::optical_depth`]).
     pub optical_depth: &'a Table2,
-    /// Sun angular radius (rad).
+    /// Angular radius of the light (rad): the sun's in the precomputation, the lit
+    /// view's light when rendering.
     pub sun_angular_radius: f64,
 }
 
@@ -69,13 +72,9 @@ impl<'a> Lookup<'a> {
         let r_d = safe_sqrt(d * d + 2.0 * r * mu * d + r * r).clamp(g.bottom, g.top);
         let mu_d = ((r * mu + d) / r_d).clamp(-1.0, 1.0);
         let n = out.len();
-        let mut a = [0.0f64; 64];
-        let mut b = [0.0f64; 64];
-        let (a, b) = if n <= 64 {
-            (&mut a[..n], &mut b[..n])
-        } else {
-            unreachable!("at most 64 wavelengths")
-        };
+        let mut a = [0.0f64; MAX_CHANNELS];
+        let mut b = [0.0f64; MAX_CHANNELS];
+        let (a, b) = (&mut a[..n], &mut b[..n]);
         if ground {
             self.optical_depth_to_top(r_d, -mu_d, a);
             self.optical_depth_to_top(r, -mu, b);
@@ -149,14 +148,4 @@ impl<'a> Lookup<'a> {
     pub fn distance_to_top(&self, r: f64, mu: f64) -> f64 {
         distance_to_top_atmosphere_boundary(r, mu, self.radii.top)
     }
-}
-
-/// GLSL smoothstep.
-#[inline]
-pub fn smoothstep(e0: f64, e1: f64, x: f64) -> f64 {
-    if e1 <= e0 {
-        return if x < e0 { 0.0 } else { 1.0 };
-    }
-    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
 }

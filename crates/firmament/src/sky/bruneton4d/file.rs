@@ -6,7 +6,7 @@
 //! | 4 | format version (u32, = 3; version 1 folded multiple scattering into `scattering`, version 2 stored the transmittance instead of the optical depth; both are refused) |
 //! | 4 | header length L (u32) |
 //! | L | header, UTF-8 JSON: `config` (sizes, orders, mie storage), `wavelengths_nm`, `atmosphere_hash` (hex), `channels`, `order_means`, `mie_ratio` |
-//! | … | f32 arrays: optical depth to the top (τ = −ln T), irradiance, scattering (single molecular), single Mie, multiple scattering, in that order, sizes from the header |
+//! | … | f32 arrays: optical depth to the top (τ = −ln T), irradiance, single Rayleigh (molecular), single Mie, multiple scattering, in that order, sizes from the header |
 //! | 8 | FNV-1a 64 checksum of everything before it |
 //!
 //! A truncated, corrupt, wrong-version or mismatched file is refused, never used.
@@ -16,7 +16,8 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::{MieStorage, Table2, Table4, TableConfig, Tables};
+use super::table::{Table2, Table4};
+use super::{MieStorage, TableConfig, Tables};
 use crate::atmosphere::model::fnv1a;
 use crate::{Error, Result};
 
@@ -48,7 +49,7 @@ pub fn to_bytes(t: &Tables) -> Vec<u8> {
     let json = serde_json::to_vec(&header).expect("header serialises");
     let floats = t.optical_depth.data.len()
         + t.irradiance.data.len()
-        + t.scattering.data.len()
+        + t.single_rayleigh.data.len()
         + t.single_mie.data.len()
         + t.multiple.data.len();
     let mut out = Vec::with_capacity(16 + json.len() + floats * 4 + 8);
@@ -59,7 +60,7 @@ pub fn to_bytes(t: &Tables) -> Vec<u8> {
     for data in [
         &t.optical_depth.data,
         &t.irradiance.data,
-        &t.scattering.data,
+        &t.single_rayleigh.data,
         &t.single_mie.data,
         &t.multiple.data,
     ] {
@@ -152,23 +153,11 @@ pub fn from_bytes(bytes: &[u8], path: &str) -> Result<Tables> {
         channels: n,
         data: take(counts[1]),
     };
-    let mut scattering = Table4::new(
-        s.scattering_r,
-        s.scattering_mu,
-        s.scattering_mu_s,
-        s.scattering_nu,
-        n,
-    );
-    scattering.data = take(counts[2]);
-    let mut single_mie = Table4::new(
-        s.scattering_r,
-        s.scattering_mu,
-        s.scattering_mu_s,
-        s.scattering_nu,
-        mie_channels,
-    );
+    let mut single_rayleigh = Table4::for_sizes(&s, n);
+    single_rayleigh.data = take(counts[2]);
+    let mut single_mie = Table4::for_sizes(&s, mie_channels);
     single_mie.data = take(counts[3]);
-    let mut multiple = scattering.clone();
+    let mut multiple = single_rayleigh.clone();
     multiple.data = take(counts[4]);
     let hash = u64::from_str_radix(&header.atmosphere_hash, 16)
         .map_err(|_| bad("bad atmosphere hash".into()))?;
@@ -179,7 +168,7 @@ pub fn from_bytes(bytes: &[u8], path: &str) -> Result<Tables> {
         transmittance: optical_depth.transmittance_of_optical_depth(),
         optical_depth,
         irradiance,
-        scattering,
+        single_rayleigh,
         single_mie,
         order_means: header.order_means,
         mie_ratio: header.mie_ratio,
@@ -190,33 +179,10 @@ pub fn from_bytes(bytes: &[u8], path: &str) -> Result<Tables> {
 /// Write tables atomically (temporary file, then rename).
 pub fn write(t: &Tables, path: &Path) -> Result<()> {
     let bytes = to_bytes(t);
-    let file_err = |e: std::io::Error| Error::File {
-        path: path.display().to_string(),
-        reason: e.to_string(),
-    };
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .ok_or_else(|| Error::invalid("out", path.display(), "a file path"))?;
-    let tmp = dir.join(format!(
-        ".{}.tmp-{}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(&bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(file_err(e));
-    }
-    Ok(())
+    crate::io::write_atomic(path, |out| {
+        out.write_all(&bytes)
+            .map_err(|e| crate::io::io_error(path, &e, true))
+    })
 }
 
 /// Read tables from a file (format checks only; see [`Tables::check_matches`]).

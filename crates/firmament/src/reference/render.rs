@@ -1,0 +1,135 @@
+//! Whole frames by the reference path tracer: the ground-truth image of the clear-sky scene
+//! that `render::render` draws from the tables (ground included, the sun's disk added
+//! through the air along the view).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use super::{render_pixels_from, ReferenceSettings};
+use crate::atmosphere::Model;
+use crate::io::ImageRgbF32;
+use crate::math::sphere::ray_sphere;
+use crate::math::Vec3;
+use crate::render::{Frame, RenderSettings};
+use crate::scene::Light;
+use crate::spectrum::ColourMatrix;
+use crate::{Error, Result};
+
+/// The frame of `settings` lit by `sun` (the model's sun in a direction), every pixel traced
+/// with `reference.samples` paths per wavelength (`include_ground` is forced on: a picture
+/// shows the ground). Colour and white balance as [`crate::render::render`]; the sun's disk
+/// is added where a view ray does not meet the ground, attenuated by the transmittance of
+/// the model's column integrals. `progress` receives the fraction done; `cancel` stops it
+/// between batches of pixels. Returns the frame and the mean relative standard error of the
+/// pixels' luminance.
+pub fn render_frame(
+    model: &Model,
+    settings: &RenderSettings,
+    sun: &Light,
+    reference: &ReferenceSettings,
+    progress: &(dyn Fn(f64) + Sync),
+    cancel: Option<&AtomicBool>,
+) -> Result<(Frame, f64)> {
+    settings.validate()?;
+    let reference = ReferenceSettings {
+        include_ground: true,
+        ..reference.clone()
+    };
+    reference.validate()?;
+    let (w, h) = (settings.width, settings.height);
+    let prepared = settings.camera.prepare(model.bottom_radius_m, w, h);
+    let mut pixels = Vec::new();
+    let mut rays = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            if let Some(ray) = prepared.ray(x as f64 + 0.5, y as f64 + 0.5) {
+                pixels.push(y * w + x);
+                rays.push((ray.origin, ray.dir));
+            }
+        }
+    }
+    let batch = (4 * w).clamp(256, 16_384);
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let mut estimates = Vec::with_capacity(rays.len());
+    for (b, chunk) in rays.chunks(batch).enumerate() {
+        if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+            return Err(Error::Interrupted);
+        }
+        estimates.extend(render_pixels_from(
+            model,
+            chunk,
+            (b * batch) as u64,
+            sun.direction,
+            &reference,
+            &|| {
+                let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                if d.is_multiple_of(256) {
+                    progress(d as f64 / rays.len() as f64);
+                }
+            },
+        ));
+    }
+    if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+        return Err(Error::Interrupted);
+    }
+    let nm = model.wavelengths.nm();
+    let colour = ColourMatrix::new(nm);
+    let balance = colour.white_balance(&model.solar_irradiance, settings.white_balance);
+    // The tracer's source is the model's sun; another light's irradiance scales it.
+    let scale: Vec<f64> = sun
+        .irradiance
+        .iter()
+        .zip(&model.solar_irradiance)
+        .map(|(l, s)| if *s > 0.0 { l / s } else { 0.0 })
+        .collect();
+    let mut image = ImageRgbF32::new(w, h);
+    let mut mask = vec![false; w * h];
+    let (mut stderr_sum, mut stderr_count) = (0.0, 0usize);
+    for ((&p, &(origin, dir)), e) in pixels.iter().zip(&rays).zip(&estimates) {
+        let mut l: Vec<f64> = e.radiance.iter().zip(&scale).map(|(v, s)| v * s).collect();
+        if sun.visible_disk {
+            let t = view_transmittance(model, origin, dir);
+            sun.add_disk_radiance(dir, &t, &mut l);
+        }
+        let (y, se) = colour.luminance_and_stderr(&e.radiance, &e.stderr);
+        if y > 0.0 {
+            stderr_sum += se / y;
+            stderr_count += 1;
+        }
+        let c = colour.to_srgb(&l);
+        image.data[p] = [
+            (c[0] * balance[0]) as f32,
+            (c[1] * balance[1]) as f32,
+            (c[2] * balance[2]) as f32,
+        ];
+        mask[p] = true;
+    }
+    let mean_stderr = if stderr_count > 0 {
+        stderr_sum / stderr_count as f64
+    } else {
+        0.0
+    };
+    Ok((Frame { image, mask }, mean_stderr))
+}
+
+/// Transmittance of the air along a view ray from `origin` to the top of the atmosphere, 0
+/// where it meets the ground (the model's column integrals).
+fn view_transmittance(model: &Model, origin: Vec3, dir: Vec3) -> Vec<f64> {
+    let n = model.channels();
+    if ray_sphere(origin, dir, model.bottom_radius_m).is_some_and(|(near, _)| near > 0.0) {
+        return vec![0.0; n];
+    }
+    let mut transmittance = vec![1.0; n];
+    if let Some((near, far)) = ray_sphere(origin, dir, model.top_radius_m) {
+        if far > 0.0 {
+            let start = near.max(0.0);
+            let p = origin + start * dir;
+            let r = p.length();
+            let mu = (p.dot(dir) / r).clamp(-1.0, 1.0);
+            let tau = model.optical_depth_along_ray(r, mu, far - start);
+            for k in 0..n {
+                transmittance[k] = (-tau[k]).exp();
+            }
+        }
+    }
+    transmittance
+}

@@ -1,0 +1,251 @@
+//! The paths: camera rays with a forced first collision, then delta tracking with
+//! next-event estimation towards the sun at every collision and ground bounce; photons from
+//! the sun for the flux budget.
+
+use std::f64::consts::PI;
+
+use super::geometry::{advance, cosine_direction, Frame};
+use super::{
+    Channel, Primary, Scratch, BUDGET_TALLIES, T_GROUND_ABSORBED, T_GROUND_DIFFUSE,
+    T_GROUND_DIRECT, T_MEDIUM_ABSORBED, T_REFLECTED, T_TRUNCATED,
+};
+use crate::math::Vec3;
+use crate::reference::rng::Rng;
+
+impl Channel<'_> {
+    /// One radiance sample (W·m⁻²·sr⁻¹·nm⁻¹) along a camera ray (the path runs from the
+    /// eye towards the light). `primary_ground`: whether the ground seen directly by this
+    /// ray contributes its reflected light.
+    ///
+    /// The first collision is forced: its optical depth is drawn from the exponential
+    /// distribution truncated to the ray's total τ_L (tabulated exactly at
+    /// `intervals` graded nodes per monotone piece, linear in between), with weight
+    /// σ_s(t)·(1 − e^{−τ_L})/σ̄(interval); the uncollided part (probability e^{−τ_L}) is
+    /// followed too when it reaches a ground that counts. This removes the variance of
+    /// "did the path collide at all", which dominates in thin air (zenith views, space).
+    pub(crate) fn radiance_sample(
+        &self,
+        frame: &Frame,
+        primary: &Primary,
+        sun: Vec3,
+        primary_ground: bool,
+        rng: &mut Rng,
+        dens: &mut Scratch,
+    ) -> f64 {
+        let mut radiance = 0.0;
+        let tau_l = *primary.tau.last().unwrap();
+        if tau_l > 0.0 {
+            let escape = (-tau_l).exp();
+            let target = -(1.0 - rng.next_f64() * (1.0 - escape)).ln();
+            let i = primary
+                .tau
+                .partition_point(|&v| v <= target)
+                .clamp(1, primary.tau.len() - 1)
+                - 1;
+            let dtau = primary.tau[i + 1] - primary.tau[i];
+            let dt = primary.t[i + 1] - primary.t[i];
+            if dtau > 0.0 && dt > 0.0 {
+                let mean_sigma = dtau / dt;
+                let t = (primary.t[i] + (target - primary.tau[i]) / mean_sigma)
+                    .clamp(primary.t[i], primary.t[i + 1]);
+                let o = advance(primary.o, t, primary.d);
+                let x0 = frame.x(primary.o);
+                let b = frame.b(primary.o, primary.d);
+                let (_, ss) = self.coefficients(self.alt(x0, b, t), dens);
+                if ss > 0.0 {
+                    let w = ss * (1.0 - escape) / mean_sigma;
+                    radiance += self.after_collision(frame, o, primary.d, w, ss, sun, rng, dens);
+                }
+            }
+        }
+        if primary.ground && primary_ground && self.ground_albedo > 0.0 {
+            let o = advance(primary.o, primary.t_end, primary.d);
+            radiance += self.after_ground(frame, o, (-tau_l).exp(), 0, sun, rng, dens);
+        }
+        radiance
+    }
+
+    /// NEE at a real collision at `o` (densities in `dens`, weight `w` already including
+    /// σ_s/σ_t), then the rest of the path.
+    pub(super) fn after_collision(
+        &self,
+        frame: &Frame,
+        o: Vec3,
+        d: Vec3,
+        mut w: f64,
+        ss: f64,
+        sun: Vec3,
+        rng: &mut Rng,
+        dens: &mut Scratch,
+    ) -> f64 {
+        let (ls, e) = self.sample_sun(sun, rng);
+        let tr = self.transmittance(frame, o, ls);
+        let mut radiance = if tr > 0.0 {
+            w * self.phase(dens, ss, d.dot(ls)) * tr * e
+        } else {
+            0.0
+        };
+        let events = 1;
+        if events >= self.max_bounces || !self.roulette(events, &mut w, rng) {
+            return radiance;
+        }
+        let d = self.scatter(d, dens, ss, rng);
+        radiance += self.trace(frame, o, d, w, events, sun, rng, dens);
+        radiance
+    }
+
+    /// A ground reflection at `o` with incoming weight `w` after `events` events: NEE, then
+    /// the rest of the path.
+    pub(super) fn after_ground(
+        &self,
+        frame: &Frame,
+        o: Vec3,
+        mut w: f64,
+        mut events: usize,
+        sun: Vec3,
+        rng: &mut Rng,
+        dens: &mut Scratch,
+    ) -> f64 {
+        let n = frame.up(o);
+        events += 1;
+        let (ls, e) = self.sample_sun(sun, rng);
+        let cos = n.dot(ls);
+        let mut radiance = 0.0;
+        if cos > 0.0 {
+            let tr = self.transmittance(frame, o, ls);
+            radiance += w * self.ground_albedo / PI * cos * tr * e;
+        }
+        w *= self.ground_albedo;
+        if events >= self.max_bounces || !self.roulette(events, &mut w, rng) {
+            return radiance;
+        }
+        let d = cosine_direction(n, rng);
+        radiance + self.trace(frame, o, d, w, events, sun, rng, dens)
+    }
+
+    /// The path from `o` along `d` with weight `w` after `events` events (delta tracking).
+    pub(super) fn trace(
+        &self,
+        frame: &Frame,
+        mut o: Vec3,
+        mut d: Vec3,
+        mut w: f64,
+        mut events: usize,
+        sun: Vec3,
+        rng: &mut Rng,
+        dens: &mut Scratch,
+    ) -> f64 {
+        let mut radiance = 0.0;
+        loop {
+            let x0 = frame.x(o);
+            let b = frame.b(o, d);
+            let (t_end, ground) = self.boundary(x0, b);
+            if let Some(t) = self.collide(x0, b, t_end, rng) {
+                o = advance(o, t, d);
+                let h = self.alt(x0, b, t);
+                let (st, ss) = self.coefficients(h, dens);
+                if st <= 0.0 || ss <= 0.0 {
+                    break;
+                }
+                w *= ss / st;
+                events += 1;
+                let (ls, e) = self.sample_sun(sun, rng);
+                let tr = self.transmittance(frame, o, ls);
+                if tr > 0.0 {
+                    radiance += w * self.phase(dens, ss, d.dot(ls)) * tr * e;
+                }
+                if events >= self.max_bounces || !self.roulette(events, &mut w, rng) {
+                    break;
+                }
+                d = self.scatter(d, dens, ss, rng);
+            } else {
+                if !ground || self.ground_albedo <= 0.0 {
+                    break;
+                }
+                o = advance(o, t_end, d);
+                let n = frame.up(o);
+                events += 1;
+                let (ls, e) = self.sample_sun(sun, rng);
+                let cos = n.dot(ls);
+                if cos > 0.0 {
+                    let tr = self.transmittance(frame, o, ls);
+                    radiance += w * self.ground_albedo / PI * cos * tr * e;
+                }
+                w *= self.ground_albedo;
+                if events >= self.max_bounces || !self.roulette(events, &mut w, rng) {
+                    break;
+                }
+                d = cosine_direction(n, rng);
+            }
+        }
+        radiance
+    }
+
+    /// One photon from offset `o` (on the top of the atmosphere) along `d` (= −sun),
+    /// tallied as fractions of its power: see the `T_*` indices.
+    pub(crate) fn budget_sample(
+        &self,
+        frame: &Frame,
+        mut o: Vec3,
+        mut d: Vec3,
+        rng: &mut Rng,
+        dens: &mut Scratch,
+    ) -> [f64; BUDGET_TALLIES] {
+        let mut tally = [0.0; BUDGET_TALLIES];
+        let mut w = 1.0;
+        let mut events = 0usize;
+        let mut scattered = false;
+        loop {
+            let x0 = frame.x(o);
+            let b = frame.b(o, d);
+            let (t_end, ground) = self.boundary(x0, b);
+            if let Some(t) = self.collide(x0, b, t_end, rng) {
+                o = advance(o, t, d);
+                let (st, ss) = self.coefficients(self.alt(x0, b, t), dens);
+                let albedo = if st > 0.0 { ss / st } else { 0.0 };
+                tally[T_MEDIUM_ABSORBED] += w * (1.0 - albedo);
+                w *= albedo;
+                events += 1;
+                scattered = true;
+                if w <= 0.0 {
+                    break;
+                }
+                if events >= self.max_bounces {
+                    tally[T_TRUNCATED] += w;
+                    break;
+                }
+                if !self.roulette(events, &mut w, rng) {
+                    break;
+                }
+                d = self.scatter(d, dens, ss, rng);
+            } else {
+                if !ground {
+                    tally[T_REFLECTED] += w;
+                    break;
+                }
+                o = advance(o, t_end, d);
+                tally[if scattered {
+                    T_GROUND_DIFFUSE
+                } else {
+                    T_GROUND_DIRECT
+                }] += w;
+                tally[T_GROUND_ABSORBED] += w * (1.0 - self.ground_albedo);
+                w *= self.ground_albedo;
+                events += 1;
+                scattered = true;
+                if w <= 0.0 {
+                    break;
+                }
+                if events >= self.max_bounces {
+                    tally[T_TRUNCATED] += w;
+                    break;
+                }
+                if !self.roulette(events, &mut w, rng) {
+                    break;
+                }
+                d = cosine_direction(frame.up(o), rng);
+            }
+        }
+        tally
+    }
+}

@@ -1,0 +1,80 @@
+//! What a picture shows: the atmosphere through a sky method, surfaces, volumes and lights
+//! ([`Scene`]), seen by a camera ([`camera`]); and the scene files that describe it in TOML
+//! ([`file`]).
+//!
+//! The world is planet-centred (metres); the observer stands above the point of the planet
+//! on the +z axis, whose local frame is x = east, y = north, z = up.
+
+pub mod camera;
+pub mod file;
+pub mod light;
+pub mod surface;
+pub mod volume;
+
+pub use camera::{Camera, PreparedCamera, Projection, Ray};
+pub use file::SceneFile;
+pub use light::{DiskProfile, Light};
+pub use surface::{Sphere, Surface, SurfaceHit};
+pub use volume::{HomogeneousSphere, Volume};
+
+use crate::math::{direction_from_zenith_azimuth, Vec3};
+use crate::sky::SkyMethod;
+
+/// Everything a frame composes. The renderer asks each part only what its seam offers: the
+/// sky method for the atmosphere's light, each surface for hits and shadows, each volume for
+/// its medium, each light for its direction, irradiance and disk.
+pub struct Scene<'a> {
+    /// The atmosphere's light transport.
+    pub sky: &'a dyn SkyMethod,
+    /// Surfaces, the planet's ground among them.
+    pub surfaces: Vec<Box<dyn Surface + 'a>>,
+    /// Participating media besides the atmosphere's constituents.
+    pub volumes: Vec<Box<dyn Volume + 'a>>,
+    /// Lights.
+    pub lights: Vec<Light>,
+}
+
+impl<'a> Scene<'a> {
+    /// The clear sky: the planet's ground sphere under the model's sun in `sun_direction`
+    /// (its disk drawn when `sun_disk`).
+    pub fn clear_sky(sky: &'a dyn SkyMethod, sun_direction: Vec3, sun_disk: bool) -> Scene<'a> {
+        let model = sky.model();
+        Scene {
+            sky,
+            surfaces: vec![Box::new(Sphere::ground(model))],
+            volumes: Vec::new(),
+            lights: vec![Light::sun(model, sun_direction, sun_disk)],
+        }
+    }
+
+    /// The nearest surface hit of `ray` closer than `max_distance_m`: (surface index, hit).
+    pub fn nearest_hit(&self, ray: &Ray, max_distance_m: f64) -> Option<(usize, SurfaceHit)> {
+        let mut best: Option<(usize, SurfaceHit)> = None;
+        for (i, s) in self.surfaces.iter().enumerate() {
+            let limit = best.map_or(max_distance_m, |(_, h)| h.distance_m);
+            if let Some(h) = s.intersect(ray, limit) {
+                best = Some((i, h));
+            }
+        }
+        best
+    }
+
+    /// The intervals of `ray` within [0, `max_distance_m`] that some surface hides from
+    /// `light` (unordered, possibly overlapping), appended to `out`.
+    pub fn shadowed_intervals(
+        &self,
+        ray: &Ray,
+        light: Vec3,
+        max_distance_m: f64,
+        out: &mut Vec<(f64, f64)>,
+    ) {
+        for s in &self.surfaces {
+            s.shadowed_intervals(ray, light, max_distance_m, out);
+        }
+    }
+}
+
+/// Sun direction from zenith and azimuth (degrees; azimuth clockwise from north).
+pub fn sun_direction(zenith_deg: f64, azimuth_deg: f64) -> Vec3 {
+    direction_from_zenith_azimuth(zenith_deg.to_radians(), azimuth_deg.to_radians())
+}

@@ -1,0 +1,83 @@
+//! Bruneton & Neyret 2008, *Precomputed Atmospheric Scattering*, as refined in Bruneton
+//! 2017: transmittance, irradiance and 4D scattering tables precomputed for one atmosphere
+//! ([`precompute`]), their parameterisations ([`params`]), storage and filtering
+//! ([`table`]), lookups ([`lookup`]), the versioned file format ([`file`]), and the
+//! evaluation of the paper's eq. 16 pieces from them ([`view`]).
+
+pub mod file;
+pub mod lookup;
+pub mod params;
+pub mod precompute;
+pub mod table;
+mod tables;
+pub mod view;
+
+pub use lookup::Lookup;
+pub use params::TableSizes;
+pub use table::{Table2, Table4};
+pub use tables::{MieStorage, TableConfig, Tables};
+pub use view::Bruneton4dView;
+
+use super::{SkyMethod, SkyView};
+use crate::atmosphere::Model;
+use crate::math::Vec3;
+use crate::scene::Light;
+use crate::Result;
+
+/// The 4D-table sky method: a model with its precomputed tables.
+pub struct Bruneton4d {
+    /// The resolved atmosphere.
+    pub model: Model,
+    /// Its tables.
+    pub tables: Tables,
+}
+
+impl Bruneton4d {
+    /// Pair a model with tables computed for it (refused if they do not match).
+    pub fn new(model: Model, tables: Tables) -> Result<Bruneton4d> {
+        tables.check_matches(&model, "(in memory)")?;
+        Ok(Bruneton4d { model, tables })
+    }
+
+    /// Precompute the tables for `model` (no progress report) and pair them.
+    pub fn compute(model: Model, config: &TableConfig) -> Result<Bruneton4d> {
+        let tables = Tables::compute(&model, config)?;
+        Ok(Bruneton4d { model, tables })
+    }
+
+    /// Number of wavelengths.
+    pub fn channels(&self) -> usize {
+        self.model.channels()
+    }
+
+    /// Table lookups for a light of angular radius `light_angular_radius_rad`.
+    pub fn lookup(&self, light_angular_radius_rad: f64) -> Lookup<'_> {
+        Lookup {
+            sun_angular_radius: light_angular_radius_rad,
+            ..Lookup::new(
+                &self.model,
+                self.tables.config.sizes,
+                &self.tables.optical_depth,
+            )
+        }
+    }
+
+    /// The view from `observer` under `light`, with its concrete type.
+    pub fn view_of<'a>(&'a self, observer: Vec3, light: &'a Light) -> Bruneton4dView<'a> {
+        Bruneton4dView::new(self, observer, light)
+    }
+}
+
+impl SkyMethod for Bruneton4d {
+    fn model(&self) -> &Model {
+        &self.model
+    }
+
+    fn name(&self) -> &'static str {
+        "bruneton4d"
+    }
+
+    fn view<'a>(&'a self, observer: Vec3, light: &'a Light) -> Box<dyn SkyView + 'a> {
+        Box::new(self.view_of(observer, light))
+    }
+}

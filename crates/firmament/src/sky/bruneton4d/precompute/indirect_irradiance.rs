@@ -1,0 +1,58 @@
+//! The indirect irradiance pass ΔE (paper eq. 15): the previous order's radiance integrated
+//! over the upper hemisphere.
+
+use std::f64::consts::PI;
+
+use rayon::prelude::*;
+
+use super::{Previous, IRRADIANCE_PHI, IRRADIANCE_THETA};
+use crate::atmosphere::Model;
+use crate::sky::bruneton4d::lookup::Lookup;
+use crate::sky::bruneton4d::params;
+use crate::sky::bruneton4d::table::Table2;
+
+/// Indirect ground irradiance ΔE from the previous order (paper eq. 15 / Bruneton 2017
+/// `ComputeIndirectIrradiance`), by midpoint quadrature over the upper hemisphere.
+pub(super) fn compute_indirect_irradiance(
+    model: &Model,
+    lookup: &Lookup,
+    previous: &Previous,
+) -> Table2 {
+    let s = lookup.sizes;
+    let n = model.channels();
+    let mut e = Table2::new(s.irradiance_mu_s, s.irradiance_r, n);
+    let dtheta = PI / 2.0 / IRRADIANCE_THETA as f64;
+    let dphi = 2.0 * PI / IRRADIANCE_PHI as f64;
+    e.data.par_chunks_mut(n).enumerate().for_each(|(i, out)| {
+        let (x, y) = (i % s.irradiance_mu_s, i / s.irradiance_mu_s);
+        let (r, mu_s) = params::irradiance_r_mu_s(
+            &lookup.radii,
+            (x as f64 + 0.5) / s.irradiance_mu_s as f64,
+            (y as f64 + 0.5) / s.irradiance_r as f64,
+            s.irradiance_mu_s,
+            s.irradiance_r,
+        );
+        let sin_s = (1.0 - mu_s * mu_s).max(0.0).sqrt();
+        let mut radiance = vec![0.0; n];
+        let mut tmp = vec![0.0; n];
+        let mut acc = vec![0.0; n];
+        for j in 0..IRRADIANCE_THETA {
+            let theta = (j as f64 + 0.5) * dtheta;
+            let (sin_t, cos_t) = theta.sin_cos();
+            let domega = dtheta * dphi * sin_t;
+            // Azimuth symmetry about the sun: sample half the circle, count twice.
+            for i_phi in 0..IRRADIANCE_PHI / 2 {
+                let phi = (i_phi as f64 + 0.5) * dphi;
+                let nu = (phi.cos() * sin_t * sin_s + cos_t * mu_s).clamp(-1.0, 1.0);
+                previous.radiance(lookup, r, cos_t, mu_s, nu, false, &mut radiance, &mut tmp);
+                for k in 0..n {
+                    acc[k] += 2.0 * radiance[k] * cos_t * domega;
+                }
+            }
+        }
+        for k in 0..n {
+            out[k] = acc[k] as f32;
+        }
+    });
+    e
+}

@@ -1,0 +1,85 @@
+//! The orders beyond the last computed one: per-order means of the tables (`order_sums` on
+//! the GPU), the geometric tail's factors (`order_tail_factors`) and their application
+//! (`order_tail`).
+
+use crate::atmosphere::ScatteringGroups;
+use crate::sky::bruneton4d::params::ScatteringGrid;
+use crate::sky::bruneton4d::table::Table4;
+
+/// Factors q/(1 − q) per channel for the orders beyond the last computed one, N: with
+/// q = mean(ΔS_N)/mean(ΔS_{N−1}) (`order_means`), the orders N+1, N+2, … are taken as
+/// ΔS_N·q, ΔS_N·q², …, summing to ΔS_N·q/(1 − q). The ratio of successive orders tends to
+/// the dominant eigenvalue of the scattering-plus-ground-reflection operator and their
+/// shape to its eigenfunction (the diffuse light of high orders; Hillaire 2020's
+/// 1/(1 − f_ms) is the isotropic, single-number form of the same series). None below 3
+/// orders (the single-scattering field is far from that shape). q is capped at 0.95.
+///
+/// Measured when introduced (`validate`, earth, altitudes 0 and 1 km, sun 60° and 10°, 398
+/// views, reference at 1 %): 4 orders + tail give a luminance bias of +0.36 % and 440 nm
+/// +0.25 % (4 orders alone: −1.00 %, −3.32 %; 8 orders alone: +0.43 %, +0.37 %).
+pub fn order_tail_factors(order_means: &[Vec<f64>]) -> Option<Vec<f64>> {
+    let n_orders = order_means.len();
+    if n_orders < 3 {
+        return None;
+    }
+    let (last, before) = (&order_means[n_orders - 1], &order_means[n_orders - 2]);
+    Some(
+        last.iter()
+            .zip(before)
+            .map(|(&l, &b)| {
+                let q = if b > 0.0 && l > 0.0 {
+                    (l / b).min(0.95)
+                } else {
+                    0.0
+                };
+                q / (1.0 - q)
+            })
+            .collect(),
+    )
+}
+
+/// a += b·f[channel], channels innermost.
+pub(super) fn add_scaled(a: &mut [f32], b: &[f32], f: &[f64]) {
+    let n = f.len();
+    for (i, (a, b)) in a.iter_mut().zip(b).enumerate() {
+        *a = (*a as f64 + *b as f64 * f[i % n]) as f32;
+    }
+}
+
+/// Mean radiance of the single-scattering tables with phase functions at ν (per channel,
+/// over texels): used to check that orders decrease.
+pub(super) fn table_mean_radiance(
+    rayleigh: &Table4,
+    mie: &Table4,
+    groups: &ScatteringGroups,
+    grid: &ScatteringGrid,
+) -> Vec<f64> {
+    let n = rayleigh.channels;
+    let mut sum = vec![0.0; n];
+    for z in 0..rayleigh.nr {
+        for y in 0..rayleigh.nmu {
+            for x in 0..rayleigh.width() {
+                let (_, _, _, nu, _) = grid.texel(x, y, z);
+                let (pr, pm) = (groups.phase[0].eval(nu), groups.phase[1].eval(nu));
+                let i = rayleigh.index(x, y, z);
+                for k in 0..n {
+                    sum[k] += rayleigh.data[i + k] as f64 * pr + mie.data[i + k] as f64 * pm;
+                }
+            }
+        }
+    }
+    let count = (rayleigh.data.len() / n) as f64;
+    sum.iter().map(|v| v / count).collect()
+}
+
+pub(super) fn table_mean(t: &Table4) -> Vec<f64> {
+    let n = t.channels;
+    let mut sum = vec![0.0; n];
+    for chunk in t.data.chunks(n) {
+        for k in 0..n {
+            sum[k] += chunk[k] as f64;
+        }
+    }
+    let count = (t.data.len() / n) as f64;
+    sum.iter().map(|v| v / count).collect()
+}

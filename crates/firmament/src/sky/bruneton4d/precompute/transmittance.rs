@@ -1,0 +1,42 @@
+//! The transmittance pass: the optical depth τ(r, μ) to the top of the atmosphere, stored
+//! instead of the transmittance (see [`Table2::transmittance_of_optical_depth`]).
+
+use rayon::prelude::*;
+
+use super::TRANSMITTANCE_SEGMENTS;
+use crate::atmosphere::Model;
+use crate::sky::bruneton4d::params::{self, Radii, TableSizes};
+use crate::sky::bruneton4d::table::{Table2, MAX_OPTICAL_DEPTH};
+
+/// τ(r, μ) to the top, capped at [`MAX_OPTICAL_DEPTH`]: 4-point Gauss–Legendre on the
+/// constituents' columns (exact optical depths per constituent, then the per-wavelength sum).
+pub fn compute_optical_depth(model: &Model, s: &TableSizes) -> Table2 {
+    let n = model.channels();
+    let radii = Radii {
+        bottom: model.bottom_radius_m,
+        top: model.top_radius_m,
+        mu_s_min: model.mu_s_min,
+    };
+    let mut t = Table2::new(s.transmittance_mu, s.transmittance_r, n);
+    let width = s.transmittance_mu;
+    t.data
+        .par_chunks_mut(width * n)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let mut columns = vec![0.0; model.constituents.len()];
+            let mut tau = vec![0.0; n];
+            for x in 0..width {
+                let u = (x as f64 + 0.5) / width as f64;
+                let v = (y as f64 + 0.5) / s.transmittance_r as f64;
+                let (r, mu) =
+                    params::transmittance_r_mu(&radii, u, v, s.transmittance_mu, s.transmittance_r);
+                let d = crate::math::sphere::distance_to_top_atmosphere_boundary(r, mu, radii.top);
+                model.columns_along_ray(r, mu, d, TRANSMITTANCE_SEGMENTS, &mut columns);
+                model.optical_depth_from_columns(&columns, &mut tau);
+                for k in 0..n {
+                    row[x * n + k] = tau[k].min(MAX_OPTICAL_DEPTH as f64) as f32;
+                }
+            }
+        });
+    t
+}

@@ -1,0 +1,458 @@
+//! Evaluation of the precomputed tables for one observer and one light (Bruneton & Neyret
+//! 2008 §5, eq. 16 pieces, as in Bruneton 2017 `GetSkyRadiance`, `GetSkyRadianceToPoint`,
+//! `GetSunAndSkyIrradiance`).
+//!
+//! The per-view cache: every ray from an observer inside the atmosphere starts at the same
+//! radius r and sun zenith cosine μ_s, so the 4D scattering tables are filtered once into a
+//! 2D (μ, ν) slice at that (r, μ_s) and the start of every ray from the observer is looked
+//! up there (the same values: the filter is separable). Rays that start elsewhere (views
+//! from space enter the atmosphere at a different point per ray) and the far ends of rays
+//! use the 4D tables.
+
+use super::lookup::Lookup;
+use super::{params, Bruneton4d, MieStorage};
+use crate::atmosphere::groups::{AEROSOLS, MOLECULES};
+use crate::math::sphere::{advance, ray_intersects_ground};
+use crate::math::{smoothstep, Vec3};
+use crate::scene::Light;
+use crate::sky::{Shadow, SkyView};
+use crate::spectrum::MAX_CHANNELS;
+
+/// [`Bruneton4d`] prepared for views from one observer under one light.
+pub struct Bruneton4dView<'a> {
+    sky: &'a Bruneton4d,
+    light: &'a Light,
+    lookup: Lookup<'a>,
+    observer: Vec3,
+    /// The tables at the observer's (r, μ_s), when it is inside the atmosphere.
+    slice: Option<Slice>,
+    /// The light's irradiance over the solar irradiance the tables were computed with.
+    scale: Vec<f64>,
+}
+
+/// The scattering tables filtered at one (r, μ_s) (`Table4::slice`): single Rayleigh and
+/// multiple scattering interleaved per texel ([single; multiple], one filter serves both),
+/// and single Mie.
+struct Slice {
+    scattering: Vec<f64>,
+    mie: Vec<f64>,
+}
+
+/// Where a view ray starts in the atmosphere.
+struct Start {
+    /// The start point (m).
+    point: Vec3,
+    /// Its radius (m) and r·μ along the ray.
+    r: f64,
+    rmu: f64,
+    /// Whether it is the observer itself (so the slice applies).
+    at_observer: bool,
+}
+
+/// Where a table lookup reads: the slice at (u_ν, u_μ), or the 4D tables at (u_ν, u_μs,
+/// u_μ, u_r).
+#[derive(Clone, Copy)]
+enum At<'s> {
+    Slice(&'s Slice, f64, f64),
+    Table([f64; 4]),
+}
+
+/// A view ray at its start: (r, μ, μ_s, ν), whether it meets the ground, whether it starts
+/// at the observer.
+struct RayGeometry {
+    r: f64,
+    mu: f64,
+    mu_s: f64,
+    nu: f64,
+    ground: bool,
+    at_observer: bool,
+}
+
+impl<'a> Bruneton4dView<'a> {
+    /// The view from `observer` under `light`.
+    pub fn new(sky: &'a Bruneton4d, observer: Vec3, light: &'a Light) -> Bruneton4dView<'a> {
+        let lookup = sky.lookup(light.angular_radius_rad);
+        let r = observer.length();
+        let slice = (r <= sky.model.top_radius_m).then(|| {
+            let mu_s = (observer.dot(light.direction) / r).clamp(-1.0, 1.0);
+            Slice::new(sky, &lookup, r, mu_s)
+        });
+        let scale = light
+            .irradiance
+            .iter()
+            .zip(&sky.model.solar_irradiance)
+            .map(|(l, s)| if *s > 0.0 { l / s } else { 0.0 })
+            .collect();
+        Bruneton4dView {
+            sky,
+            light,
+            lookup,
+            observer,
+            slice,
+            scale,
+        }
+    }
+
+    fn channels(&self) -> usize {
+        self.sky.channels()
+    }
+
+    /// Where the ray from the observer along `dir` enters the atmosphere: the observer
+    /// itself when inside, else the entry point of the top; None when the ray misses it.
+    fn start(&self, dir: Vec3) -> Option<Start> {
+        let top = self.sky.model.top_radius_m;
+        let camera = self.observer;
+        let r = camera.length();
+        let rmu = camera.dot(dir);
+        if r <= top {
+            return Some(Start {
+                point: camera,
+                r,
+                rmu,
+                at_observer: true,
+            });
+        }
+        let disc = rmu * rmu - r * r + top * top;
+        if disc < 0.0 {
+            return None;
+        }
+        let d = -rmu - disc.sqrt();
+        if d <= 0.0 {
+            return None;
+        }
+        Some(Start {
+            point: camera + dir * d,
+            r: top,
+            rmu: rmu + d,
+            at_observer: false,
+        })
+    }
+
+    fn geometry(&self, start: &Start, dir: Vec3) -> RayGeometry {
+        let r = start.r;
+        let mu = (start.rmu / r).clamp(-1.0, 1.0);
+        RayGeometry {
+            r,
+            mu,
+            mu_s: (start.point.dot(self.light.direction) / r).clamp(-1.0, 1.0),
+            nu: dir.dot(self.light.direction).clamp(-1.0, 1.0),
+            ground: ray_intersects_ground(r, mu, self.sky.model.bottom_radius_m),
+            at_observer: start.at_observer,
+        }
+    }
+
+    /// Rayleigh + multiple scattering (divided by the molecular phase function) and single
+    /// Mie scattering, without phase functions, at distance `d` (m) along the ray (Bruneton
+    /// 2017 `GetCombinedScattering`; the ratio rule for red-only Mie). `at_start` (d = 0):
+    /// the ray's start, from the slice when the ray starts at the observer.
+    fn combined_scattering(
+        &self,
+        g: &RayGeometry,
+        d: f64,
+        at_start: bool,
+        scat: &mut [f64],
+        mie: &mut [f64],
+    ) {
+        let sky = self.sky;
+        let tables = &sky.tables;
+        let lk = &self.lookup;
+        let n = scat.len();
+        let (r, mu, mu_s) = if at_start {
+            (g.r, g.mu, g.mu_s)
+        } else {
+            let (bottom, top) = (sky.model.bottom_radius_m, sky.model.top_radius_m);
+            let (r_d, mu_d) = advance(g.r, g.mu, d, bottom, top);
+            (
+                r_d,
+                mu_d,
+                ((g.r * g.mu_s + d * g.nu) / r_d).clamp(-1.0, 1.0),
+            )
+        };
+        let mut both = [0.0f64; 2 * MAX_CHANNELS];
+        let at = match self.slice.as_ref().filter(|_| at_start && g.at_observer) {
+            Some(s) => {
+                // The slice already filtered (μ_s, r): only u_ν and u_μ are needed.
+                let u_nu = params::u_nu(mu, mu_s, g.nu);
+                let u_mu = params::scattering_u_mu(&lk.radii, &lk.sizes, r, mu, g.ground);
+                tables.single_rayleigh.sample_slice_channels_into(
+                    &s.scattering,
+                    2 * n,
+                    u_nu,
+                    u_mu,
+                    &mut both[..2 * n],
+                );
+                scat.copy_from_slice(&both[..n]);
+                At::Slice(s, u_nu, u_mu)
+            }
+            None => {
+                let uvwz =
+                    params::scattering_uvwz(&lk.radii, &lk.sizes, r, mu, mu_s, g.nu, g.ground);
+                tables.single_rayleigh.sample_into(uvwz, scat);
+                tables.multiple.sample_into(uvwz, &mut both[n..2 * n]);
+                At::Table(uvwz)
+            }
+        };
+        // Multiple scattering is stored as radiance; callers apply the molecular phase
+        // function to `scat`, so it goes in divided by it.
+        let p = sky.model.groups.phase[MOLECULES].eval(g.nu).max(1e-30);
+        for k in 0..n {
+            scat[k] += both[n + k] / p;
+        }
+        let single_mie = &tables.single_mie;
+        let sample = |out: &mut [f64]| match at {
+            At::Slice(s, u_nu, u_mu) => single_mie.sample_slice_into(&s.mie, u_nu, u_mu, out),
+            At::Table(uvwz) => single_mie.sample_into(uvwz, out),
+        };
+        match tables.config.mie {
+            MieStorage::Separate => sample(mie),
+            MieStorage::RedOnly => {
+                let mut red = [0.0];
+                sample(&mut red);
+                for k in 0..n {
+                    mie[k] = if scat[0] > 0.0 {
+                        scat[k] * red[0] / scat[0] * tables.mie_ratio[k]
+                    } else {
+                        0.0
+                    };
+                }
+            }
+        }
+    }
+
+    /// Σ over the lit intervals [a, b] of T(0, a)·S(a) − T(0, b)·S(b), with phase functions,
+    /// into `radiance` (scaled to the light). `end` is the ray's length; an interval that
+    /// reaches it subtracts nothing when `open_end` (a ray to the sky: nothing is scattered
+    /// beyond the boundary). Single Mie is multiplied by `mie_fade`.
+    fn lit_radiance(
+        &self,
+        g: &RayGeometry,
+        intervals: &[(f64, f64)],
+        end: f64,
+        open_end: bool,
+        mie_fade: f64,
+        radiance: &mut [f64],
+    ) {
+        let n = self.channels();
+        let lk = &self.lookup;
+        let mut buf = [[0.0f64; MAX_CHANNELS]; 5];
+        let [scat, mie, scat_b, mie_b, t] = &mut buf;
+        let (scat, mie, scat_b, mie_b, t) = (
+            &mut scat[..n],
+            &mut mie[..n],
+            &mut scat_b[..n],
+            &mut mie_b[..n],
+            &mut t[..n],
+        );
+        let phase = &self.sky.model.groups.phase;
+        let (pr, pm) = (phase[MOLECULES].eval(g.nu), phase[AEROSOLS].eval(g.nu));
+        radiance[..n].iter_mut().for_each(|v| *v = 0.0);
+        for &(a, b) in intervals {
+            let (a, b) = (a.max(0.0), b.min(end));
+            if b <= a {
+                continue;
+            }
+            self.combined_scattering(g, a, a == 0.0, scat, mie);
+            if a > 0.0 {
+                lk.transmittance(g.r, g.mu, a, g.ground, t);
+                for k in 0..n {
+                    scat[k] *= t[k];
+                    mie[k] *= t[k];
+                }
+            }
+            if b < end || !open_end {
+                self.combined_scattering(g, b, false, scat_b, mie_b);
+                lk.transmittance(g.r, g.mu, b, g.ground, t);
+                for k in 0..n {
+                    scat[k] = (scat[k] - t[k] * scat_b[k]).max(0.0);
+                    mie[k] = (mie[k] - t[k] * mie_b[k]).max(0.0);
+                }
+            }
+            for k in 0..n {
+                radiance[k] += scat[k] * pr + mie[k] * mie_fade * pm;
+            }
+        }
+        for (v, s) in radiance[..n].iter_mut().zip(&self.scale) {
+            *v *= s;
+        }
+    }
+
+    /// Distance from the start along the ray to the nearest boundary (ground or top).
+    fn boundary_distance(&self, g: &RayGeometry) -> f64 {
+        let m = &self.sky.model;
+        crate::math::sphere::distance_to_nearest_atmosphere_boundary(
+            g.r,
+            g.mu,
+            m.bottom_radius_m,
+            m.top_radius_m,
+            g.ground,
+        )
+    }
+}
+
+impl SkyView for Bruneton4dView<'_> {
+    fn observer(&self) -> Vec3 {
+        self.observer
+    }
+
+    fn light(&self) -> &Light {
+        self.light
+    }
+
+    fn sky_radiance(
+        &self,
+        dir: Vec3,
+        shadow: Shadow,
+        radiance: &mut [f64],
+        transmittance: &mut [f64],
+    ) {
+        let n = self.channels();
+        let Some(start) = self.start(dir) else {
+            radiance[..n].iter_mut().for_each(|v| *v = 0.0);
+            transmittance.iter_mut().for_each(|v| *v = 1.0);
+            return;
+        };
+        let g = self.geometry(&start, dir);
+        // An empty `transmittance` asks for radiance only (saves a lookup per sky pixel).
+        if transmittance.is_empty() {
+        } else if g.ground {
+            transmittance[..n].iter_mut().for_each(|v| *v = 0.0);
+        } else {
+            self.lookup.transmittance_to_top(g.r, g.mu, transmittance);
+        }
+        // The start's offset: a camera in space starts where the ray enters the top.
+        let offset = (start.point - self.observer).length();
+        let end = f64::INFINITY;
+        match shadow {
+            Shadow::None => self.lit_radiance(&g, &[(0.0, end)], end, true, 1.0, radiance),
+            Shadow::Length(l) if l <= 0.0 => {
+                self.lit_radiance(&g, &[(0.0, end)], end, true, 1.0, radiance)
+            }
+            Shadow::Length(l) => self.lit_radiance(&g, &[(l, end)], end, true, 1.0, radiance),
+            Shadow::Lit(intervals) => {
+                let shifted: Vec<(f64, f64)> = intervals
+                    .iter()
+                    .map(|&(a, b)| (a - offset, b - offset))
+                    .collect();
+                let length = self.boundary_distance(&g);
+                self.lit_radiance(&g, &shifted, length, true, 1.0, radiance)
+            }
+        }
+    }
+
+    fn sky_radiance_to_point(
+        &self,
+        point: Vec3,
+        shadow: Shadow,
+        radiance: &mut [f64],
+        transmittance: &mut [f64],
+    ) {
+        let n = self.channels();
+        let dir = (point - self.observer).normalize_or_zero();
+        let Some(start) = self.start(dir) else {
+            radiance[..n].iter_mut().for_each(|v| *v = 0.0);
+            transmittance[..n].iter_mut().for_each(|v| *v = 1.0);
+            return;
+        };
+        let g = self.geometry(&start, dir);
+        let d_total = (point - start.point).length();
+        self.lookup
+            .transmittance(g.r, g.mu, d_total, g.ground, transmittance);
+        // Bruneton 2017: fade single Mie when the light is below the horizon (table
+        // artefacts).
+        let fade = smoothstep(0.0, 0.01, g.mu_s);
+        let offset = (start.point - self.observer).length();
+        match shadow {
+            Shadow::None => {
+                self.lit_radiance(&g, &[(0.0, d_total)], d_total, false, fade, radiance)
+            }
+            Shadow::Length(l) => {
+                let d = (d_total - l.max(0.0)).max(0.0);
+                self.lit_radiance(&g, &[(0.0, d)], d_total, false, fade, radiance)
+            }
+            Shadow::Lit(intervals) => {
+                let shifted: Vec<(f64, f64)> = intervals
+                    .iter()
+                    .map(|&(a, b)| (a - offset, b - offset))
+                    .collect();
+                self.lit_radiance(&g, &shifted, d_total, false, fade, radiance)
+            }
+        }
+    }
+
+    fn transmittance_to_point(&self, point: Vec3, out: &mut [f64]) {
+        let dir = (point - self.observer).normalize_or_zero();
+        let Some(start) = self.start(dir) else {
+            out.iter_mut().for_each(|v| *v = 1.0);
+            return;
+        };
+        let g = self.geometry(&start, dir);
+        let d = (point - start.point).length();
+        self.lookup.transmittance(g.r, g.mu, d, g.ground, out);
+    }
+
+    fn transmittance_to_light(&self, point: Vec3, out: &mut [f64]) {
+        let r = point.length();
+        let light = self.light.direction;
+        let lk = &self.lookup;
+        let top = self.sky.model.top_radius_m;
+        if r > top {
+            // Above the atmosphere: enter it along the light's ray, or see the light
+            // unobstructed.
+            let rmu = point.dot(light);
+            let disc = rmu * rmu - r * r + top * top;
+            let d = -rmu - disc.max(0.0).sqrt();
+            if disc >= 0.0 && d > 0.0 {
+                lk.transmittance_to_sun(top, ((rmu + d) / top).clamp(-1.0, 1.0), out);
+            } else {
+                out.iter_mut().for_each(|v| *v = 1.0);
+            }
+            return;
+        }
+        lk.transmittance_to_sun(r, (point.dot(light) / r).clamp(-1.0, 1.0), out);
+    }
+
+    fn sun_and_sky_irradiance(
+        &self,
+        point: Vec3,
+        normal: Vec3,
+        direct: &mut [f64],
+        sky: &mut [f64],
+    ) {
+        let n = self.channels();
+        let model = &self.sky.model;
+        let lk = &self.lookup;
+        let light = self.light.direction;
+        let length = point.length();
+        let r = length.clamp(model.bottom_radius_m, model.top_radius_m);
+        let mu_s = (point.dot(light) / length).clamp(-1.0, 1.0);
+        lk.irradiance(&self.sky.tables.irradiance, r, mu_s, sky);
+        let occlusion = (1.0 + normal.dot(point) / length) * 0.5;
+        for (v, s) in sky[..n].iter_mut().zip(&self.scale) {
+            *v *= occlusion * s;
+        }
+        lk.transmittance_to_sun(r, mu_s, direct);
+        let cos = normal.dot(light).max(0.0);
+        for k in 0..n {
+            direct[k] *= self.light.irradiance[k] * cos;
+        }
+    }
+}
+
+impl Slice {
+    fn new(sky: &Bruneton4d, lookup: &Lookup, r: f64, mu_s: f64) -> Slice {
+        let tables = &sky.tables;
+        let uvwz = params::scattering_uvwz(&lookup.radii, &lookup.sizes, r, 0.0, mu_s, 0.0, false);
+        let n = sky.channels();
+        let single = tables.single_rayleigh.slice(uvwz[1], uvwz[3]);
+        let multiple = tables.multiple.slice(uvwz[1], uvwz[3]);
+        let mut scattering = Vec::with_capacity(2 * single.len());
+        for (a, b) in single.chunks(n).zip(multiple.chunks(n)) {
+            scattering.extend_from_slice(a);
+            scattering.extend_from_slice(b);
+        }
+        Slice {
+            scattering,
+            mie: tables.single_mie.slice(uvwz[1], uvwz[3]),
+        }
+    }
+}

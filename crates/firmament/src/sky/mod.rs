@@ -1,0 +1,103 @@
+//! The sky-method seam: what rendering asks of the atmosphere, and the methods that answer.
+//!
+//! A [`SkyMethod`] evaluates the light transport of one resolved atmosphere ([`Model`]). For
+//! one observer and one light it prepares a [`SkyView`], the method's per-view cache
+//! (Bruneton's tables filtered at the observer's radius and sun angle; Hillaire's sky-view
+//! and aerial-perspective tables will be caches of the same kind), and every question a
+//! renderer asks goes through that view: sky radiance and transmittance along a ray from the
+//! observer, in-scattered radiance and transmittance to a point (aerial perspective) with
+//! the parts of the ray in shadow left out ([`Shadow`]: light shafts), the transmittance
+//! from any point to the light, and the light's direct and sky irradiance on a surface.
+//!
+//! Radiance is W·m⁻²·sr⁻¹·nm⁻¹ and irradiance W·m⁻²·nm⁻¹ per channel of the model's
+//! wavelength grid; positions are planet-centred metres, directions unit vectors. A light
+//! other than the one the method was built for (the moon lighting the sun's tables) scales
+//! the results by its own irradiance.
+//!
+//! Methods: [`bruneton4d`] (Bruneton & Neyret 2008, the 4D precomputed tables).
+
+pub mod bruneton4d;
+
+pub use bruneton4d::Bruneton4d;
+
+use crate::atmosphere::Model;
+use crate::math::Vec3;
+use crate::scene::Light;
+
+/// Which parts of a view ray the light reaches (Bruneton & Neyret 2008 §5, eq. 17–18).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Shadow<'a> {
+    /// The whole ray is lit.
+    #[default]
+    None,
+    /// The paper's shadowed length (m): in shadow over the first metres of a ray to the sky,
+    /// over the last metres of a ray to a point (the shadow behind an occluder seen from the
+    /// front).
+    Length(f64),
+    /// The lit intervals [start, end] (m from the observer along the ray), increasing and
+    /// disjoint; the rest of the ray is in shadow. Exact light shafts from the CPU's lit
+    /// segments.
+    Lit(&'a [(f64, f64)]),
+}
+
+/// A way of evaluating an atmosphere's light transport (the 4D tables, Hillaire 2020, the
+/// 3D table, the reference path tracer).
+pub trait SkyMethod: Send + Sync {
+    /// The atmosphere it evaluates.
+    fn model(&self) -> &Model;
+
+    /// A short name for messages ("bruneton4d").
+    fn name(&self) -> &'static str;
+
+    /// The evaluation for views from `observer` (planet-centred, m; anywhere, in space too)
+    /// lit by `light`: the method's per-view cache is built here, once per frame and light.
+    fn view<'a>(&'a self, observer: Vec3, light: &'a Light) -> Box<dyn SkyView + 'a>;
+}
+
+/// A sky method prepared for one observer and one light. Outputs are per channel of the
+/// model's wavelength grid, overwritten.
+pub trait SkyView: Send + Sync {
+    /// The observer.
+    fn observer(&self) -> Vec3;
+
+    /// The light.
+    fn light(&self) -> &Light;
+
+    /// Radiance scattered towards the observer along the ray in direction `dir` up to the
+    /// atmosphere boundary or the planet's ground (the ground's own radiance and the light's
+    /// disk excluded), and the transmittance along that ray (0 where it meets the ground).
+    /// An empty `transmittance` asks for the radiance only.
+    fn sky_radiance(
+        &self,
+        dir: Vec3,
+        shadow: Shadow,
+        radiance: &mut [f64],
+        transmittance: &mut [f64],
+    );
+
+    /// Radiance scattered towards the observer between it and `point` (aerial perspective,
+    /// paper eq. 16's S|x − T(x, x_s)·S|x_s) and the transmittance between them.
+    fn sky_radiance_to_point(
+        &self,
+        point: Vec3,
+        shadow: Shadow,
+        radiance: &mut [f64],
+        transmittance: &mut [f64],
+    );
+
+    /// Transmittance of the air between the observer and `point`.
+    fn transmittance_to_point(&self, point: Vec3, out: &mut [f64]);
+
+    /// Transmittance from `point` to the light, with the planet's occlusion of its disk.
+    fn transmittance_to_light(&self, point: Vec3, out: &mut [f64]);
+
+    /// The light's direct irradiance and the sky's irradiance on a surface at `point` with
+    /// unit `normal` (the sky term with the (1 + n·n̄)/2 occlusion factor of paper eq. 16).
+    fn sun_and_sky_irradiance(
+        &self,
+        point: Vec3,
+        normal: Vec3,
+        direct: &mut [f64],
+        sky: &mut [f64],
+    );
+}
