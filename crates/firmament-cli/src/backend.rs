@@ -11,7 +11,7 @@ use firmament::math::Vec3;
 use firmament::render::{Frame, RenderSettings};
 use firmament::scene::Scene;
 use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, Tables};
-use firmament_gpu::lut::Precomputer;
+use firmament_gpu::Precomputer;
 use firmament_gpu::{GpuContext, GpuError, GpuRenderer, GpuSky};
 use indicatif::{ProgressBar, ProgressStyle};
 

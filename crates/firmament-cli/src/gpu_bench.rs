@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use anyhow::Result;
-use firmament_gpu::lut::Precomputer;
+use firmament_gpu::Precomputer;
 use firmament_gpu::{GpuContext, GpuRenderer, GpuSky};
 use serde_json::json;
 

@@ -7,8 +7,8 @@ use std::time::Instant;
 use firmament::atmosphere::Atmosphere;
 use firmament::sky::bruneton4d::TableConfig;
 use firmament::spectrum::Wavelengths;
-use firmament_gpu::lut::Precomputer;
 use firmament_gpu::GpuContext;
+use firmament_gpu::Precomputer;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);

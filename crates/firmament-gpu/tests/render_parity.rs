@@ -592,7 +592,7 @@ fn tables_kept_on_the_device_render_like_tables_read_back() {
         mie: MieStorage::RedOnly,
         order_tail: true,
     };
-    let precomputer = firmament_gpu::lut::Precomputer::new(&gpu.ctx).unwrap();
+    let precomputer = firmament_gpu::Precomputer::new(&gpu.ctx).unwrap();
     let on_device = GpuSky::precompute(&gpu.ctx, &precomputer, &model, &config).unwrap();
     let tables = precomputer.run(&gpu.ctx, &model, &config).unwrap();
     let read_back =

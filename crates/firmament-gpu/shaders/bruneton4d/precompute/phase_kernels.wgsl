@@ -1,13 +1,9 @@
 // Azimuthal harmonics of each scattering group's phase function, for every table radius,
 // view zenith (table μ) and incident zenith: b_m with P(Δφ) = Σ b_m cos(mΔφ), by the
-// trapezoid rule over [0, π] (lut::precompute::PhaseKernels). Computed once: they do not
-// depend on the scattering order.
+// trapezoid rule over [0, π] (Rust twin precompute/phase_kernels.rs, `PhaseKernels::new`).
+// Computed once: they do not depend on the scattering order.
 
 @group(0) @binding(7) var<storage, read_write> kernels_out: array<f32>;
-
-const DENSITY_THETA: u32 = 32u;
-const HARMONICS: u32 = 16u;
-const KERNEL_STEPS: u32 = 96u;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -19,7 +15,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let l = (i / 2u) % DENSITY_THETA;
     let row = i / (2u * DENSITY_THETA);
     let base = i * HARMONICS;
-    var o: array<f32, 16>;
+    var o: array<f32, HARMONICS>;
     for (var m = 0u; m < HARMONICS; m++) {
         o[m] = 0.0;
     }

@@ -1,6 +1,7 @@
-// The geometric tail of the orders beyond the last one, N (lut::precompute, `order_tail`):
-// multiple += ΔS_N·f and irradiance += ΔE_{N−1}·f, with f from order_tail_factors.wgsl.
-// Reads ΔS_N at slot a, ΔE at the irradiance slot, the factors at slot b.
+// The geometric tail of the orders beyond the last one, N (Rust twin precompute/order_tail.rs,
+// applied by `add_scaled` in precompute/mod.rs): multiple += ΔS_N·f and irradiance +=
+// ΔE_{N−1}·f, with f from order_tail_factors.wgsl. Reads ΔS_N at slot a, ΔE at the
+// irradiance slot, the factors at slot b.
 
 @group(0) @binding(7) var<storage, read_write> multiple_sum: array<vec4<f32>>;
 @group(0) @binding(8) var<storage, read_write> irradiance_sum: array<vec4<f32>>;

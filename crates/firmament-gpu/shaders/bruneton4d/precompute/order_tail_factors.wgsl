@@ -1,7 +1,7 @@
-// Factors q/(1 − q) of the geometric tail of the orders beyond the last one, N
-// (lut::precompute::order_tail_factors): q = Σ ΔS_N / Σ ΔS_{N−1} per channel over the order
-// row sums (order_sums.wgsl, read at slot a), capped at 0.95; 0 where either sum is 0.
-// N is the pass order. One invocation per channel group.
+// Factors q/(1 − q) of the geometric tail of the orders beyond the last one, N (Rust twin
+// precompute/order_tail.rs, `order_tail_factors`): q = Σ ΔS_N / Σ ΔS_{N−1} per channel over
+// the order row sums (order_sums.wgsl, read at slot a), capped at 0.95; 0 where either sum
+// is 0. N is the pass order. One invocation per channel group.
 
 @group(0) @binding(7) var<storage, read_write> tail_factors: array<vec4<f32>>;
 

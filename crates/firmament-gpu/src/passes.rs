@@ -1,21 +1,25 @@
-//! Compute pipelines: one per WGSL pass file, each with `functions.wgsl` prepended, an
+//! Compute pipelines: one per WGSL pass (its source composed by [`crate::shader`]), an
 //! explicit bind group layout (slots 0–2 always: atmosphere, pass parameters, data), and a
 //! dispatch helper that spreads large tables over two dispatch dimensions.
 
 use wgpu::util::DeviceExt;
 
-/// Shared functions, prepended to every pass.
-const FUNCTIONS: &str = include_str!("../../shaders/functions.wgsl");
-
-/// Workgroup size of every pass (`WORKGROUP` in functions.wgsl).
+/// Workgroup size of every pass (`WORKGROUP` in the WGSL prelude).
 pub const WORKGROUP: u32 = 64;
 
 /// How a pass uses a binding slot.
 #[derive(Clone, Copy, Debug)]
 pub enum Slot {
+    /// A uniform buffer.
     Uniform,
+    /// A read-only storage buffer.
     Read,
+    /// A read-write storage buffer.
     Write,
+    /// A 2D texture of unfilterable floats, read with `textureLoad`.
+    Texture,
+    /// A write-only 2D storage texture of this format.
+    StorageTexture(wgpu::TextureFormat),
 }
 
 /// Binding slots every pass has.
@@ -32,15 +36,14 @@ pub struct Pass {
 }
 
 impl Pass {
-    /// Compile `source` (a pass file) with the shared functions; `slots` are the pass's own
-    /// bindings besides the common ones.
+    /// Compile `code` (a whole composed source); `slots` are the pass's own bindings besides
+    /// the common ones.
     pub fn new(
         device: &wgpu::Device,
         name: &'static str,
-        source: &str,
+        code: String,
         slots: &[(u32, Slot)],
     ) -> Pass {
-        let code = format!("{FUNCTIONS}\n{source}");
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(name),
             source: wgpu::ShaderSource::Wgsl(code.into()),
@@ -66,6 +69,16 @@ impl Pass {
                         ty: wgpu::BufferBindingType::Storage { read_only: false },
                         has_dynamic_offset: false,
                         min_binding_size: None,
+                    },
+                    Slot::Texture => wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    Slot::StorageTexture(format) => wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format,
+                        view_dimension: wgpu::TextureViewDimension::D2,
                     },
                 },
                 count: None,

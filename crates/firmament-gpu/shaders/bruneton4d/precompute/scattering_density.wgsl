@@ -1,14 +1,12 @@
 // Second half of the scattering density ΔJ (paper eq. 11, Bruneton 2017
-// `ComputeScatteringDensity`; lut::precompute::compute_scattering_density): the incident
-// field's azimuthal harmonics convolved with the phase functions' harmonics (exact for the
-// band-limited field), then evaluated at each texel's view azimuth, times β_s(r).
+// `ComputeScatteringDensity`; Rust twin precompute/scattering_density.rs,
+// `compute_scattering_density`, its convolution): the incident field's azimuthal harmonics
+// convolved with the phase functions' harmonics (exact for the band-limited field), then
+// evaluated at each texel's view azimuth, times β_s(r).
 
 @group(0) @binding(7) var<storage, read> kernels: array<f32>;
 @group(0) @binding(8) var<storage, read> coefficients: array<vec4<f32>>;
 @group(0) @binding(9) var<storage, read_write> density_out: array<vec4<f32>>;
-
-const DENSITY_THETA: u32 = 32u;
-const HARMONICS: u32 = 16u;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -25,11 +23,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let t0 = scattering_texel(i_mu_s, y, z);
     let mu_s = t0.mu_s;
     let sin_s = sqrt(max(1.0 - mu_s * mu_s, 0.0));
-    let altitude = altitude_of(t0.rho, t0.r);
-    var beta = array<vec4<f32>, 2>(group_scattering(0u, altitude, k), group_scattering(1u, altitude, k));
+    let altitude_km = altitude_of(t0.rho_km, t0.r_km);
+    var beta = array<vec4<f32>, 2>(group_scattering(0u, altitude_km, k), group_scattering(1u, altitude_km, k));
     var present = array<bool, 2>(atm.group0_present != 0u, atm.group1_present != 0u);
     let dtheta = PI / f32(DENSITY_THETA);
-    var acc: array<vec4<f32>, 32>;
+    var acc: array<vec4<f32>, 2u * HARMONICS>;
     for (var m = 0u; m < 2u * HARMONICS; m++) {
         acc[m] = vec4<f32>(0.0);
     }

@@ -1,5 +1,7 @@
-//! The adapter, device and queue, and how errors reported by the device reach the caller
-//! (never as a panic: wgpu's default handler for uncaptured errors panics).
+//! The adapter, device and queue (opened here, or handed in by an engine), how errors
+//! reported by the device reach the caller (never as a panic: wgpu's default handler for
+//! uncaptured errors panics), and the plumbing every GPU step shares: error scopes, limit
+//! checks, reading buffers back.
 
 use std::sync::{Arc, Mutex};
 
@@ -111,6 +113,28 @@ impl GpuContext {
         })
     }
 
+    /// A context on a device the caller already holds (an engine's, or a viewer's egui-wgpu
+    /// device): firmament records its work on `device` and `queue` and never replaces the
+    /// caller's error handlers; failures still come back as [`GpuError`] from error scopes.
+    /// `info` describes the adapter (for messages and [`GpuContext::is_software`]). The
+    /// device needs the limits the tables and frames use (storage buffers of their size,
+    /// 8 storage buffers per stage); they are checked before any work.
+    pub fn from_device(
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+        info: wgpu::AdapterInfo,
+    ) -> GpuContext {
+        let limits = device.limits();
+        GpuContext {
+            device,
+            queue,
+            info,
+            limits,
+            uncaptured: Arc::new(Mutex::new(Vec::new())),
+            lost: Arc::new(Mutex::new(None)),
+        }
+    }
+
     /// The adapter's name, e.g. "NVIDIA GeForce RTX 4090" or "llvmpipe (LLVM 15.0.6, 256 bits)".
     pub fn adapter_name(&self) -> &str {
         &self.info.name
@@ -166,6 +190,120 @@ impl GpuContext {
             Some(messages.join("; "))
         }
     }
+}
+
+/// Run `f` inside validation, out-of-memory and internal error scopes; the first error
+/// reported (or reported to the uncaptured handler, or a device loss) becomes `Err`.
+pub(crate) fn scoped<T>(
+    ctx: &GpuContext,
+    during: &str,
+    f: impl FnOnce() -> Result<T, GpuError>,
+) -> Result<T, GpuError> {
+    let device = ctx.device();
+    let internal = device.push_error_scope(wgpu::ErrorFilter::Internal);
+    let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+    let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let result = f();
+    let errors = [
+        pollster::block_on(validation.pop()),
+        pollster::block_on(oom.pop()),
+        pollster::block_on(internal.pop()),
+    ];
+    let execution = |reason: String| GpuError::Execution {
+        during: during.to_string(),
+        reason,
+    };
+    if let Some(e) = errors.into_iter().flatten().next() {
+        return Err(execution(e.to_string()));
+    }
+    if let Some(reason) = ctx.take_reported_errors() {
+        return Err(execution(reason));
+    }
+    result
+}
+
+/// Refuse storage buffers larger than the device binds or allocates, before allocating
+/// anything: (what, bytes) each.
+pub(crate) fn check_buffers(ctx: &GpuContext, buffers: &[(&str, u64)]) -> Result<(), GpuError> {
+    let limits = ctx.limits();
+    for &(what, bytes) in buffers {
+        for (limit, name) in [
+            (
+                limits.max_storage_buffer_binding_size,
+                "max_storage_buffer_binding_size",
+            ),
+            (limits.max_buffer_size, "max_buffer_size"),
+        ] {
+            if bytes > limit {
+                return Err(GpuError::Limit {
+                    what: format!("the {what}"),
+                    needed: format!("{bytes} bytes"),
+                    limit: format!("{limit} bytes"),
+                    limit_name: name,
+                    adapter: ctx.adapter_name().to_string(),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Map the staging buffers (MAP_READ), wait for the device, and copy their bytes out.
+pub(crate) fn read_back(
+    ctx: &GpuContext,
+    staging: &[&wgpu::Buffer],
+    during: &str,
+) -> Result<Vec<Vec<u8>>, GpuError> {
+    let failure = |reason: String| GpuError::Execution {
+        during: during.to_string(),
+        reason,
+    };
+    let (tx, rx) = std::sync::mpsc::channel();
+    for (i, b) in staging.iter().enumerate() {
+        let tx = tx.clone();
+        b.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send((i, r));
+        });
+    }
+    drop(tx);
+    ctx.device()
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| failure(e.to_string()))?;
+    for _ in 0..staging.len() {
+        let (_, r) = rx
+            .recv()
+            .map_err(|_| failure("the device never finished mapping the buffers".into()))?;
+        r.map_err(|e| failure(e.to_string()))?;
+    }
+    let mut out = Vec::with_capacity(staging.len());
+    for b in staging {
+        let view = b
+            .slice(..)
+            .get_mapped_range()
+            .map_err(|e| failure(e.to_string()))?;
+        out.push(view.to_vec());
+        drop(view);
+        b.unmap();
+    }
+    Ok(out)
+}
+
+/// A MAP_READ | COPY_DST buffer of `size` bytes to copy GPU results into.
+pub(crate) fn staging_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+/// Little-endian f32 values of raw bytes.
+pub(crate) fn f32s(bytes: &[u8]) -> Vec<f32> {
+    bytes
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect()
 }
 
 /// A context for test suites: `Some` when an adapter is found; when none is, `None` (the

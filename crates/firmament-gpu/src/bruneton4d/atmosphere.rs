@@ -1,11 +1,13 @@
-//! The atmosphere as the shaders read it: the `Atmosphere` uniform of `functions.wgsl` (same
-//! field order) and a storage buffer of vec4 with per-wavelength data (channel groups of 4),
-//! constituents, density layers and tabulated phase functions. Lengths in km, coefficients
-//! in km⁻¹, computed in f64 and rounded once.
+//! The atmosphere as the shaders read it: the `Atmosphere` uniform of
+//! `shaders/common/types.wgsl` (same field order) and a storage buffer of vec4 with
+//! per-wavelength data (channel groups of 4), constituents, density layers and tabulated
+//! phase functions (`shaders/common/bindings.wgsl`). Lengths in km, coefficients in km⁻¹,
+//! computed in f64 and rounded once.
 
-use firmament::atmosphere::Model;
+use firmament::atmosphere::groups::{AEROSOLS, MOLECULES};
+use firmament::atmosphere::{Model, ScatteringGroups};
 use firmament::math::sphere::distance_to_top_atmosphere_boundary;
-use firmament::medium::{ConstituentKind, PhaseFunction};
+use firmament::medium::PhaseFunction;
 use firmament::sky::bruneton4d::TableSizes;
 
 /// Wavelengths per channel group (one vec4).
@@ -16,74 +18,6 @@ pub fn groups(channels: usize) -> usize {
     channels.div_ceil(GROUP)
 }
 
-/// The scattering groups as the tables store them (lut::precompute::Groups): 0 molecules,
-/// 1 everything else that scatters; each group's phase function is its first member's.
-pub struct ScatteringGroups {
-    /// Group of each constituent (None: does not scatter).
-    pub of_constituent: Vec<Option<usize>>,
-    /// Phase function of each group.
-    pub phase: [PhaseFunction; 2],
-    /// Whether each group has members.
-    pub present: [bool; 2],
-    /// Group scattering coefficient at the ground per wavelength (m⁻¹).
-    pub ground_scattering: [Vec<f64>; 2],
-}
-
-impl ScatteringGroups {
-    pub fn new(model: &Model) -> ScatteringGroups {
-        let n = model.channels();
-        let mut of_constituent = Vec::new();
-        let mut phase = [
-            PhaseFunction::Rayleigh {
-                depolarization: 0.0,
-            },
-            PhaseFunction::HenyeyGreenstein { g: 0.0 },
-        ];
-        let mut present = [false, false];
-        let mut ground_scattering = [vec![0.0; n], vec![0.0; n]];
-        for c in &model.constituents {
-            if c.scattering.iter().all(|&s| s == 0.0) {
-                of_constituent.push(None);
-                continue;
-            }
-            let g = if c.kind == ConstituentKind::Molecules {
-                0
-            } else {
-                1
-            };
-            if !present[g] {
-                phase[g] = c.phase.clone();
-                present[g] = true;
-            }
-            let rho = c.density.density(0.0);
-            for k in 0..n {
-                ground_scattering[g][k] += rho * c.scattering[k];
-            }
-            of_constituent.push(Some(g));
-        }
-        ScatteringGroups {
-            of_constituent,
-            phase,
-            present,
-            ground_scattering,
-        }
-    }
-
-    /// β_M/β_R scaled to channel 0 (the ratio rule of `MieStorage::RedOnly`).
-    pub fn mie_ratio(&self) -> Vec<f64> {
-        let [r, m] = &self.ground_scattering;
-        (0..r.len())
-            .map(|k| {
-                if r[k] > 0.0 && m[0] > 0.0 && r[0] > 0.0 {
-                    (r[0] / m[0]) * (m[k] / r[k])
-                } else {
-                    0.0
-                }
-            })
-            .collect()
-    }
-}
-
 /// The packed atmosphere.
 pub struct Packed {
     /// The `Atmosphere` uniform, one 32-bit word per field (padded to 16 bytes).
@@ -92,7 +26,7 @@ pub struct Packed {
     pub data: Vec<f32>,
 }
 
-/// A phase function as (kind, offset, count, a, b, c) of `phase_eval` in functions.wgsl;
+/// A phase function as (kind, offset, count, a, b, c) of `phase_eval` in common/phase.wgsl;
 /// tabulated knots are appended to `data`.
 fn pack_phase(p: &PhaseFunction, data: &mut Vec<f32>) -> [u32; 6] {
     let f = |x: f64| (x as f32).to_bits();
@@ -117,7 +51,8 @@ fn pack_phase(p: &PhaseFunction, data: &mut Vec<f32>) -> [u32; 6] {
 }
 
 /// Pack `model` for tables of `sizes`.
-pub fn pack(model: &Model, sizes: &TableSizes, groups_info: &ScatteringGroups) -> Packed {
+pub fn pack(model: &Model, sizes: &TableSizes) -> Packed {
+    let groups_info = &model.groups;
     let n = model.channels();
     let g = groups(n);
     let km = 1e-3;
@@ -145,8 +80,8 @@ pub fn pack(model: &Model, sizes: &TableSizes, groups_info: &ScatteringGroups) -
     // Per constituent: info (first layer, layer count, group or −1), scattering, extinction.
     let constituent_offset = data.len() / 4;
     let mut first_layer = 0usize;
-    for (c, group) in model.constituents.iter().zip(&groups_info.of_constituent) {
-        let group = group.map_or(-1.0, |x| x as f32);
+    for c in &model.constituents {
+        let group = ScatteringGroups::group_of(c).map_or(-1.0, |x| x as f32);
         data.extend_from_slice(&[
             first_layer as f32,
             c.density.layers.len() as f32,
@@ -178,8 +113,8 @@ pub fn pack(model: &Model, sizes: &TableSizes, groups_info: &ScatteringGroups) -
             ]);
         }
     }
-    let phase0 = pack_phase(&groups_info.phase[0], &mut data);
-    let phase1 = pack_phase(&groups_info.phase[1], &mut data);
+    let phase0 = pack_phase(&groups_info.phase[MOLECULES], &mut data);
+    let phase1 = pack_phase(&groups_info.phase[AEROSOLS], &mut data);
 
     let f = |x: f64| (x as f32).to_bits();
     let u = |x: usize| x as u32;
@@ -209,8 +144,8 @@ pub fn pack(model: &Model, sizes: &TableSizes, groups_info: &ScatteringGroups) -
     ];
     uniform.extend_from_slice(&phase0);
     uniform.extend_from_slice(&phase1);
-    uniform.push(groups_info.present[0] as u32);
-    uniform.push(groups_info.present[1] as u32);
+    uniform.push(groups_info.present(MOLECULES) as u32);
+    uniform.push(groups_info.present(AEROSOLS) as u32);
     while !uniform.len().is_multiple_of(4) {
         uniform.push(0);
     }
@@ -226,12 +161,11 @@ mod tests {
     #[test]
     fn uniform_has_the_shader_struct_size() {
         let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
-        let groups_info = ScatteringGroups::new(&model);
-        let p = pack(&model, &TableSizes::small(), &groups_info);
+        let p = pack(&model, &TableSizes::small());
         // 36 fields of the WGSL `Atmosphere` struct.
         assert_eq!(p.uniform.len(), 36);
         assert_eq!(p.data.len() % 4, 0);
-        assert!(groups_info.present[0]);
+        assert!(model.groups.present(MOLECULES));
     }
 
     #[test]

@@ -1,15 +1,14 @@
 // Multiple scattering ΔS of order n from ΔJ (paper eq. 12, Bruneton 2017
-// `ComputeMultipleScattering`; lut::precompute::compute_multiple_scattering): 50 intervals
-// along the view ray with the exponentially fitted Simpson rule (Filon-type, functions.wgsl
-// `exponential_simpson_weights`), pair of intervals by pair. ΔJ is looked up at each sample
-// with u_ν from (μ, μ_s) at that sample (params::u_nu: the azimuth relative to the range
-// of ν there). Adds ΔS, as radiance, to the multiple-scattering sum (`Tables::multiple`;
-// not divided by a phase function). Reads ΔJ at slot a.
+// `ComputeMultipleScattering`; Rust twin precompute/multiple_scattering.rs,
+// `compute_multiple_scattering`): RAY_INTERVALS intervals along the view ray with the
+// exponentially fitted Simpson rule (ray.wgsl `exponential_simpson_weights`), pair of
+// intervals by pair. ΔJ is looked up at each sample with u_ν from (μ, μ_s) at that sample
+// (params::u_nu: the azimuth relative to the range of ν there). Adds ΔS, as radiance, to
+// the multiple-scattering sum (`Tables::multiple`; not divided by a phase function). Reads
+// ΔJ at slot a.
 
 @group(0) @binding(7) var<storage, read_write> delta_multiple_out: array<vec4<f32>>;
 @group(0) @binding(8) var<storage, read_write> multiple_sum: array<vec4<f32>>;
-
-const RAY_INTERVALS: u32 = 50u;
 
 // One ray sample: the transmittance from the ray origin, the total β_s·T (which the
 // quadrature's exponential fit follows: ΔJ is β_s times a smooth field) and ΔJ there.
@@ -19,19 +18,19 @@ struct MultipleSample {
     j: vec4<f32>,
 }
 
-fn multiple_sample(t: ScatteringTexel, d: f32, k: u32) -> MultipleSample {
-    let rho_d = rho_at(t.r, t.rho, t.mu, d);
-    let r_d = radius_from_rho(rho_d);
-    let mu_d = clamp_cosine((t.r * t.mu + d) / r_d);
-    let uvwz = scattering_uvwz(r_d, rho_d, mu_d, 0.0, 0.0, t.ground);
-    let mu_s_d = clamp_cosine((t.r * t.mu_s + d * t.nu) / r_d);
+fn multiple_sample(t: ScatteringTexel, d_km: f32, k: u32) -> MultipleSample {
+    let rho_d_km = rho_at(t.r_km, t.rho_km, t.mu, d_km);
+    let r_d_km = radius_from_rho(rho_d_km);
+    let mu_d = clamp_cosine((t.r_km * t.mu + d_km) / r_d_km);
+    let uvwz = scattering_uvwz(r_d_km, rho_d_km, mu_d, 0.0, 0.0, t.ground);
+    let mu_s_d = clamp_cosine((t.r_km * t.mu_s + d_km * t.nu) / r_d_km);
     let u_mu_s = texcoord_from_unit(x_mu_s(mu_s_d), atm.scattering_mu_s);
     let u_nu = u_nu_from_nu(mu_d, mu_s_d, t.nu);
     let f = scattering_filter_rows(u_nu, u_mu_s, lerp_weights(uvwz.z, atm.scattering_mu), lerp_weights(uvwz.w, atm.scattering_r));
     var s: MultipleSample;
-    s.t = transmittance(t.r, t.rho, t.mu, d, t.ground, k);
-    let altitude = altitude_of(rho_d, r_d);
-    s.f = (group_scattering(0u, altitude, k) + group_scattering(1u, altitude, k)) * s.t;
+    s.t = transmittance(t.r_km, t.rho_km, t.mu, d_km, t.ground, k);
+    let altitude_km = altitude_of(rho_d_km, r_d_km);
+    s.f = (group_scattering(0u, altitude_km, k) + group_scattering(1u, altitude_km, k)) * s.t;
     s.j = sample_scattering_a(f, k);
     return s;
 }
@@ -48,26 +47,26 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let y = (i / width) % atm.scattering_mu;
     let z = i / (width * atm.scattering_mu);
     let t = scattering_texel(x, y, z);
-    var ray_length: f32;
+    var ray_length_km: f32;
     if (t.ground) {
-        ray_length = distance_to_bottom(t.r, t.rho, t.mu);
+        ray_length_km = distance_to_bottom(t.r_km, t.rho_km, t.mu);
     } else {
-        ray_length = distance_to_top(t.r, t.rho, t.mu);
+        ray_length_km = distance_to_top(t.r_km, t.rho_km, t.mu);
     }
-    let dx = ray_length / f32(RAY_INTERVALS);
+    let dx_km = ray_length_km / f32(RAY_INTERVALS);
     var acc = vec4<f32>(0.0);
     // Samples 2p, 2p + 1, 2p + 2 of pair p; the last is the next pair's first.
     var s0 = multiple_sample(t, 0.0, k);
     for (var p = 0u; p < RAY_INTERVALS / 2u; p++) {
-        let s1 = multiple_sample(t, f32(2u * p + 1u) * dx, k);
-        let s2 = multiple_sample(t, f32(2u * p + 2u) * dx, k);
+        let s1 = multiple_sample(t, f32(2u * p + 1u) * dx_km, k);
+        let s2 = multiple_sample(t, f32(2u * p + 2u) * dx_km, k);
         let w = exponential_simpson_weights(s0.t, s1.t, s2.t, s0.f, s1.f, s2.f);
         acc += w.w0 * s0.j + w.w1 * s1.j + w.w2 * s2.j;
         s0 = s2;
     }
     // Clamped at 0 as on the CPU (a negative end weight can take a sum below zero).
     let o = i * atm.groups + k;
-    let delta = max(acc * dx, vec4<f32>(0.0));
+    let delta = max(acc * dx_km, vec4<f32>(0.0));
     delta_multiple_out[o] = delta;
     multiple_sum[o] += delta;
 }

@@ -1,6 +1,7 @@
-// Per-row sums of one scattering order's radiance (for `Tables::order_means`): order 1 sums
-// the single-scattering tables with the phase functions at each texel's ν
-// (lut::precompute::table_mean_radiance), order n ≥ 2 sums ΔS. Slots a and b.
+// Per-row sums of one scattering order's radiance (for `Tables::order_means`; Rust twin
+// precompute/order_tail.rs, `table_mean_radiance` and `table_mean`): order 1 sums the
+// single-scattering tables with the phase functions at each texel's ν, order n ≥ 2 sums
+// ΔS. Slots a and b.
 
 @group(0) @binding(7) var<storage, read_write> row_sums: array<vec4<f32>>;
 

@@ -1,5 +1,6 @@
 //! The precomputation of Bruneton & Neyret 2008 Algorithm 4.1 on the GPU, pass for pass as
-//! `firmament::lut::precompute` does it on the CPU: transmittance, direct irradiance, single
+//! `firmament::sky::bruneton4d::precompute` does it on the CPU (each pass's WGSL file,
+//! `shaders/bruneton4d/precompute/`, is named like the CPU pass it mirrors): transmittance, direct irradiance, single
 //! scattering (Rayleigh and Mie apart), then for each order n ≥ 2 the scattering density ΔJ
 //! (the same spherical convolution in azimuth as the CPU: the incident field's cosine series
 //! convolved with the phase functions' harmonics), the indirect irradiance ΔE and the multiple
@@ -8,39 +9,47 @@
 //!
 //! Tables live in storage buffers (not textures) with the CPU's texel order and the channels
 //! in groups of four (one vec4 per group): filtering is done in the shaders with exact f32
-//! weights, as `firmament::lut::table` does, so CPU and GPU compare texel by texel.
-
-pub mod atmosphere;
-pub(crate) mod passes;
+//! weights, as `firmament::sky::bruneton4d::table` does, so CPU and GPU compare texel by
+//! texel.
 
 use firmament::atmosphere::Model;
+use firmament::sky::bruneton4d::precompute::{DENSITY_THETA, HARMONICS};
 use firmament::sky::bruneton4d::{MieStorage, Table2, Table4, TableConfig, Tables};
 
+use super::atmosphere::{self, groups, GROUP};
+use crate::device::{check_buffers, f32s, read_back, scoped, staging_buffer};
+use crate::passes::{self, dispatch, init, storage, Pass, Slot};
+use crate::shader::{self, precompute_source};
 use crate::{GpuContext, GpuError};
-use atmosphere::{groups, ScatteringGroups, GROUP};
-use passes::{dispatch, init, storage, Pass, Slot};
 
-/// Incident zeniths, azimuth harmonics of the scattering density (lut::precompute).
-const DENSITY_THETA: usize = 32;
-const HARMONICS: usize = 16;
 /// Storage buffers bound at once by the widest pass (the density field).
 const STORAGE_BUFFERS_NEEDED: u32 = 6;
 
-/// The tables as the precomputation leaves them on the device: channel groups padded to
-/// vec4, single Mie in full even for [`MieStorage::RedOnly`] (the host keeps channel 0), and
-/// the packed atmosphere they were computed with.
-pub(crate) struct DeviceTables {
+/// The tables on the device, as the precomputation leaves them (or as uploaded from CPU
+/// tables): storage buffers of `vec4<f32>` with the CPU's texel order (`firmament::sky::
+/// bruneton4d::table`) and the channels in groups of four (channel group k of texel i at
+/// index i·groups + k, padding lanes zero), bound by the render shader at the slots
+/// `shaders/bruneton4d/view.wgsl` lists.
+pub struct GpuTables {
+    /// The `Atmosphere` uniform (binding 0; `shaders/common/types.wgsl`).
     pub atmosphere: wgpu::Buffer,
+    /// Per-wavelength data, constituents, layers, tabulated phases (binding 2).
     pub data: wgpu::Buffer,
-    /// Optical depth τ = −ln T to the top (what the lookups read; `Tables::optical_depth`).
+    /// Optical depth τ = −ln T to the top, what the lookups read (binding 3;
+    /// `Tables::optical_depth`).
     pub transmittance: wgpu::Buffer,
+    /// Indirect ground irradiance E(r, μ_s) (binding 4; `Tables::irradiance`).
     pub irradiance: wgpu::Buffer,
-    /// Single molecular scattering (`Tables::scattering`).
-    pub scattering: wgpu::Buffer,
+    /// Single Rayleigh scattering (binding 5; `Tables::single_rayleigh`).
+    pub single_rayleigh: wgpu::Buffer,
+    /// Single Mie scattering (binding 6; `Tables::single_mie`): every channel, or for
+    /// red-only storage channel 0 of each texel in the full layout (GPU precomputation) or
+    /// one vec4 per texel (uploaded CPU tables).
     pub single_mie: wgpu::Buffer,
-    /// Orders ≥ 2 summed, radiance (`Tables::multiple`; zeros for one order).
+    /// Orders ≥ 2 summed, radiance (binding 7; `Tables::multiple`; zeros for one order).
     pub multiple: wgpu::Buffer,
-    pub row_sums: wgpu::Buffer,
+    /// Per-order row sums (for `Tables::order_means`).
+    pub(crate) row_sums: wgpu::Buffer,
 }
 
 /// Compiled pipelines, reusable across precomputations on one context.
@@ -58,47 +67,6 @@ pub struct Precomputer {
     order_tail: Pass,
 }
 
-/// Precompute every table for `model` on the GPU; the result has the CPU's layout
-/// ([`Tables::compute`]).
-pub fn precompute(
-    ctx: &GpuContext,
-    model: &Model,
-    config: &TableConfig,
-) -> Result<Tables, GpuError> {
-    let p = Precomputer::new(ctx)?;
-    p.run(ctx, model, config)
-}
-
-/// Run `f` inside validation, out-of-memory and internal error scopes; the first error
-/// reported (or reported to the uncaptured handler, or a device loss) becomes `Err`.
-pub(crate) fn scoped<T>(
-    ctx: &GpuContext,
-    during: &str,
-    f: impl FnOnce() -> Result<T, GpuError>,
-) -> Result<T, GpuError> {
-    let device = ctx.device();
-    let internal = device.push_error_scope(wgpu::ErrorFilter::Internal);
-    let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-    let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let result = f();
-    let errors = [
-        pollster::block_on(validation.pop()),
-        pollster::block_on(oom.pop()),
-        pollster::block_on(internal.pop()),
-    ];
-    let execution = |reason: String| GpuError::Execution {
-        during: during.to_string(),
-        reason,
-    };
-    if let Some(e) = errors.into_iter().flatten().next() {
-        return Err(execution(e.to_string()));
-    }
-    if let Some(reason) = ctx.take_reported_errors() {
-        return Err(execution(reason));
-    }
-    result
-}
-
 impl Precomputer {
     /// Compile the passes.
     pub fn new(ctx: &GpuContext) -> Result<Precomputer, GpuError> {
@@ -109,201 +77,97 @@ impl Precomputer {
                 transmittance: Pass::new(
                     d,
                     "transmittance",
-                    include_str!("../../shaders/transmittance.wgsl"),
+                    precompute_source(shader::passes::TRANSMITTANCE),
                     &[(7, Write)],
                 ),
                 direct_irradiance: Pass::new(
                     d,
                     "direct_irradiance",
-                    include_str!("../../shaders/direct_irradiance.wgsl"),
+                    precompute_source(shader::passes::DIRECT_IRRADIANCE),
                     &[(3, Read), (7, Write), (8, Write)],
                 ),
                 single_scattering: Pass::new(
                     d,
                     "single_scattering",
-                    include_str!("../../shaders/single_scattering.wgsl"),
+                    precompute_source(shader::passes::SINGLE_SCATTERING),
                     &[(3, Read), (7, Write), (8, Write)],
                 ),
                 phase_kernels: Pass::new(
                     d,
                     "phase_kernels",
-                    include_str!("../../shaders/phase_kernels.wgsl"),
+                    precompute_source(shader::passes::PHASE_KERNELS),
                     &[(7, Write)],
                 ),
                 density_field: Pass::new(
                     d,
                     "scattering_density_field",
-                    include_str!("../../shaders/scattering_density_field.wgsl"),
+                    precompute_source(shader::passes::SCATTERING_DENSITY_FIELD),
                     &[(3, Read), (4, Read), (5, Read), (6, Read), (7, Write)],
                 ),
                 scattering_density: Pass::new(
                     d,
                     "scattering_density",
-                    include_str!("../../shaders/scattering_density.wgsl"),
+                    precompute_source(shader::passes::SCATTERING_DENSITY),
                     &[(7, Read), (8, Read), (9, Write)],
                 ),
                 indirect_irradiance: Pass::new(
                     d,
                     "indirect_irradiance",
-                    include_str!("../../shaders/indirect_irradiance.wgsl"),
+                    precompute_source(shader::passes::INDIRECT_IRRADIANCE),
                     &[(5, Read), (6, Read), (7, Write), (8, Write)],
                 ),
                 multiple_scattering: Pass::new(
                     d,
                     "multiple_scattering",
-                    include_str!("../../shaders/multiple_scattering.wgsl"),
+                    precompute_source(shader::passes::MULTIPLE_SCATTERING),
                     &[(3, Read), (5, Read), (7, Write), (8, Write)],
                 ),
                 order_sums: Pass::new(
                     d,
                     "order_sums",
-                    include_str!("../../shaders/order_sums.wgsl"),
+                    precompute_source(shader::passes::ORDER_SUMS),
                     &[(5, Read), (6, Read), (7, Write)],
                 ),
                 order_tail_factors: Pass::new(
                     d,
                     "order_tail_factors",
-                    include_str!("../../shaders/order_tail_factors.wgsl"),
+                    precompute_source(shader::passes::ORDER_TAIL_FACTORS),
                     &[(5, Read), (7, Write)],
                 ),
                 order_tail: Pass::new(
                     d,
                     "order_tail",
-                    include_str!("../../shaders/order_tail.wgsl"),
+                    precompute_source(shader::passes::ORDER_TAIL),
                     &[(4, Read), (5, Read), (6, Read), (7, Write), (8, Write)],
                 ),
             })
         })
     }
 
-    /// Precompute every table for `model` with these pipelines.
+    /// Precompute every table for `model` with these pipelines and read them back: the
+    /// CPU's layout ([`Tables::compute`]).
     pub fn run(
         &self,
         ctx: &GpuContext,
         model: &Model,
         config: &TableConfig,
     ) -> Result<Tables, GpuError> {
-        let tables = self.run_on_device(ctx, model, config)?;
-        let n = model.channels();
-        let s = config.sizes;
-        let g = groups(n);
-        let orders = config.orders;
-        let t_texels = s.transmittance_mu * s.transmittance_r;
-        let e_texels = s.irradiance_mu_s * s.irradiance_r;
-        let s_texels = s.scattering_r * s.scattering_mu * s.scattering_mu_s * s.scattering_nu;
-        let rows = s.scattering_r * s.scattering_mu;
-        let groups_info = ScatteringGroups::new(model);
-        let device = ctx.device();
-        let staging = scoped(ctx, "table precomputation", || {
-            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("firmament tables readback"),
-            });
-            let sources = [
-                &tables.transmittance,
-                &tables.irradiance,
-                &tables.scattering,
-                &tables.single_mie,
-                &tables.multiple,
-                &tables.row_sums,
-            ];
-            let staging: Vec<wgpu::Buffer> = sources
-                .iter()
-                .map(|src| {
-                    let b = device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("readback"),
-                        size: src.size(),
-                        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                        mapped_at_creation: false,
-                    });
-                    encoder.copy_buffer_to_buffer(src, 0, &b, 0, src.size());
-                    b
-                })
-                .collect();
-            ctx.queue().submit([encoder.finish()]);
-            Ok(staging)
-        })?;
-        let values = scoped(ctx, "reading the tables back", || read_back(ctx, &staging))?;
-        let [t_data, e_data, s_data, m_data, multiple_data, rows_data] =
-            <[Vec<f32>; 6]>::try_from(values).expect("six buffers");
-        let unpad = |v: &[f32], texels: usize| -> Vec<f32> {
-            let mut out = Vec::with_capacity(texels * n);
-            for t in 0..texels {
-                out.extend_from_slice(&v[t * g * GROUP..t * g * GROUP + n]);
-            }
-            out
-        };
-        let optical_depth = Table2 {
-            width: s.transmittance_mu,
-            height: s.transmittance_r,
-            channels: n,
-            data: unpad(&t_data, t_texels),
-        };
-        let irradiance = Table2 {
-            width: s.irradiance_mu_s,
-            height: s.irradiance_r,
-            channels: n,
-            data: unpad(&e_data, e_texels),
-        };
-        let table4 = |data: Vec<f32>, channels: usize| Table4 {
-            nr: s.scattering_r,
-            nmu: s.scattering_mu,
-            nmu_s: s.scattering_mu_s,
-            nnu: s.scattering_nu,
-            channels,
-            data,
-        };
-        let scattering = table4(unpad(&s_data, s_texels), n);
-        let single_mie = match config.mie {
-            MieStorage::Separate => table4(unpad(&m_data, s_texels), n),
-            MieStorage::RedOnly => {
-                table4((0..s_texels).map(|t| m_data[t * g * GROUP]).collect(), 1)
-            }
-        };
-        let order_means = (0..orders)
-            .map(|o| {
-                let mut sum = vec![0.0f64; n];
-                for row in 0..rows {
-                    let base = ((o * rows + row) * g) * GROUP;
-                    for (k, acc) in sum.iter_mut().enumerate() {
-                        *acc += rows_data[base + k] as f64;
-                    }
-                }
-                sum.iter().map(|v| v / s_texels as f64).collect()
-            })
-            .collect();
-        Ok(Tables {
-            config: *config,
-            wavelengths_nm: model.wavelengths.nm().to_vec(),
-            atmosphere_hash: model.hash,
-            transmittance: optical_depth.transmittance_of_optical_depth(),
-            optical_depth,
-            irradiance,
-            single_rayleigh: scattering,
-            single_mie,
-            order_means,
-            mie_ratio: groups_info.mie_ratio(),
-            multiple: table4(unpad(&multiple_data, s_texels), n),
-        })
+        self.run_on_device(ctx, model, config)?
+            .read_back(ctx, model, config)
     }
 
     /// Precompute every table for `model` and leave them on the device (submitted, not
-    /// waited for): the buffers [`crate::GpuSky::precompute`] renders from.
-    pub(crate) fn run_on_device(
+    /// waited for): the buffers [`crate::GpuSky::precompute`] renders from, or an engine
+    /// binds itself; [`GpuTables::read_back`] brings them to the host.
+    pub fn run_on_device(
         &self,
         ctx: &GpuContext,
         model: &Model,
         config: &TableConfig,
-    ) -> Result<DeviceTables, GpuError> {
+    ) -> Result<GpuTables, GpuError> {
         config.validate()?;
         let n = model.channels();
-        if n > 64 {
-            return Err(firmament::Error::invalid(
-                "wavelengths",
-                n,
-                "at most 64 wavelengths for the precomputed tables",
-            )
-            .into());
-        }
+        firmament::spectrum::check_channels(n, "the precomputed tables")?;
         let s = config.sizes;
         let g = groups(n);
         let orders = config.orders;
@@ -331,8 +195,7 @@ impl Precomputer {
             s_texels,
         )?;
 
-        let groups_info = ScatteringGroups::new(model);
-        let packed = atmosphere::pack(model, &s, &groups_info);
+        let packed = atmosphere::pack(model, &s);
         let max_dim = ctx.limits().max_compute_workgroups_per_dimension;
         let device = ctx.device();
 
@@ -533,12 +396,12 @@ impl Precomputer {
                 }
             }
             ctx.queue().submit([encoder.finish()]);
-            Ok(DeviceTables {
+            Ok(GpuTables {
                 atmosphere: atm,
                 data,
                 transmittance,
                 irradiance,
-                scattering: rayleigh,
+                single_rayleigh: rayleigh,
                 single_mie: mie,
                 multiple,
                 row_sums,
@@ -580,71 +443,107 @@ impl Precomputer {
     }
 }
 
-/// Refuse storage buffers larger than the device binds or allocates, before allocating
-/// anything: (what, bytes) each.
-pub(crate) fn check_buffers(ctx: &GpuContext, buffers: &[(&str, u64)]) -> Result<(), GpuError> {
-    let limits = ctx.limits();
-    for &(what, bytes) in buffers {
-        for (limit, name) in [
-            (
-                limits.max_storage_buffer_binding_size,
-                "max_storage_buffer_binding_size",
-            ),
-            (limits.max_buffer_size, "max_buffer_size"),
-        ] {
-            if bytes > limit {
-                return Err(GpuError::Limit {
-                    what: format!("the {what}"),
-                    needed: format!("{bytes} bytes"),
-                    limit: format!("{limit} bytes"),
-                    limit_name: name,
-                    adapter: ctx.adapter_name().to_string(),
-                });
+impl GpuTables {
+    /// Read the tables back into the CPU's layout (for files and CPU lookups): waits for the
+    /// precomputation. `model` and `config` are the ones they were computed with.
+    pub fn read_back(
+        &self,
+        ctx: &GpuContext,
+        model: &Model,
+        config: &TableConfig,
+    ) -> Result<Tables, GpuError> {
+        let n = model.channels();
+        let s = config.sizes;
+        let g = groups(n);
+        let orders = config.orders;
+        let t_texels = s.transmittance_mu * s.transmittance_r;
+        let e_texels = s.irradiance_mu_s * s.irradiance_r;
+        let s_texels = s.scattering_r * s.scattering_mu * s.scattering_mu_s * s.scattering_nu;
+        let rows = s.scattering_r * s.scattering_mu;
+        let device = ctx.device();
+        let sources = [
+            &self.transmittance,
+            &self.irradiance,
+            &self.single_rayleigh,
+            &self.single_mie,
+            &self.multiple,
+            &self.row_sums,
+        ];
+        let staging = scoped(ctx, "table precomputation", || {
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("firmament tables readback"),
+            });
+            let staging: Vec<wgpu::Buffer> = sources
+                .iter()
+                .map(|src| {
+                    let b = staging_buffer(device, "readback", src.size());
+                    encoder.copy_buffer_to_buffer(src, 0, &b, 0, src.size());
+                    b
+                })
+                .collect();
+            ctx.queue().submit([encoder.finish()]);
+            Ok(staging)
+        })?;
+        let during = "reading the tables back";
+        let bytes = scoped(ctx, during, || {
+            read_back(ctx, &staging.iter().collect::<Vec<_>>(), during)
+        })?;
+        let values: Vec<Vec<f32>> = bytes.iter().map(|b| f32s(b)).collect();
+        let [t_data, e_data, s_data, m_data, multiple_data, rows_data] =
+            <[Vec<f32>; 6]>::try_from(values).expect("six buffers");
+        let unpad = |v: &[f32], texels: usize| -> Vec<f32> {
+            let mut out = Vec::with_capacity(texels * n);
+            for t in 0..texels {
+                out.extend_from_slice(&v[t * g * GROUP..t * g * GROUP + n]);
             }
-        }
+            out
+        };
+        let optical_depth = Table2 {
+            width: s.transmittance_mu,
+            height: s.transmittance_r,
+            channels: n,
+            data: unpad(&t_data, t_texels),
+        };
+        let irradiance = Table2 {
+            width: s.irradiance_mu_s,
+            height: s.irradiance_r,
+            channels: n,
+            data: unpad(&e_data, e_texels),
+        };
+        let table4 = |data: Vec<f32>, channels: usize| Table4 {
+            data,
+            ..Table4::for_sizes(&s, channels)
+        };
+        let single_mie = match config.mie {
+            MieStorage::Separate => table4(unpad(&m_data, s_texels), n),
+            MieStorage::RedOnly => {
+                table4((0..s_texels).map(|t| m_data[t * g * GROUP]).collect(), 1)
+            }
+        };
+        let order_means = (0..orders)
+            .map(|o| {
+                let mut sum = vec![0.0f64; n];
+                for row in 0..rows {
+                    let base = ((o * rows + row) * g) * GROUP;
+                    for (k, acc) in sum.iter_mut().enumerate() {
+                        *acc += rows_data[base + k] as f64;
+                    }
+                }
+                sum.iter().map(|v| v / s_texels as f64).collect()
+            })
+            .collect();
+        Ok(Tables {
+            config: *config,
+            wavelengths_nm: model.wavelengths.nm().to_vec(),
+            atmosphere_hash: model.hash,
+            transmittance: optical_depth.transmittance_of_optical_depth(),
+            optical_depth,
+            irradiance,
+            single_rayleigh: table4(unpad(&s_data, s_texels), n),
+            single_mie,
+            order_means,
+            mie_ratio: model.groups.mie_ratio(),
+            multiple: table4(unpad(&multiple_data, s_texels), n),
+        })
     }
-    Ok(())
-}
-
-/// Map the staging buffers, wait for the device, and copy their contents out as f32.
-pub(crate) fn read_back(
-    ctx: &GpuContext,
-    staging: &[wgpu::Buffer],
-) -> Result<Vec<Vec<f32>>, GpuError> {
-    let (tx, rx) = std::sync::mpsc::channel();
-    for (i, b) in staging.iter().enumerate() {
-        let tx = tx.clone();
-        b.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send((i, r));
-        });
-    }
-    drop(tx);
-    let failure = |reason: String| GpuError::Execution {
-        during: "reading the tables back".into(),
-        reason,
-    };
-    ctx.device()
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| failure(e.to_string()))?;
-    for _ in 0..staging.len() {
-        let (_, r) = rx
-            .recv()
-            .map_err(|_| failure("the device never finished mapping the tables".into()))?;
-        r.map_err(|e| failure(e.to_string()))?;
-    }
-    let mut out = Vec::with_capacity(staging.len());
-    for b in staging {
-        let view = b
-            .slice(..)
-            .get_mapped_range()
-            .map_err(|e| failure(e.to_string()))?;
-        out.push(
-            view.chunks_exact(4)
-                .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-                .collect(),
-        );
-        drop(view);
-        b.unmap();
-    }
-    Ok(out)
 }

@@ -1,14 +1,12 @@
 // Single scattering (Bruneton & Neyret 2008 eq. 7; Bruneton 2017 `ComputeSingleScattering`;
-// lut::precompute::compute_single_scattering): Rayleigh and Mie integrated apart without
-// phase functions, 50 intervals along the view ray with the exponentially fitted Simpson
-// rule (Filon-type, functions.wgsl `exponential_simpson_weights`), pair of intervals by
-// pair. The Rayleigh part is also the final `Tables::scattering` (multiple scattering is
-// summed apart, multiple_scattering.wgsl).
+// Rust twin precompute/single_scattering.rs, `compute_single_scattering`): Rayleigh and Mie
+// integrated apart without phase functions, RAY_INTERVALS intervals along the view ray with
+// the exponentially fitted Simpson rule (ray.wgsl `exponential_simpson_weights`), pair of
+// intervals by pair. The Rayleigh part is also the final `Tables::single_rayleigh`
+// (multiple scattering is summed apart, multiple_scattering.wgsl).
 
 @group(0) @binding(7) var<storage, read_write> rayleigh_out: array<vec4<f32>>;
 @group(0) @binding(8) var<storage, read_write> mie_out: array<vec4<f32>>;
-
-const RAY_INTERVALS: u32 = 50u;
 
 // One ray sample: the transmittance from the ray origin, and the Rayleigh and Mie
 // integrands without it (β_s times the transmittance to the sun).
@@ -21,16 +19,16 @@ struct SingleSample {
     g_m: vec4<f32>,
 }
 
-fn single_sample(t: ScatteringTexel, d: f32, k: u32) -> SingleSample {
-    let rho_d = rho_at(t.r, t.rho, t.mu, d);
-    let r_d = radius_from_rho(rho_d);
-    let mu_s_d = clamp_cosine((t.r * t.mu_s + d * t.nu) / r_d);
-    let sun = transmittance_to_sun(r_d, rho_d, mu_s_d, k);
-    let altitude = altitude_of(rho_d, r_d);
+fn single_sample(t: ScatteringTexel, d_km: f32, k: u32) -> SingleSample {
+    let rho_d_km = rho_at(t.r_km, t.rho_km, t.mu, d_km);
+    let r_d_km = radius_from_rho(rho_d_km);
+    let mu_s_d = clamp_cosine((t.r_km * t.mu_s + d_km * t.nu) / r_d_km);
+    let sun = transmittance_to_sun(r_d_km, rho_d_km, mu_s_d, k);
+    let altitude_km = altitude_of(rho_d_km, r_d_km);
     var s: SingleSample;
-    s.t = transmittance(t.r, t.rho, t.mu, d, t.ground, k);
-    let beta_r = group_scattering(0u, altitude, k);
-    let beta_m = group_scattering(1u, altitude, k);
+    s.t = transmittance(t.r_km, t.rho_km, t.mu, d_km, t.ground, k);
+    let beta_r = group_scattering(0u, altitude_km, k);
+    let beta_m = group_scattering(1u, altitude_km, k);
     s.f_r = beta_r * s.t;
     s.f_m = beta_m * s.t;
     s.g_r = sun * beta_r;
@@ -50,20 +48,20 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let y = (i / width) % atm.scattering_mu;
     let z = i / (width * atm.scattering_mu);
     let t = scattering_texel(x, y, z);
-    var ray_length: f32;
+    var ray_length_km: f32;
     if (t.ground) {
-        ray_length = distance_to_bottom(t.r, t.rho, t.mu);
+        ray_length_km = distance_to_bottom(t.r_km, t.rho_km, t.mu);
     } else {
-        ray_length = distance_to_top(t.r, t.rho, t.mu);
+        ray_length_km = distance_to_top(t.r_km, t.rho_km, t.mu);
     }
-    let dx = ray_length / f32(RAY_INTERVALS);
+    let dx_km = ray_length_km / f32(RAY_INTERVALS);
     var acc_r = vec4<f32>(0.0);
     var acc_m = vec4<f32>(0.0);
     // Samples 2p, 2p + 1, 2p + 2 of pair p; the last is the next pair's first.
     var s0 = single_sample(t, 0.0, k);
     for (var p = 0u; p < RAY_INTERVALS / 2u; p++) {
-        let s1 = single_sample(t, f32(2u * p + 1u) * dx, k);
-        let s2 = single_sample(t, f32(2u * p + 2u) * dx, k);
+        let s1 = single_sample(t, f32(2u * p + 1u) * dx_km, k);
+        let s2 = single_sample(t, f32(2u * p + 2u) * dx_km, k);
         let w_r = exponential_simpson_weights(s0.t, s1.t, s2.t, s0.f_r, s1.f_r, s2.f_r);
         let w_m = exponential_simpson_weights(s0.t, s1.t, s2.t, s0.f_m, s1.f_m, s2.f_m);
         acc_r += w_r.w0 * s0.g_r + w_r.w1 * s1.g_r + w_r.w2 * s2.g_r;
@@ -72,7 +70,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     // Clamped at 0 as on the CPU: the fitted rule's end weight is negative for a pair with
     // Δτ > 2.9, so a sum can round below zero.
-    let e = solar_irradiance(k) * dx;
+    let e = solar_irradiance(k) * dx_km;
     let o = i * atm.groups + k;
     rayleigh_out[o] = max(acc_r * e, vec4<f32>(0.0));
     mie_out[o] = max(acc_m * e, vec4<f32>(0.0));

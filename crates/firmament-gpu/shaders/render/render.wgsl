@@ -1,0 +1,115 @@
+// A frame, one invocation per pixel (firmament::render, Shader::shade): the ray through the
+// pixel (camera.wgsl) meets the planet's ground, lit by each light and the sky and seen
+// through aerial perspective, or goes to the sky and the lights' disks; every piece comes
+// from the sky method's functions (bruneton4d/view.wgsl), summed over the lights and the
+// channel groups into linear sRGB. An optional per-pixel shadowed length (paper eq. 17–18:
+// from shadow volumes or a shadow map) leaves the light shafts out.
+
+// Per-frame constants (firmament_gpu::render::FrameConstants writes them in this order).
+struct Frame {
+    width: u32,
+    height: u32,
+    // This dispatch covers rows first_row .. first_row + rows (frames too large for one
+    // storage binding are drawn in bands).
+    first_row: u32,
+    rows: u32,
+    // 0 perspective, 1 fisheye, 2 equirect, 3 cubemap, 4 orbit (camera::Projection).
+    projection: u32,
+    lights: u32,
+    // Whether a per-pixel shadowed length is bound (shadow_lengths, metres).
+    shadow_input: u32,
+    // Single Mie storage (View.mie_layout).
+    mie_layout: u32,
+    // View basis of the pinhole projections (PreparedCamera), local frame x east, y north, z up.
+    forward: vec4<f32>,
+    right: vec4<f32>,
+    up: vec4<f32>,
+    // White-balance factors per linear sRGB channel (1 when off).
+    balance: vec4<f32>,
+    // The observer: radius, ρ = sqrt(r² − R_g²) (inside the atmosphere) and r − R_t (km), and
+    // whether it is inside the atmosphere.
+    camera_r_km: f32,
+    camera_rho_km: f32,
+    camera_above_top_km: f32,
+    inside: u32,
+    tan_half_fov: f32,
+    pad0: f32,
+    pad1: f32,
+    pad2: f32,
+}
+
+@group(0) @binding(10) var<uniform> frame: Frame;
+// The shadowed length of each pixel (m), when frame.shadow_input is set.
+@group(0) @binding(16) var shadow_lengths: texture_2d<f32>;
+
+fn observer() -> Observer {
+    var o: Observer;
+    o.inside = frame.inside != 0u;
+    o.r_km = frame.camera_r_km;
+    o.rho_km = frame.camera_rho_km;
+    o.above_top_km = frame.camera_above_top_km;
+    return o;
+}
+
+// ColourMatrix::to_srgb of channel group k.
+fn to_srgb(l: vec4<f32>, k: u32) -> vec3<f32> {
+    let base = k * CHANNEL_STRIDE + CHANNEL_SRGB;
+    return vec3<f32>(dot(view_constants[base], l), dot(view_constants[base + 1u], l), dot(view_constants[base + 2u], l));
+}
+
+// Shader::shade for one ray, summed to linear sRGB over the lights and channel groups.
+fn shade(dir: vec3<f32>, shadow_length_km: f32) -> vec3<f32> {
+    let o = observer();
+    var v: View;
+    v.mie_layout = frame.mie_layout;
+    var rgb = vec3<f32>(0.0);
+    for (var light = 0u; light < frame.lights; light++) {
+        let vl = view_light(light);
+        let g = ground_ray(v, o, vl, dir, shadow_length_km);
+        if (g.hit) {
+            // The ground lit by the light and the sky, seen through aerial perspective.
+            let gl = ground_light(vl, g.mu_s_ground);
+            for (var k = 0u; k < atm.groups; k++) {
+                let scale = light_scale(light, k);
+                let t = transmittance_to_point(g, k);
+                let e = sun_and_sky_irradiance(gl, k);
+                let direct = e.direct * light_irradiance(light, k);
+                let l = sky_radiance_to_point(v, g, k) * scale
+                    + ground_albedo(k) / PI * (direct + e.sky * scale) * t;
+                rgb += to_srgb(l, k);
+            }
+            continue;
+        }
+        // The sky, and the light's disk through the air (never towards the ground).
+        let s = sky_ray(v, o, vl, dir, shadow_length_km);
+        let disk = light_disk(light, dir);
+        for (var k = 0u; k < atm.groups; k++) {
+            var l = sky_radiance(v, s, k) * light_scale(light, k);
+            if (disk.inside) {
+                l += disk_radiance(light, disk.mu, k) * sky_transmittance(s, k);
+            }
+            rgb += to_srgb(l, k);
+        }
+    }
+    return rgb;
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = invocation_index(gid, nwg);
+    if (i >= frame.rows * frame.width) {
+        return;
+    }
+    let x = i % frame.width;
+    let y = frame.first_row + i / frame.width;
+    let ray = camera_ray(f32(x) + 0.5, f32(y) + 0.5);
+    var out = vec4<f32>(0.0);
+    if (ray.valid) {
+        var shadow_km = 0.0;
+        if (frame.shadow_input != 0u) {
+            shadow_km = textureLoad(shadow_lengths, vec2<u32>(x, y), 0).x * 1e-3;
+        }
+        out = vec4<f32>(shade(ray.dir, shadow_km) * frame.balance.xyz, 1.0);
+    }
+    write_pixel(i, x, y, out);
+}
