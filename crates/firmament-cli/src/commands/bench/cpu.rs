@@ -9,7 +9,7 @@ use firmament::scene::{sun_direction, Camera, Projection, Scene};
 use firmament::sky::bruneton4d::Bruneton4d;
 use serde_json::json;
 
-use crate::bench::{median, BenchArgs};
+use super::{median, BenchArgs};
 
 /// The benchmark cameras: heading 200°, 60° field of view.
 pub fn camera(projection: Projection, altitude_m: f64, pitch_deg: f64) -> Camera {

@@ -8,9 +8,9 @@ use firmament_gpu::lut::Precomputer;
 use firmament_gpu::{GpuContext, GpuRenderer, GpuSky};
 use serde_json::json;
 
+use super::cpu as render_bench;
+use super::{median, time_runs, BenchArgs};
 use crate::backend::{gpu_failure, wait_idle};
-use crate::bench::{median, time_runs, BenchArgs};
-use crate::render_bench;
 
 /// How the GPU precompute is timed (the `gpu_precompute_timing_method` key).
 pub const PRECOMPUTE_METHOD: &str = "wall clock per run: GpuSky::precompute (atmosphere upload, table buffer allocation, encoding, submit) until the device is idle; tables left on the device (no readback); pipelines compiled once beforehand (gpu_pipeline_creation_s)";

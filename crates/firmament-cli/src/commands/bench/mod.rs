@@ -1,5 +1,8 @@
 //! `firmament bench`: medians of the main costs, printed as text or one JSON object.
 
+mod cpu;
+mod gpu;
+
 use std::time::Instant;
 
 use anyhow::Result;
@@ -8,7 +11,8 @@ use serde_json::json;
 
 use crate::backend::{describe, open_gpu, probe_hardware, Probe};
 use crate::common::AtmosphereArgs;
-use crate::{gpu_bench, render_bench};
+use cpu as render_bench;
+use gpu as gpu_bench;
 
 /// What `firmament bench` measures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

@@ -11,7 +11,7 @@ use firmament::scene::camera::orbit_fit_fov_deg;
 use firmament::scene::{Camera, Projection, SceneFile as Scene};
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
-use crate::render::{atmosphere_args, render_scene, write_outputs};
+use crate::commands::render::{atmosphere_args, render_scene, write_outputs};
 
 /// Arguments of `firmament gallery`.
 #[derive(Args, Debug)]
