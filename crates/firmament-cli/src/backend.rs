@@ -42,20 +42,6 @@ pub enum Backend {
     Gpu(Box<Gpu>),
 }
 
-/// The adapter in words: "NAME, BACKEND" (plus "software rasteriser" where it is one).
-pub fn describe(ctx: &GpuContext) -> String {
-    format!(
-        "{}, {}{}",
-        ctx.adapter_name(),
-        ctx.backend(),
-        if ctx.is_software() {
-            ", software rasteriser"
-        } else {
-            ""
-        }
-    )
-}
-
 /// The error for a failed GPU step: what failed, the device's reason, and the way out.
 pub fn gpu_failure(what: &str, e: GpuError) -> anyhow::Error {
     anyhow::anyhow!("{what} failed on the GPU: {e} (`--backend cpu` does the same work on the CPU)")
@@ -63,55 +49,74 @@ pub fn gpu_failure(what: &str, e: GpuError) -> anyhow::Error {
 
 /// What `auto` found: a hardware GPU opened, or why not (for the message).
 pub enum Probe {
-    Hardware(Box<GpuContext>),
+    Hardware(Box<Gpu>),
     NoHardware(String),
 }
 
-/// Look for a hardware adapter with compute shaders and open it (adapters are enumerated
-/// first: no device is created for a software one). Where there is no hardware GPU this
-/// costs the Vulkan loader's start-up, about 65 ms with Mesa's drivers installed.
-pub fn probe_hardware() -> Probe {
-    let desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-    let backends = desc.backends;
-    let instance = wgpu::Instance::new(desc);
-    let adapters: Vec<wgpu::AdapterInfo> =
-        pollster::block_on(instance.enumerate_adapters(backends))
-            .into_iter()
-            .filter(|a| {
-                a.get_downlevel_capabilities()
-                    .flags
-                    .contains(wgpu::DownlevelFlags::COMPUTE_SHADERS)
-            })
-            .map(|a| a.get_info())
-            .collect();
-    drop(instance);
-    if !adapters
-        .iter()
-        .any(|a| a.device_type != wgpu::DeviceType::Cpu)
-    {
-        return Probe::NoHardware(match adapters.first() {
-            Some(a) => format!("no hardware GPU; found software adapter {}", a.name),
-            None => "no GPU adapter found".into(),
-        });
+impl Gpu {
+    /// Open the GPU for `--backend gpu`: any adapter, or a clear error.
+    pub fn open() -> Result<Gpu> {
+        let ctx = GpuContext::new().map_err(|e| {
+            anyhow::anyhow!(
+                "--backend gpu: could not open a GPU: {e} (`--backend cpu` computes on the CPU)"
+            )
+        })?;
+        Ok(Gpu { ctx })
     }
-    // GpuContext::new ranks hardware before software: it opens the one found.
-    match GpuContext::new() {
-        Ok(ctx) if !ctx.is_software() => Probe::Hardware(Box::new(ctx)),
-        Ok(ctx) => Probe::NoHardware(format!(
-            "no hardware GPU opened; found software adapter {}",
-            ctx.adapter_name()
-        )),
-        Err(e) => Probe::NoHardware(format!("GPU unusable: {e}")),
-    }
-}
 
-/// Open the GPU for `--backend gpu`: any adapter, or a clear error.
-pub fn open_gpu() -> Result<GpuContext> {
-    GpuContext::new().map_err(|e| {
-        anyhow::anyhow!(
-            "--backend gpu: could not open a GPU: {e} (`--backend cpu` computes on the CPU)"
+    /// Look for a hardware adapter with compute shaders and open it (adapters are
+    /// enumerated first: no device is created for a software one). Where there is no
+    /// hardware GPU this costs the Vulkan loader's start-up, about 65 ms with Mesa's drivers
+    /// installed.
+    pub fn probe_hardware() -> Probe {
+        let desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        let backends = desc.backends;
+        let instance = wgpu::Instance::new(desc);
+        let adapters: Vec<wgpu::AdapterInfo> =
+            pollster::block_on(instance.enumerate_adapters(backends))
+                .into_iter()
+                .filter(|a| {
+                    a.get_downlevel_capabilities()
+                        .flags
+                        .contains(wgpu::DownlevelFlags::COMPUTE_SHADERS)
+                })
+                .map(|a| a.get_info())
+                .collect();
+        drop(instance);
+        if !adapters
+            .iter()
+            .any(|a| a.device_type != wgpu::DeviceType::Cpu)
+        {
+            return Probe::NoHardware(match adapters.first() {
+                Some(a) => format!("no hardware GPU; found software adapter {}", a.name),
+                None => "no GPU adapter found".into(),
+            });
+        }
+        // GpuContext::new ranks hardware before software: it opens the one found.
+        match GpuContext::new() {
+            Ok(ctx) if !ctx.is_software() => Probe::Hardware(Box::new(Gpu { ctx })),
+            Ok(ctx) => Probe::NoHardware(format!(
+                "no hardware GPU opened; found software adapter {}",
+                ctx.adapter_name()
+            )),
+            Err(e) => Probe::NoHardware(format!("GPU unusable: {e}")),
+        }
+    }
+
+    /// The adapter in words: "NAME, BACKEND" (plus "software rasteriser" where it is one).
+    pub fn describe(&self) -> String {
+        let ctx = &self.ctx;
+        format!(
+            "{}, {}{}",
+            ctx.adapter_name(),
+            ctx.backend(),
+            if ctx.is_software() {
+                ", software rasteriser"
+            } else {
+                ""
+            }
         )
-    })
+    }
 }
 
 impl Backend {
@@ -121,14 +126,14 @@ impl Backend {
         let (backend, line) = match choice {
             BackendChoice::Cpu => (Backend::Cpu, cpu_line()),
             BackendChoice::Gpu => {
-                let ctx = open_gpu()?;
-                let line = format!("gpu ({})", describe(&ctx));
-                (Backend::Gpu(Box::new(Gpu { ctx })), line)
+                let gpu = Gpu::open()?;
+                let line = format!("gpu ({})", gpu.describe());
+                (Backend::Gpu(Box::new(gpu)), line)
             }
-            BackendChoice::Auto => match probe_hardware() {
-                Probe::Hardware(ctx) => {
-                    let line = format!("gpu (auto: {})", describe(&ctx));
-                    (Backend::Gpu(Box::new(Gpu { ctx: *ctx })), line)
+            BackendChoice::Auto => match Gpu::probe_hardware() {
+                Probe::Hardware(gpu) => {
+                    let line = format!("gpu (auto: {})", gpu.describe());
+                    (Backend::Gpu(gpu), line)
                 }
                 Probe::NoHardware(why) => (
                     Backend::Cpu,
@@ -169,23 +174,24 @@ fn check_interrupted() -> Result<()> {
     Ok(())
 }
 
-/// Wait until the device has finished everything submitted.
-pub fn wait_idle(ctx: &GpuContext, during: &str) -> Result<()> {
-    ctx.device()
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map(|_| ())
-        .map_err(|e| {
-            gpu_failure(
-                during,
-                GpuError::Execution {
-                    during: during.to_string(),
-                    reason: e.to_string(),
-                },
-            )
-        })
-}
-
 impl Gpu {
+    /// Wait until the device has finished everything submitted.
+    pub fn wait_idle(&self, during: &str) -> Result<()> {
+        self.ctx
+            .device()
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| {
+                gpu_failure(
+                    during,
+                    GpuError::Execution {
+                        during: during.to_string(),
+                        reason: e.to_string(),
+                    },
+                )
+            })
+    }
+
     /// Precompute the tables on the GPU and read them back (for files and CPU lookups).
     pub fn tables(&self, model: &Model, config: &TableConfig, quiet: bool) -> Result<Tables> {
         let bar = spinner("precomputing tables on the GPU", quiet);
@@ -259,7 +265,7 @@ impl<'a> RenderSky<'a> {
                     .and_then(|p| GpuSky::precompute(ctx, &p, &model, &config))
                     .map_err(|e| gpu_failure("precomputing the tables", e))
                     .and_then(|sky| {
-                        wait_idle(ctx, "precomputing the tables")?;
+                        gpu.wait_idle("precomputing the tables")?;
                         Ok(sky)
                     });
                 bar.finish_and_clear();

@@ -184,3 +184,16 @@ pub fn check_output_dir(path: &Path, flag: &str) -> Result<()> {
     }
     Ok(())
 }
+
+/// The median of a sorted sample (NaN when it is empty).
+pub fn median_of_sorted(sorted: &[f64]) -> f64 {
+    let n = sorted.len();
+    if n == 0 {
+        return f64::NAN;
+    }
+    if n % 2 == 1 {
+        sorted[n / 2]
+    } else {
+        0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
+    }
+}

@@ -1,97 +1,102 @@
-//! Frame timings for `firmament bench`: the CPU renderer from precomputed tables.
+//! CPU timings for `firmament bench`: the precomputation of the tables (with the seconds of
+//! each stage) and the renderer's frames from precomputed tables.
 
+use std::collections::BTreeMap;
+use std::sync::Mutex;
 use std::time::Instant;
 
 use anyhow::Result;
-use firmament::math::Vec3;
-use firmament::render::{self, RenderSettings};
-use firmament::scene::{sun_direction, Camera, Projection, Scene};
-use firmament::sky::bruneton4d::Bruneton4d;
-use serde_json::json;
+use firmament::atmosphere::Model;
+use firmament::render::{self, ToneCurve};
+use firmament::scene::Scene;
+use firmament::sky::bruneton4d::precompute::precompute;
+use firmament::sky::bruneton4d::{Bruneton4d, TableConfig};
 
-use super::{median, BenchArgs};
+use super::report::{CpuFrames, CpuPrecompute};
+use super::scenes::{self, BenchFrame};
+use super::timing::{median, time_runs};
 
-/// The benchmark cameras: heading 200°, 60° field of view.
-pub fn camera(projection: Projection, altitude_m: f64, pitch_deg: f64) -> Camera {
-    Camera {
-        projection,
-        altitude_m,
-        heading_deg: 200.0,
-        pitch_deg,
-        roll_deg: 0.0,
-        fov_deg: 60.0,
-    }
-}
-
-/// The 1080p frame: from 1.5 km, half sky, half ground with aerial perspective, the sun in
-/// view (the CPU and GPU frame benchmarks).
-pub fn camera_1080p() -> Camera {
-    camera(Projection::Perspective, 1500.0, 20.0)
-}
-
-/// Settings of every benchmark frame.
-pub fn settings(camera: &Camera, width: usize, height: usize) -> RenderSettings<'_> {
-    RenderSettings {
-        camera,
-        width,
-        height,
-        white_balance: false,
-    }
-}
-
-/// The sun of every benchmark frame: 60° from the zenith at azimuth 200°, disk drawn.
-pub fn sun() -> Vec3 {
-    sun_direction(60.0, 200.0)
-}
-
-/// Time one kind of frame.
-fn frame(
-    sky: &Bruneton4d,
-    camera: Camera,
-    width: usize,
-    height: usize,
+/// Median seconds of the precomputation over `runs`, one more run for the stages, and the
+/// `spectral` model's precomputation (at most 3 runs) when given.
+pub fn precompute_timings(
+    model: &Model,
+    config: &TableConfig,
     runs: usize,
-) -> Result<f64> {
-    let settings = settings(&camera, width, height);
-    let mut times = Vec::new();
-    for _ in 0..runs.max(1) {
-        let t = Instant::now();
-        let f = render::render(
-            &Scene::clear_sky(sky, sun(), true),
-            &settings,
-            &|_| {},
-            None,
-        )?;
-        let _ = f.to_srgb8(1e-4, render::ToneCurve::Aces);
-        times.push(t.elapsed().as_secs_f64());
+    spectral: Option<&Model>,
+) -> Result<CpuPrecompute> {
+    let seconds = time_runs(runs, || {
+        precompute(model, config, &|_, _| {}, None)?;
+        Ok(())
+    })?;
+    let mut timings = CpuPrecompute {
+        cpu_precompute_s: Some(median(seconds)),
+        cpu_precompute_wavelengths: Some(model.channels()),
+        cpu_precompute_orders: Some(config.orders),
+        cpu_precompute_stages_s: Some(stage_seconds(model, config)?),
+        ..Default::default()
+    };
+    if let Some(spectral) = spectral {
+        let seconds = time_runs(runs.min(3), || {
+            precompute(spectral, config, &|_, _| {}, None)?;
+            Ok(())
+        })?;
+        timings.cpu_precompute_spectral_s = Some(median(seconds));
+        timings.cpu_precompute_spectral_wavelengths = Some(spectral.channels());
     }
-    Ok(median(times))
+    Ok(timings)
 }
 
-/// The CPU frame keys, null (not measured).
-pub const KEYS: [&str; 3] = [
-    "cpu_frame_1080p_perspective_s",
-    "cpu_frame_1024_fisheye_s",
-    "cpu_frame_4096x2048_equirect_s",
-];
+/// Where the time goes: one precomputation with a timestamp at each progress report, the
+/// seconds summed per kind of stage (the progress message up to its first comma).
+fn stage_seconds(model: &Model, config: &TableConfig) -> Result<BTreeMap<String, f64>> {
+    let current = Mutex::new((Instant::now(), String::from("start")));
+    let finished = Mutex::new(Vec::<(String, f64)>::new());
+    precompute(
+        model,
+        config,
+        &|stage, _| {
+            let mut current = current.lock().unwrap();
+            let kind = stage.split(',').next().unwrap_or(stage).to_string();
+            let seconds = current.0.elapsed().as_secs_f64();
+            let previous = std::mem::replace(&mut current.1, kind);
+            finished.lock().unwrap().push((previous, seconds));
+            current.0 = Instant::now();
+        },
+        None,
+    )?;
+    let mut per_stage = BTreeMap::new();
+    // The first entry is the time before the first report.
+    for (stage, seconds) in finished.into_inner().unwrap().into_iter().skip(1) {
+        *per_stage.entry(stage).or_insert(0.0) += seconds;
+    }
+    Ok(per_stage)
+}
 
-/// Add render timings to the benchmark result.
-pub fn extend(result: &mut serde_json::Value, args: &BenchArgs) -> Result<()> {
-    let sky = args.atmosphere.sky(true)?;
-    result[KEYS[0]] = json!(frame(&sky, camera_1080p(), 1920, 1080, args.runs)?);
-    result[KEYS[1]] = json!(frame(
-        &sky,
-        camera(Projection::Fisheye, 2.0, 0.0),
-        1024,
-        1024,
-        args.runs
-    )?);
-    result[KEYS[2]] = json!(frame(
-        &sky,
-        camera(Projection::Equirect, 2.0, 0.0),
-        4096,
-        2048,
-        args.runs.min(3)
-    )?);
-    Ok(())
+/// Median seconds of the benchmark frames rendered from `sky`.
+pub fn frame_timings(sky: &Bruneton4d, runs: usize) -> Result<CpuFrames> {
+    Ok(CpuFrames {
+        cpu_frame_1080p_perspective_s: Some(frame_seconds(
+            sky,
+            &scenes::perspective_1080p(),
+            runs,
+        )?),
+        cpu_frame_1024_fisheye_s: Some(frame_seconds(sky, &scenes::fisheye_1024(), runs)?),
+        cpu_frame_4096x2048_equirect_s: Some(frame_seconds(
+            sky,
+            &scenes::equirect_4096x2048(),
+            runs,
+        )?),
+    })
+}
+
+/// Median seconds of one frame, tone mapped to 8 bits.
+fn frame_seconds(sky: &Bruneton4d, frame: &BenchFrame, runs: usize) -> Result<f64> {
+    let settings = frame.settings();
+    let seconds = time_runs(frame.runs(runs), || {
+        let scene = Scene::clear_sky(sky, scenes::sun(), true);
+        let image = render::render(&scene, &settings, &|_| {}, None)?;
+        let _ = image.to_srgb8(1e-4, ToneCurve::Aces);
+        Ok(())
+    })?;
+    Ok(median(seconds))
 }

@@ -1,18 +1,22 @@
 //! `firmament bench`: medians of the main costs, printed as text or one JSON object.
+//!
+//! The leaves know nothing of each other's callers: [`timing`] (runs and medians),
+//! [`scenes`] (the frames measured) and [`report`] (what is printed) import nothing of
+//! bench; [`cpu`] and [`gpu`] measure with them; this module chooses what to measure and
+//! prints the report.
 
 mod cpu;
 mod gpu;
-
-use std::time::Instant;
+mod report;
+mod scenes;
+mod timing;
 
 use anyhow::Result;
 use clap::{Args, ValueEnum};
-use serde_json::json;
 
-use crate::backend::{describe, open_gpu, probe_hardware, Probe};
+use crate::backend::{Gpu, Probe};
 use crate::common::AtmosphereArgs;
-use cpu as render_bench;
-use gpu as gpu_bench;
+use report::{BenchReport, Machine};
 
 /// What `firmament bench` measures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -55,40 +59,24 @@ pub struct BenchArgs {
     pub gpu_runs: Option<usize>,
 }
 
-/// Median of a sample (seconds).
-pub fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
-/// Run `f` `runs` times (at least once); the seconds of each.
-pub fn time_runs(runs: usize, mut f: impl FnMut() -> Result<()>) -> Result<Vec<f64>> {
-    let mut times = Vec::with_capacity(runs);
-    for _ in 0..runs.max(1) {
-        let t = Instant::now();
-        f()?;
-        times.push(t.elapsed().as_secs_f64());
-    }
-    Ok(times)
-}
-
 /// Run the benchmarks.
 pub fn run(args: &BenchArgs) -> Result<()> {
     let model = args.atmosphere.model()?;
     let config = args.atmosphere.table_config()?;
-    let cpu = cpu_name();
-    let threads = rayon::current_num_threads();
+    let spectral_model = if args.spectral {
+        let mut spectral_args = args.atmosphere.clone();
+        spectral_args.wavelengths = "spectral".into();
+        Some(spectral_args.model()?)
+    } else {
+        None
+    };
+    let machine = Machine::this();
     // The GPU to measure, or why none.
     let (gpu, gpu_skipped) = match args.backend {
         BenchBackend::Cpu => (None, Some("not requested (--backend cpu)".to_string())),
-        BenchBackend::Gpu | BenchBackend::All => (Some(open_gpu()?), None),
-        BenchBackend::Auto => match probe_hardware() {
-            Probe::Hardware(ctx) => (Some(*ctx), None),
+        BenchBackend::Gpu | BenchBackend::All => (Some(Gpu::open()?), None),
+        BenchBackend::Auto => match Gpu::probe_hardware() {
+            Probe::Hardware(gpu) => (Some(*gpu), None),
             Probe::NoHardware(why) => (
                 None,
                 Some(format!("{why} (--backend all measures a software adapter)")),
@@ -98,11 +86,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let measure_cpu = args.backend != BenchBackend::Gpu;
     if !args.json {
         eprintln!(
-            "machine: {cpu}, {threads} threads; {} runs per measurement",
-            args.runs
+            "machine: {}, {} threads; {} runs per measurement",
+            machine.cpu, machine.threads, args.runs
         );
         match (&gpu, &gpu_skipped) {
-            (Some(ctx), _) => eprintln!("backend: gpu ({})", describe(ctx)),
+            (Some(gpu), _) => eprintln!("backend: gpu ({})", gpu.describe()),
             (None, Some(why)) => eprintln!("backend: gpu not measured: {why}"),
             (None, None) => {}
         }
@@ -110,109 +98,36 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             eprintln!("backend: cpu not measured (--backend gpu)");
         }
     }
-    let mut result = json!({
-        "machine": { "cpu": cpu, "threads": threads },
-        "runs": args.runs,
-        "cpu_precompute_s": null,
-        "cpu_precompute_wavelengths": null,
-        "cpu_precompute_orders": null,
-        "cpu_precompute_stages_s": null,
-        "cpu_precompute_spectral_s": null,
-        "cpu_precompute_spectral_wavelengths": null,
-        "gpu_skipped": gpu_skipped,
-    });
-    for key in render_bench::KEYS.iter().chain(&gpu_bench::KEYS) {
-        result[*key] = serde_json::Value::Null;
-    }
+    let mut report = BenchReport {
+        machine,
+        runs: args.runs,
+        cpu_precompute: Default::default(),
+        cpu_frames: Default::default(),
+        gpu_skipped,
+        gpu: Default::default(),
+    };
     if measure_cpu {
-        cpu_precompute(&mut result, args, &model, &config)?;
-        render_bench::extend(&mut result, args)?;
+        report.cpu_precompute =
+            cpu::precompute_timings(&model, &config, args.runs, spectral_model.as_ref())?;
+        report.cpu_frames = cpu::frame_timings(&args.atmosphere.sky(true)?, args.runs)?;
     }
-    if let Some(ctx) = &gpu {
-        gpu_bench::extend(&mut result, args, ctx, !args.json)?;
+    if let Some(gpu) = &gpu {
+        let runs = args.gpu_runs.unwrap_or(args.runs).max(1);
+        report.gpu = gpu::timings(
+            gpu,
+            &model,
+            &config,
+            spectral_model.as_ref(),
+            runs,
+            !args.json,
+        )?;
     }
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&result)?);
+        println!("{}", serde_json::to_string_pretty(&report.to_json())?);
     } else {
-        for (k, v) in result.as_object().unwrap() {
-            println!("{k}: {v}");
+        for line in report.lines() {
+            println!("{line}");
         }
     }
     Ok(())
-}
-
-/// The CPU precompute: median, stages, spectral.
-fn cpu_precompute(
-    result: &mut serde_json::Value,
-    args: &BenchArgs,
-    model: &firmament::atmosphere::Model,
-    config: &firmament::sky::bruneton4d::TableConfig,
-) -> Result<()> {
-    let mut stages: Vec<(String, f64)> = Vec::new();
-    let precompute = time_runs(args.runs, || {
-        let _ =
-            firmament::sky::bruneton4d::precompute::precompute(model, config, &|_, _| {}, None)?;
-        Ok(())
-    })?;
-    // Where the time goes: one more run with stage timestamps.
-    {
-        let last = std::sync::Mutex::new((Instant::now(), String::from("start")));
-        let acc = std::sync::Mutex::new(Vec::<(String, f64)>::new());
-        firmament::sky::bruneton4d::precompute::precompute(
-            model,
-            config,
-            &|stage, _| {
-                let mut l = last.lock().unwrap();
-                let kind = stage.split(',').next().unwrap_or(stage).to_string();
-                let dt = l.0.elapsed().as_secs_f64();
-                let prev = std::mem::replace(&mut l.1, kind);
-                acc.lock().unwrap().push((prev, dt));
-                l.0 = Instant::now();
-            },
-            None,
-        )?;
-        for (name, dt) in acc.into_inner().unwrap().into_iter().skip(1) {
-            match stages.iter_mut().find(|(n, _)| *n == name) {
-                Some(e) => e.1 += dt,
-                None => stages.push((name, dt)),
-            }
-        }
-    }
-    result["cpu_precompute_s"] = json!(median(precompute));
-    result["cpu_precompute_wavelengths"] = json!(model.channels());
-    result["cpu_precompute_orders"] = json!(config.orders);
-    result["cpu_precompute_stages_s"] = stages
-        .iter()
-        .map(|(n, t)| (n.clone(), json!(t)))
-        .collect::<serde_json::Map<_, _>>()
-        .into();
-    if args.spectral {
-        let mut spectral_args = args.atmosphere.clone();
-        spectral_args.wavelengths = "spectral".into();
-        let spectral_model = spectral_args.model()?;
-        let times = time_runs(args.runs.min(3), || {
-            let _ = firmament::sky::bruneton4d::precompute::precompute(
-                &spectral_model,
-                config,
-                &|_, _| {},
-                None,
-            )?;
-            Ok(())
-        })?;
-        result["cpu_precompute_spectral_s"] = json!(median(times));
-        result["cpu_precompute_spectral_wavelengths"] = json!(spectral_model.channels());
-    }
-    Ok(())
-}
-
-/// The CPU model name from /proc/cpuinfo (Linux), or "unknown".
-pub fn cpu_name() -> String {
-    std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("model name"))
-                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
-        })
-        .unwrap_or_else(|| "unknown".into())
 }
