@@ -60,6 +60,18 @@ pub struct AtmosphereArgs {
     pub order_tail: bool,
 }
 
+impl Default for AtmosphereArgs {
+    /// The values of an empty command line (the defaults live once, in the clap attributes).
+    fn default() -> Self {
+        #[derive(clap::Parser)]
+        struct Defaults {
+            #[command(flatten)]
+            atmosphere: AtmosphereArgs,
+        }
+        <Defaults as clap::Parser>::parse_from(["firmament"]).atmosphere
+    }
+}
+
 impl AtmosphereArgs {
     /// The chosen atmosphere.
     pub fn atmosphere(&self) -> Result<Atmosphere> {
