@@ -161,13 +161,28 @@ pub fn progress_bar(len: u64, quiet: bool) -> ProgressBar {
     if quiet {
         return ProgressBar::hidden();
     }
-    let bar = ProgressBar::new(len);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] {wide_bar} {percent:>3}% {msg}",
-        )
-        .expect("valid template"),
+    drawn(
+        ProgressBar::new(len),
+        "{spinner} [{elapsed_precise}] {wide_bar} {percent:>3}% {msg}",
+    )
+}
+
+/// A spinner on stderr for work that reports no progress (the GPU's); hidden when `quiet`.
+pub fn spinner(message: &str, quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let bar = drawn(
+        ProgressBar::new_spinner(),
+        "{spinner} [{elapsed_precise}] {msg}",
     );
+    bar.set_message(message.to_string());
+    bar
+}
+
+/// `bar` drawn with `template`, ticking by itself.
+fn drawn(bar: ProgressBar, template: &str) -> ProgressBar {
+    bar.set_style(ProgressStyle::with_template(template).expect("valid template"));
     bar.enable_steady_tick(Duration::from_millis(200));
     bar
 }
