@@ -196,6 +196,14 @@ pub fn check_range(flag: &str, v: f64, lo: f64, hi: f64, unit: &str) -> Result<(
     }
 }
 
+/// The reference path tracer's `--samples`: at least 2 paths (a standard error needs two).
+pub fn check_reference_samples(samples: usize) -> Result<()> {
+    if samples < 2 {
+        anyhow::bail!("invalid value for `--samples`: {samples} (accepted: an integer ≥ 2)");
+    }
+    Ok(())
+}
+
 /// The directory of a path exists (for clear errors before long work).
 pub fn check_output_dir(path: &Path, flag: &str) -> Result<()> {
     let dir = path

@@ -40,7 +40,9 @@ use firmament::sky::bruneton4d::Bruneton4d;
 use firmament::spectrum::ColourMatrix;
 use serde_json::{json, Value};
 
-use crate::common::{check_output_dir, check_range, progress_bar, AtmosphereArgs};
+use crate::common::{
+    check_output_dir, check_range, check_reference_samples, progress_bar, AtmosphereArgs,
+};
 use compare::{compare_tables, ViewRecord};
 use sampling::{trace_views, SamplePlan, PILOT_SAMPLES};
 use summary::{RelativeErrors, Summaries};
@@ -165,10 +167,10 @@ impl Selection {
             .clone()
             .unwrap_or_else(|| if args.quick { "small" } else { "default" }.into());
         let samples = match args.samples {
-            Some(n) if n < 2 => {
-                anyhow::bail!("invalid value for `--samples`: {n} (accepted: an integer ≥ 2)")
+            Some(n) => {
+                check_reference_samples(n)?;
+                SamplePlan::Fixed(n)
             }
-            Some(n) => SamplePlan::Fixed(n),
             None => {
                 let pct = args
                     .target_stderr
