@@ -17,7 +17,7 @@ use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, Tables};
 use firmament_gpu::lut::Precomputer;
 use firmament_gpu::{GpuContext, GpuError, GpuRenderer, GpuSky};
 
-use crate::common::{cancel_flag, progress_bar, spinner, AtmosphereArgs};
+use crate::common::{cancel_flag, print_tables_time, progress_bar, spinner, AtmosphereArgs};
 
 /// The `--backend` flag of render, bake, query and gallery.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
@@ -184,42 +184,51 @@ impl Gpu {
 
     /// Precompute the tables on the GPU and read them back (for files and CPU lookups).
     pub fn tables(&self, model: &Model, config: &TableConfig, quiet: bool) -> Result<Tables> {
-        let started = Instant::now();
-        let tables = on_gpu("precomputing tables on the GPU", quiet, || {
-            Precomputer::new(&self.ctx)
-                .and_then(|p| p.run(&self.ctx, model, config))
-                .map_err(|e| gpu_failure("precomputing the tables", e))
-        })?;
-        if !quiet {
-            eprintln!(
-                "tables: {:.2} s on the GPU ({} wavelengths, {} orders; shader compilation and readback included)",
-                started.elapsed().as_secs_f64(),
-                model.channels(),
-                config.orders
-            );
-        }
-        Ok(tables)
+        self.precompute(
+            model,
+            config,
+            quiet,
+            "shader compilation and readback included",
+            || {
+                Precomputer::new(&self.ctx)
+                    .and_then(|p| p.run(&self.ctx, model, config))
+                    .map_err(|e| gpu_failure("precomputing the tables", e))
+            },
+        )
     }
 
     /// Precompute the tables on the GPU and keep them on the device (for GPU frames).
     fn sky(&self, model: &Model, config: &TableConfig, quiet: bool) -> Result<GpuSky> {
+        self.precompute(
+            model,
+            config,
+            quiet,
+            "shader compilation included; kept on the device",
+            || {
+                let sky = Precomputer::new(&self.ctx)
+                    .and_then(|p| GpuSky::precompute(&self.ctx, &p, model, config))
+                    .map_err(|e| gpu_failure("precomputing the tables", e))?;
+                self.wait_idle("precomputing the tables")?;
+                Ok(sky)
+            },
+        )
+    }
+
+    /// A precomputation on the GPU under a spinner, then its `tables: …` line (with `note`).
+    fn precompute<T>(
+        &self,
+        model: &Model,
+        config: &TableConfig,
+        quiet: bool,
+        note: &str,
+        work: impl FnOnce() -> Result<T>,
+    ) -> Result<T> {
         let started = Instant::now();
-        let sky = on_gpu("precomputing tables on the GPU", quiet, || {
-            let sky = Precomputer::new(&self.ctx)
-                .and_then(|p| GpuSky::precompute(&self.ctx, &p, model, config))
-                .map_err(|e| gpu_failure("precomputing the tables", e))?;
-            self.wait_idle("precomputing the tables")?;
-            Ok(sky)
-        })?;
+        let computed = on_gpu("precomputing tables on the GPU", quiet, work)?;
         if !quiet {
-            eprintln!(
-                "tables: {:.2} s on the GPU ({} wavelengths, {} orders; shader compilation included; kept on the device)",
-                started.elapsed().as_secs_f64(),
-                model.channels(),
-                config.orders
-            );
+            print_tables_time(started, model, config, " on the GPU", &format!("; {note}"));
         }
-        Ok(sky)
+        Ok(computed)
     }
 }
 

@@ -146,14 +146,26 @@ pub fn compute_tables(model: &Model, config: &TableConfig, quiet: bool) -> Resul
     bar.finish_and_clear();
     let tables = tables.context("precomputing the tables")?;
     if !quiet {
-        eprintln!(
-            "tables: {:.2} s ({} wavelengths, {} orders)",
-            started.elapsed().as_secs_f64(),
-            model.channels(),
-            config.orders
-        );
+        print_tables_time(started, model, config, "", "");
     }
     Ok(tables)
+}
+
+/// The line on stderr after a precomputation started at `started`: `tables: SECONDS
+/// s{place} (N wavelengths, M orders{note})`.
+pub fn print_tables_time(
+    started: Instant,
+    model: &Model,
+    config: &TableConfig,
+    place: &str,
+    note: &str,
+) {
+    eprintln!(
+        "tables: {:.2} s{place} ({} wavelengths, {} orders{note})",
+        started.elapsed().as_secs_f64(),
+        model.channels(),
+        config.orders
+    );
 }
 
 /// A progress bar drawn on stderr only for work long enough to need one.
