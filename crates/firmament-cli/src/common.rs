@@ -48,7 +48,7 @@ pub struct AtmosphereArgs {
     /// Scattering orders to precompute when no --tables are given.
     #[arg(long, default_value_t = 4)]
     pub orders: usize,
-    /// Table sizes when no --tables are given: `default` (SPEC sizes) or `small` (fast, coarse).
+    /// Table sizes when no --tables are given: `default` (Bruneton 2017's sizes) or `small` (fast, coarse).
     #[arg(long, default_value = "default", value_name = "default|small")]
     pub table_size: String,
     /// Store single Mie scattering for every wavelength (`separate`) or only the first (`red-only`, ratio rule).
