@@ -1,5 +1,6 @@
 //! What several subcommands share: choosing the atmosphere and wavelengths, getting the
-//! tables (from a file or computed with a progress bar), Ctrl-C.
+//! tables (from a file or computed with a progress bar), progress bars and spinners,
+//! Ctrl-C, the checks of flag values, and the median that bench and validate report.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -1,9 +1,9 @@
 //! `firmament bench`: medians of the main costs, printed as text or one JSON object.
 //!
-//! The leaves know nothing of each other's callers: [`timing`] (runs and medians),
-//! [`scenes`] (the frames measured) and [`report`] (what is printed) import nothing of
-//! bench; [`cpu`] and [`gpu`] measure with them; this module chooses what to measure and
-//! prints the report.
+//! Imports run one way: the leaves [`timing`] (runs and medians), [`scenes`] (the frames
+//! measured) and [`report`] (what is printed) import nothing of bench; [`cpu`] and [`gpu`]
+//! measure with them and take plain values, not the arguments; this module chooses what to
+//! measure and prints the report.
 
 mod cpu;
 mod gpu;
