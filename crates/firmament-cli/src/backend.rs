@@ -1,21 +1,23 @@
 //! `--backend cpu|gpu|auto`: where the tables are precomputed and frames rendered. The GPU
 //! work goes through `firmament_gpu` (wgpu); everything after a frame (exposure, tone
 //! mapping, image files) is the CPU code either way.
+//!
+//! With `commands/bench/gpu.rs`, the only place that calls `firmament_gpu`: the commands
+//! see [`Backend`], [`Gpu`] and [`RenderSky`].
 
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use anyhow::Result;
 use clap::ValueEnum;
 use firmament::atmosphere::Model;
 use firmament::math::Vec3;
 use firmament::render::{Frame, RenderSettings};
-use firmament::scene::Scene;
+use firmament::scene::{Light, Scene};
 use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, Tables};
 use firmament_gpu::Precomputer;
 use firmament_gpu::{GpuContext, GpuError, GpuRenderer, GpuSky};
-use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::common::{cancel_flag, AtmosphereArgs};
+use crate::common::{cancel_flag, print_tables_time, progress_bar, spinner, AtmosphereArgs};
 
 /// The `--backend` flag of render, bake, query and gallery.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
@@ -31,87 +33,21 @@ pub enum BackendChoice {
     Auto,
 }
 
-/// An opened GPU.
-pub struct Gpu {
-    pub ctx: GpuContext,
-}
-
 /// The backend a command runs on.
 pub enum Backend {
     Cpu,
     Gpu(Box<Gpu>),
 }
 
-/// The adapter in words: "NAME, BACKEND" (plus "software rasteriser" where it is one).
-pub fn describe(ctx: &GpuContext) -> String {
-    format!(
-        "{}, {}{}",
-        ctx.adapter_name(),
-        ctx.backend(),
-        if ctx.is_software() {
-            ", software rasteriser"
-        } else {
-            ""
-        }
-    )
-}
-
-/// The error for a failed GPU step: what failed, the device's reason, and the way out.
-pub fn gpu_failure(what: &str, e: GpuError) -> anyhow::Error {
-    anyhow::anyhow!("{what} failed on the GPU: {e} (`--backend cpu` does the same work on the CPU)")
+/// An opened GPU.
+pub struct Gpu {
+    pub ctx: GpuContext,
 }
 
 /// What `auto` found: a hardware GPU opened, or why not (for the message).
 pub enum Probe {
-    Hardware(Box<GpuContext>),
+    Hardware(Box<Gpu>),
     NoHardware(String),
-}
-
-/// Look for a hardware adapter with compute shaders and open it (adapters are enumerated
-/// first: no device is created for a software one). Where there is no hardware GPU this
-/// costs the Vulkan loader's start-up, about 65 ms with Mesa's drivers installed.
-pub fn probe_hardware() -> Probe {
-    let desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-    let backends = desc.backends;
-    let instance = wgpu::Instance::new(desc);
-    let adapters: Vec<wgpu::AdapterInfo> =
-        pollster::block_on(instance.enumerate_adapters(backends))
-            .into_iter()
-            .filter(|a| {
-                a.get_downlevel_capabilities()
-                    .flags
-                    .contains(wgpu::DownlevelFlags::COMPUTE_SHADERS)
-            })
-            .map(|a| a.get_info())
-            .collect();
-    drop(instance);
-    if !adapters
-        .iter()
-        .any(|a| a.device_type != wgpu::DeviceType::Cpu)
-    {
-        return Probe::NoHardware(match adapters.first() {
-            Some(a) => format!("no hardware GPU; found software adapter {}", a.name),
-            None => "no GPU adapter found".into(),
-        });
-    }
-    // GpuContext::new ranks hardware before software: it opens the one found.
-    match GpuContext::new() {
-        Ok(ctx) if !ctx.is_software() => Probe::Hardware(Box::new(ctx)),
-        Ok(ctx) => Probe::NoHardware(format!(
-            "no hardware GPU opened; found software adapter {}",
-            ctx.adapter_name()
-        )),
-        Err(e) => Probe::NoHardware(format!("GPU unusable: {e}")),
-    }
-}
-
-/// Open the GPU for `--backend gpu`: any adapter, or a clear error.
-pub fn open_gpu() -> Result<GpuContext> {
-    GpuContext::new().map_err(|e| {
-        anyhow::anyhow!(
-            "--backend gpu: could not open a GPU: {e} (`--backend cpu` computes on the CPU)"
-        )
-    })
 }
 
 impl Backend {
@@ -121,14 +57,14 @@ impl Backend {
         let (backend, line) = match choice {
             BackendChoice::Cpu => (Backend::Cpu, cpu_line()),
             BackendChoice::Gpu => {
-                let ctx = open_gpu()?;
-                let line = format!("gpu ({})", describe(&ctx));
-                (Backend::Gpu(Box::new(Gpu { ctx })), line)
+                let gpu = Gpu::open()?;
+                let line = format!("gpu ({})", gpu.describe());
+                (Backend::Gpu(Box::new(gpu)), line)
             }
-            BackendChoice::Auto => match probe_hardware() {
-                Probe::Hardware(ctx) => {
-                    let line = format!("gpu (auto: {})", describe(&ctx));
-                    (Backend::Gpu(Box::new(Gpu { ctx: *ctx })), line)
+            BackendChoice::Auto => match Gpu::probe_hardware() {
+                Probe::Hardware(gpu) => {
+                    let line = format!("gpu (auto: {})", gpu.describe());
+                    (Backend::Gpu(gpu), line)
                 }
                 Probe::NoHardware(why) => (
                     Backend::Cpu,
@@ -146,65 +82,153 @@ impl Backend {
     }
 }
 
-/// A spinner on stderr for GPU work (which reports no progress); hidden when `quiet`.
-fn spinner(message: &str, quiet: bool) -> ProgressBar {
-    if quiet {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new_spinner();
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {msg}")
-            .expect("valid template"),
-    );
-    bar.set_message(message.to_string());
-    bar.enable_steady_tick(Duration::from_millis(200));
-    bar
+/// The error for a failed GPU step: what failed, the device's reason, and the way out.
+pub fn gpu_failure(what: &str, e: GpuError) -> anyhow::Error {
+    anyhow::anyhow!("{what} failed on the GPU: {e} (`--backend cpu` does the same work on the CPU)")
 }
 
-/// Ctrl-C cannot stop a GPU submission; refuse to go on once it is done.
-fn check_interrupted() -> Result<()> {
+/// GPU work under a spinner on stderr (hidden when `quiet`): the GPU reports no progress,
+/// and Ctrl-C cannot stop a submission, so once the work is done it refuses to go on.
+fn on_gpu<T>(message: &str, quiet: bool, work: impl FnOnce() -> Result<T>) -> Result<T> {
+    let bar = spinner(message, quiet);
+    let result = work();
+    bar.finish_and_clear();
+    let value = result?;
     if cancel_flag().load(std::sync::atomic::Ordering::Relaxed) {
         anyhow::bail!("interrupted");
     }
-    Ok(())
-}
-
-/// Wait until the device has finished everything submitted.
-pub fn wait_idle(ctx: &GpuContext, during: &str) -> Result<()> {
-    ctx.device()
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map(|_| ())
-        .map_err(|e| {
-            gpu_failure(
-                during,
-                GpuError::Execution {
-                    during: during.to_string(),
-                    reason: e.to_string(),
-                },
-            )
-        })
+    Ok(value)
 }
 
 impl Gpu {
+    /// Open the GPU for `--backend gpu`: any adapter, or a clear error.
+    pub fn open() -> Result<Gpu> {
+        let ctx = GpuContext::new().map_err(|e| {
+            anyhow::anyhow!(
+                "--backend gpu: could not open a GPU: {e} (`--backend cpu` computes on the CPU)"
+            )
+        })?;
+        Ok(Gpu { ctx })
+    }
+
+    /// Look for a hardware adapter with compute shaders and open it (adapters are
+    /// enumerated first: no device is created for a software one). Where there is no
+    /// hardware GPU this costs the Vulkan loader's start-up, about 65 ms with Mesa's drivers
+    /// installed.
+    pub fn probe_hardware() -> Probe {
+        let desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        let backends = desc.backends;
+        let instance = wgpu::Instance::new(desc);
+        let adapters: Vec<wgpu::AdapterInfo> =
+            pollster::block_on(instance.enumerate_adapters(backends))
+                .into_iter()
+                .filter(|a| {
+                    a.get_downlevel_capabilities()
+                        .flags
+                        .contains(wgpu::DownlevelFlags::COMPUTE_SHADERS)
+                })
+                .map(|a| a.get_info())
+                .collect();
+        drop(instance);
+        if !adapters
+            .iter()
+            .any(|a| a.device_type != wgpu::DeviceType::Cpu)
+        {
+            return Probe::NoHardware(match adapters.first() {
+                Some(a) => format!("no hardware GPU; found software adapter {}", a.name),
+                None => "no GPU adapter found".into(),
+            });
+        }
+        // GpuContext::new ranks hardware before software: it opens the one found.
+        match GpuContext::new() {
+            Ok(ctx) if !ctx.is_software() => Probe::Hardware(Box::new(Gpu { ctx })),
+            Ok(ctx) => Probe::NoHardware(format!(
+                "no hardware GPU opened; found software adapter {}",
+                ctx.adapter_name()
+            )),
+            Err(e) => Probe::NoHardware(format!("GPU unusable: {e}")),
+        }
+    }
+
+    /// The adapter in words: "NAME, BACKEND" (plus "software rasteriser" where it is one).
+    pub fn describe(&self) -> String {
+        let ctx = &self.ctx;
+        format!(
+            "{}, {}{}",
+            ctx.adapter_name(),
+            ctx.backend(),
+            if ctx.is_software() {
+                ", software rasteriser"
+            } else {
+                ""
+            }
+        )
+    }
+
+    /// Wait until the device has finished everything submitted.
+    pub fn wait_idle(&self, during: &str) -> Result<()> {
+        self.ctx
+            .device()
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| {
+                gpu_failure(
+                    during,
+                    GpuError::Execution {
+                        during: during.to_string(),
+                        reason: e.to_string(),
+                    },
+                )
+            })
+    }
+
     /// Precompute the tables on the GPU and read them back (for files and CPU lookups).
     pub fn tables(&self, model: &Model, config: &TableConfig, quiet: bool) -> Result<Tables> {
-        let bar = spinner("precomputing tables on the GPU", quiet);
+        self.precompute(
+            model,
+            config,
+            quiet,
+            "shader compilation and readback included",
+            || {
+                Precomputer::new(&self.ctx)
+                    .and_then(|p| p.run(&self.ctx, model, config))
+                    .map_err(|e| gpu_failure("precomputing the tables", e))
+            },
+        )
+    }
+
+    /// Precompute the tables on the GPU and keep them on the device (for GPU frames).
+    fn sky(&self, model: &Model, config: &TableConfig, quiet: bool) -> Result<GpuSky> {
+        self.precompute(
+            model,
+            config,
+            quiet,
+            "shader compilation included; kept on the device",
+            || {
+                let sky = Precomputer::new(&self.ctx)
+                    .and_then(|p| GpuSky::precompute(&self.ctx, &p, model, config))
+                    .map_err(|e| gpu_failure("precomputing the tables", e))?;
+                self.wait_idle("precomputing the tables")?;
+                Ok(sky)
+            },
+        )
+    }
+
+    /// A precomputation on the GPU under a spinner, then its `tables: …` line (with `note`).
+    fn precompute<T>(
+        &self,
+        model: &Model,
+        config: &TableConfig,
+        quiet: bool,
+        note: &str,
+        work: impl FnOnce() -> Result<T>,
+    ) -> Result<T> {
         let started = Instant::now();
-        let tables = Precomputer::new(&self.ctx)
-            .and_then(|p| p.run(&self.ctx, model, config))
-            .map_err(|e| gpu_failure("precomputing the tables", e));
-        bar.finish_and_clear();
-        let tables = tables?;
-        check_interrupted()?;
+        let computed = on_gpu("precomputing tables on the GPU", quiet, work)?;
         if !quiet {
-            eprintln!(
-                "tables: {:.2} s on the GPU ({} wavelengths, {} orders; shader compilation and readback included)",
-                started.elapsed().as_secs_f64(),
-                model.channels(),
-                config.orders
-            );
+            print_tables_time(started, model, config, " on the GPU", &format!("; {note}"));
         }
-        Ok(tables)
+        Ok(computed)
     }
 }
 
@@ -229,7 +253,7 @@ pub enum RenderSky<'a> {
         gpu: &'a Gpu,
         sky: Box<GpuSky>,
         /// The model the sky was computed for (lights are built from it).
-        sky_model: Box<firmament::atmosphere::Model>,
+        sky_model: Box<Model>,
         renderer: Box<GpuRenderer>,
     },
 }
@@ -242,42 +266,14 @@ impl<'a> RenderSky<'a> {
             Backend::Cpu => return Ok(RenderSky::Cpu(Box::new(atmosphere.sky(quiet)?))),
             Backend::Gpu(gpu) => gpu,
         };
-        let ctx = &gpu.ctx;
         let sky_model = atmosphere.model()?;
         let sky = match &atmosphere.tables {
-            Some(_) => {
-                let cpu_sky = atmosphere.sky(quiet)?;
-                GpuSky::from_sky(ctx, &cpu_sky)
-                    .map_err(|e| gpu_failure("uploading the tables", e))?
-            }
-            None => {
-                let model = atmosphere.model()?;
-                let config = atmosphere.table_config()?;
-                let bar = spinner("precomputing tables on the GPU", quiet);
-                let started = Instant::now();
-                let sky = Precomputer::new(ctx)
-                    .and_then(|p| GpuSky::precompute(ctx, &p, &model, &config))
-                    .map_err(|e| gpu_failure("precomputing the tables", e))
-                    .and_then(|sky| {
-                        wait_idle(ctx, "precomputing the tables")?;
-                        Ok(sky)
-                    });
-                bar.finish_and_clear();
-                let sky = sky?;
-                check_interrupted()?;
-                if !quiet {
-                    eprintln!(
-                        "tables: {:.2} s on the GPU ({} wavelengths, {} orders; shader compilation included; kept on the device)",
-                        started.elapsed().as_secs_f64(),
-                        model.channels(),
-                        config.orders
-                    );
-                }
-                sky
-            }
+            Some(_) => GpuSky::from_sky(&gpu.ctx, &atmosphere.sky(quiet)?)
+                .map_err(|e| gpu_failure("uploading the tables", e))?,
+            None => gpu.sky(&sky_model, &atmosphere.table_config()?, quiet)?,
         };
-        let renderer =
-            GpuRenderer::new(ctx).map_err(|e| gpu_failure("compiling the render shader", e))?;
+        let renderer = GpuRenderer::new(&gpu.ctx)
+            .map_err(|e| gpu_failure("compiling the render shader", e))?;
         Ok(RenderSky::Gpu {
             gpu,
             sky: Box::new(sky),
@@ -305,7 +301,7 @@ impl<'a> RenderSky<'a> {
     ) -> Result<Frame> {
         match self {
             RenderSky::Cpu(sky) => {
-                let bar = crate::common::progress_bar(1000, quiet);
+                let bar = progress_bar(1000, quiet);
                 bar.set_message("rendering");
                 let frame = firmament::render::render(
                     &Scene::clear_sky(sky.as_ref(), sun, sun_disk),
@@ -321,18 +317,12 @@ impl<'a> RenderSky<'a> {
                 sky,
                 sky_model,
                 renderer,
-            } => {
-                let bar = spinner("rendering on the GPU", quiet);
-                let model = sky_model.as_ref();
-                let lights = [firmament::scene::Light::sun(model, sun, sun_disk)];
-                let frame = renderer
+            } => on_gpu("rendering on the GPU", quiet, || {
+                let lights = [Light::sun(sky_model, sun, sun_disk)];
+                renderer
                     .render(&gpu.ctx, sky, &lights, settings)
-                    .map_err(|e| gpu_failure("rendering", e));
-                bar.finish_and_clear();
-                let frame = frame?;
-                check_interrupted()?;
-                Ok(frame)
-            }
+                    .map_err(|e| gpu_failure("rendering", e))
+            }),
         }
     }
 }

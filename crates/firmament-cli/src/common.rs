@@ -1,5 +1,6 @@
 //! What several subcommands share: choosing the atmosphere and wavelengths, getting the
-//! tables (from a file or computed with a progress bar), Ctrl-C.
+//! tables (from a file or computed with a progress bar), progress bars and spinners,
+//! Ctrl-C, the checks of flag values, and the median that bench and validate report.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -48,7 +49,7 @@ pub struct AtmosphereArgs {
     /// Scattering orders to precompute when no --tables are given.
     #[arg(long, default_value_t = 4)]
     pub orders: usize,
-    /// Table sizes when no --tables are given: `default` (SPEC sizes) or `small` (fast, coarse).
+    /// Table sizes when no --tables are given: `default` (Bruneton 2017's sizes) or `small` (fast, coarse).
     #[arg(long, default_value = "default", value_name = "default|small")]
     pub table_size: String,
     /// Store single Mie scattering for every wavelength (`separate`) or only the first (`red-only`, ratio rule).
@@ -58,6 +59,18 @@ pub struct AtmosphereArgs {
     /// ratio of the last two orders when --orders ≥ 3): the plain truncated sum.
     #[arg(long = "no-order-tail", action = clap::ArgAction::SetFalse)]
     pub order_tail: bool,
+}
+
+impl Default for AtmosphereArgs {
+    /// The values of an empty command line (the defaults live once, in the clap attributes).
+    fn default() -> Self {
+        #[derive(clap::Parser)]
+        struct Defaults {
+            #[command(flatten)]
+            atmosphere: AtmosphereArgs,
+        }
+        <Defaults as clap::Parser>::parse_from(["firmament"]).atmosphere
+    }
 }
 
 impl AtmosphereArgs {
@@ -134,14 +147,26 @@ pub fn compute_tables(model: &Model, config: &TableConfig, quiet: bool) -> Resul
     bar.finish_and_clear();
     let tables = tables.context("precomputing the tables")?;
     if !quiet {
-        eprintln!(
-            "tables: {:.2} s ({} wavelengths, {} orders)",
-            started.elapsed().as_secs_f64(),
-            model.channels(),
-            config.orders
-        );
+        print_tables_time(started, model, config, "", "");
     }
     Ok(tables)
+}
+
+/// The line on stderr after a precomputation started at `started`: `tables: SECONDS
+/// s{place} (N wavelengths, M orders{note})`.
+pub fn print_tables_time(
+    started: Instant,
+    model: &Model,
+    config: &TableConfig,
+    place: &str,
+    note: &str,
+) {
+    eprintln!(
+        "tables: {:.2} s{place} ({} wavelengths, {} orders{note})",
+        started.elapsed().as_secs_f64(),
+        model.channels(),
+        config.orders
+    );
 }
 
 /// A progress bar drawn on stderr only for work long enough to need one.
@@ -149,13 +174,28 @@ pub fn progress_bar(len: u64, quiet: bool) -> ProgressBar {
     if quiet {
         return ProgressBar::hidden();
     }
-    let bar = ProgressBar::new(len);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] {wide_bar} {percent:>3}% {msg}",
-        )
-        .expect("valid template"),
+    drawn(
+        ProgressBar::new(len),
+        "{spinner} [{elapsed_precise}] {wide_bar} {percent:>3}% {msg}",
+    )
+}
+
+/// A spinner on stderr for work that reports no progress (the GPU's); hidden when `quiet`.
+pub fn spinner(message: &str, quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let bar = drawn(
+        ProgressBar::new_spinner(),
+        "{spinner} [{elapsed_precise}] {msg}",
     );
+    bar.set_message(message.to_string());
+    bar
+}
+
+/// `bar` drawn with `template`, ticking by itself.
+fn drawn(bar: ProgressBar, template: &str) -> ProgressBar {
+    bar.set_style(ProgressStyle::with_template(template).expect("valid template"));
     bar.enable_steady_tick(Duration::from_millis(200));
     bar
 }
@@ -167,6 +207,14 @@ pub fn check_range(flag: &str, v: f64, lo: f64, hi: f64, unit: &str) -> Result<(
     } else {
         anyhow::bail!("invalid value for `{flag}`: {v} (accepted: a number in [{lo}, {hi}] {unit})")
     }
+}
+
+/// The reference path tracer's `--samples`: at least 2 paths (a standard error needs two).
+pub fn check_reference_samples(samples: usize) -> Result<()> {
+    if samples < 2 {
+        anyhow::bail!("invalid value for `--samples`: {samples} (accepted: an integer ≥ 2)");
+    }
+    Ok(())
 }
 
 /// The directory of a path exists (for clear errors before long work).
@@ -183,4 +231,17 @@ pub fn check_output_dir(path: &Path, flag: &str) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The median of a sorted sample (NaN when it is empty).
+pub fn median_of_sorted(sorted: &[f64]) -> f64 {
+    let n = sorted.len();
+    if n == 0 {
+        return f64::NAN;
+    }
+    if n % 2 == 1 {
+        sorted[n / 2]
+    } else {
+        0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
+    }
 }

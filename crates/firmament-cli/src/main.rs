@@ -1,23 +1,19 @@
 //! `firmament`: physically based sky and atmosphere rendering from the command line.
+//!
+//! A thin layer over the `firmament` library: each subcommand ([`commands`]) turns flags
+//! into library calls and prints or writes what they return; [`common`] and [`backend`]
+//! hold what several subcommands share.
 
 mod backend;
-mod bench;
+mod commands;
 mod common;
-mod gallery;
-mod gpu_bench;
-mod query;
-mod render;
-mod render_bench;
-mod validate;
 
-use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
-use firmament::atmosphere::{presets, Atmosphere};
 
-use common::AtmosphereArgs;
+use commands::{atmosphere, bake, bench, gallery, query, render, validate};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -37,21 +33,10 @@ enum Command {
     /// Print or check atmosphere definitions.
     Atmosphere {
         #[command(subcommand)]
-        action: AtmosphereAction,
+        action: atmosphere::AtmosphereAction,
     },
     /// Precompute the tables and write them to a file for `--tables`.
-    Bake {
-        #[command(flatten)]
-        atmosphere: AtmosphereArgs,
-        /// Output table file.
-        #[arg(long, value_name = "FILE")]
-        out: PathBuf,
-        /// Where the tables are computed: `cpu`, `gpu` (wgpu, any adapter; read back and
-        /// written in the same format) or `auto` (a hardware GPU when wgpu finds one, else
-        /// the CPU; never a software rasteriser such as lavapipe).
-        #[arg(long, value_enum, value_name = "cpu|gpu|auto", default_value_t = backend::BackendChoice::Auto)]
-        backend: backend::BackendChoice,
-    },
+    Bake(bake::BakeArgs),
     /// Render a picture of the sky (with no arguments: a default scene to firmament.png and firmament.exr).
     Render(render::RenderArgs),
     /// The canonical views as PNGs with an index.html contact sheet.
@@ -62,59 +47,14 @@ enum Command {
     Validate(validate::ValidateArgs),
 }
 
-#[derive(Subcommand, Debug)]
-enum AtmosphereAction {
-    /// Print a preset as a complete, commented TOML file.
-    Show {
-        /// Preset name.
-        name: String,
-    },
-    /// List the presets.
-    List,
-    /// Check an atmosphere file and print it back, complete.
-    Check {
-        /// TOML file.
-        file: PathBuf,
-    },
-}
-
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Query(args) => {
             let value = query::run(&args)?;
             println!("{}", serde_json::to_string_pretty(&value)?);
         }
-        Command::Atmosphere { action } => match action {
-            AtmosphereAction::Show { name } => print!("{}", presets::toml_text(&name)?),
-            AtmosphereAction::List => {
-                for name in presets::NAMES {
-                    let a = Atmosphere::preset(name)?;
-                    println!("{name:14} {}", a.description);
-                }
-            }
-            AtmosphereAction::Check { file } => {
-                let a = Atmosphere::from_file(&file)?;
-                print!("{}", a.to_toml());
-            }
-        },
-        Command::Bake {
-            atmosphere,
-            out,
-            backend,
-        } => {
-            common::check_output_dir(&out, "--out")?;
-            if atmosphere.tables.is_some() {
-                anyhow::bail!("`bake` computes tables: --tables makes no sense here");
-            }
-            let model = atmosphere.model()?;
-            let config = atmosphere.table_config()?;
-            let tables = match backend::Backend::open(backend, false)? {
-                backend::Backend::Cpu => common::compute_tables(&model, &config, false)?,
-                backend::Backend::Gpu(gpu) => gpu.tables(&model, &config, false)?,
-            };
-            firmament::sky::bruneton4d::file::write(&tables, &out)?;
-            eprintln!("wrote {}", out.display());
-        }
+        Command::Atmosphere { action } => atmosphere::run(&action)?,
+        Command::Bake(args) => bake::run(&args)?,
         Command::Bench(args) => bench::run(&args)?,
         Command::Render(args) => render::run(&args)?,
         Command::Gallery(args) => gallery::run(&args)?,

@@ -6,63 +6,12 @@
 //! skip (saying so), unless `CI` is set, where they fail. They run one at a time (lavapipe
 //! uses every core) on small tables and tiny images.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 use std::sync::{Mutex, MutexGuard, OnceLock};
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_firmament"))
-}
-
-fn tmp() -> &'static Path {
-    static DIR: OnceLock<PathBuf> = OnceLock::new();
-    DIR.get_or_init(|| {
-        let d =
-            std::env::temp_dir().join(format!("firmament-cli-backend-test-{}", std::process::id()));
-        std::fs::create_dir_all(&d).unwrap();
-        d
-    })
-}
-
-fn run(args: &[&str]) -> Output {
-    bin().args(args).output().unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn succeeds(o: &Output) {
-    assert!(o.status.success(), "{}", stderr(o));
-    assert!(!stderr(o).contains("panicked"), "{}", stderr(o));
-}
-
-fn fails_with(o: &Output, words: &[&str]) {
-    assert!(!o.status.success(), "should fail: {}", stderr(o));
-    let e = stderr(o);
-    for w in words {
-        assert!(e.contains(w), "missing {w:?} in: {e}");
-    }
-    assert!(!e.contains("panicked"), "{e}");
-}
-
-/// Small RGB tables for the earth preset, baked once on the CPU.
-fn tables() -> &'static str {
-    static T: OnceLock<PathBuf> = OnceLock::new();
-    T.get_or_init(|| {
-        let p = tmp().join("earth-small.lut");
-        let o = bin()
-            .args(["bake", "--backend", "cpu", "--table-size", "small"])
-            .args(["--orders", "3", "--out"])
-            .arg(&p)
-            .output()
-            .unwrap();
-        succeeds(&o);
-        p
-    })
-    .to_str()
-    .unwrap()
-}
+use common::{bin, fails_with, run, stderr, succeeds, tables_arg, tmp};
 
 /// Whether GPU tests run: an adapter opens (panics under `CI` when none does). Holds the
 /// lock that keeps GPU tests apart.
@@ -181,7 +130,7 @@ fn every_command_says_which_backend() {
     let o = run(&[
         "render",
         "--tables",
-        tables(),
+        tables_arg(),
         "--width",
         "16",
         "--height",
@@ -199,7 +148,7 @@ fn every_command_says_which_backend() {
     let o = run(&[
         "render",
         "--tables",
-        tables(),
+        tables_arg(),
         "--width",
         "16",
         "--height",
@@ -214,7 +163,7 @@ fn every_command_says_which_backend() {
     let o = run(&[
         "query",
         "--tables",
-        tables(),
+        tables_arg(),
         "--altitude-m",
         "0",
         "--sun-zenith-deg",
@@ -248,7 +197,7 @@ fn missing_gpu_is_a_clear_error_and_auto_falls_back() {
             "--backend",
             "gpu",
             "--tables",
-            tables(),
+            tables_arg(),
             "--width",
             "16",
             "--height",
@@ -275,7 +224,7 @@ fn missing_gpu_is_a_clear_error_and_auto_falls_back() {
     let o = no_gpu(&[
         "render",
         "--tables",
-        tables(),
+        tables_arg(),
         "--width",
         "16",
         "--height",
@@ -302,7 +251,7 @@ fn gpu_render_from_table_file_matches_cpu() {
             name,
             &[
                 "--tables",
-                tables(),
+                tables_arg(),
                 "--camera",
                 camera,
                 "--width",

@@ -1,58 +1,11 @@
 //! The `firmament` binary end to end: JSON output, every camera and format, and clear
 //! errors (non-zero exit, no output file) for bad input.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-use std::sync::OnceLock;
+mod common;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_firmament"))
-}
+use std::path::Path;
 
-fn tmp() -> &'static Path {
-    static DIR: OnceLock<PathBuf> = OnceLock::new();
-    DIR.get_or_init(|| {
-        let d = std::env::temp_dir().join(format!("firmament-cli-test-{}", std::process::id()));
-        std::fs::create_dir_all(&d).unwrap();
-        d
-    })
-}
-
-/// Small RGB tables for the earth preset, baked once.
-fn tables() -> &'static Path {
-    static T: OnceLock<PathBuf> = OnceLock::new();
-    T.get_or_init(|| {
-        let p = tmp().join("earth-small.lut");
-        let out = bin()
-            .args(["bake", "--table-size", "small", "--orders", "3", "--out"])
-            .arg(&p)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        p
-    })
-}
-
-fn run(args: &[&str]) -> Output {
-    bin().args(args).output().unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn fails_with(o: &Output, words: &[&str]) {
-    assert!(!o.status.success(), "should fail: {}", stderr(o));
-    let e = stderr(o);
-    for w in words {
-        assert!(e.contains(w), "missing {w:?} in: {e}");
-    }
-    assert!(!e.contains("panicked"), "{e}");
-}
+use common::{fails_with, run, stderr, tables, tmp};
 
 #[test]
 fn query_prints_the_documented_json() {

@@ -2,35 +2,19 @@
 //! the table method's daylight accuracy), `query --method reference`, `render --method
 //! reference`, and the errors for unknown methods.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
 
 use serde_json::Value;
 
-fn firmament(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_firmament"))
-        .args(args)
-        .output()
-        .expect("run the firmament binary")
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("firmament-cli-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use common::{run, stderr, tmp_subdir};
 
 /// The reduced validation runs, passes the daylight thresholds and writes the documented
 /// JSON fields.
 #[test]
 fn validate_quick_passes_and_writes_json() {
-    let dir = temp_dir("validate");
+    let dir = tmp_subdir("validate");
     let json_path = dir.join("quick.json");
-    let out = firmament(&[
+    let out = run(&[
         "validate",
         "--quick",
         "--quiet",
@@ -98,7 +82,7 @@ fn validate_quick_passes_and_writes_json() {
 
 #[test]
 fn query_method_reference_adds_stderr_and_samples() {
-    let out = firmament(&[
+    let out = run(&[
         "query",
         "--altitude-m",
         "0",
@@ -136,7 +120,7 @@ fn query_method_reference_adds_stderr_and_samples() {
         assert!(view["luminance_cd_m2_stderr"].as_f64().unwrap() > 0.0);
     }
     // The table method has neither field.
-    let out = firmament(&[
+    let out = run(&[
         "query",
         "--altitude-m",
         "0",
@@ -155,7 +139,7 @@ fn query_method_reference_adds_stderr_and_samples() {
 
 #[test]
 fn unknown_method_is_a_clear_error() {
-    let out = firmament(&[
+    let out = run(&[
         "query",
         "--altitude-m",
         "0",
@@ -172,9 +156,9 @@ fn unknown_method_is_a_clear_error() {
         e.contains("invalid value for `--method`: magic (accepted: lut, reference)"),
         "{e}"
     );
-    let dir = temp_dir("method");
+    let dir = tmp_subdir("method");
     let png = dir.join("x.png");
-    let out = firmament(&[
+    let out = run(&[
         "render",
         "--method",
         "magic",
@@ -189,10 +173,10 @@ fn unknown_method_is_a_clear_error() {
 
 #[test]
 fn render_method_reference_writes_the_same_formats() {
-    let dir = temp_dir("render");
+    let dir = tmp_subdir("render");
     let png = dir.join("ref.png");
     let exr = dir.join("ref.exr");
-    let out = firmament(&[
+    let out = run(&[
         "render",
         "--method",
         "reference",

@@ -3,15 +3,15 @@
 use anyhow::Result;
 use clap::Args;
 use firmament::math::{direction_from_zenith_azimuth, Vec3};
-use firmament::scene::Light;
+use firmament::reference::{self, ReferenceSettings};
+use firmament::scene::{sun_direction, Light};
 use firmament::sky::{Shadow, SkyMethod};
-use firmament::spectrum::{spectrum_to_xyz, xyz_to_linear_srgb};
+use firmament::spectrum::{luminance_from_spectrum, spectrum_to_xyz, xyz_to_linear_srgb};
+use serde::Serialize;
 use serde_json::json;
 
-use firmament::reference::{self, ReferenceSettings};
-
 use crate::backend::{Backend, BackendChoice};
-use crate::common::{check_range, AtmosphereArgs};
+use crate::common::{check_range, check_reference_samples, AtmosphereArgs};
 
 /// Arguments of `firmament query`.
 #[derive(Args, Debug)]
@@ -54,6 +54,24 @@ pub struct QueryArgs {
     pub quiet: bool,
 }
 
+/// The answer for one `--view`; the last three only with `--method reference`.
+#[derive(Serialize)]
+struct ViewAnswer {
+    zenith_deg: f64,
+    azimuth_deg: f64,
+    radiance: Vec<f64>,
+    luminance_cd_m2: f64,
+    xyz: [f64; 3],
+    srgb_linear: [f64; 3],
+    transmittance: Vec<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    radiance_stderr: Option<Vec<f64>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    luminance_cd_m2_stderr: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    samples: Option<usize>,
+}
+
 fn parse_view(s: &str) -> Result<(f64, f64)> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     let parsed: Vec<f64> = parts.iter().filter_map(|p| p.parse().ok()).collect();
@@ -92,12 +110,7 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
                 seed: args.seed,
                 ..Default::default()
             };
-            if settings.samples < 2 {
-                anyhow::bail!(
-                    "invalid value for `--samples`: {} (accepted: an integer ≥ 2)",
-                    args.samples
-                );
-            }
+            check_reference_samples(settings.samples)?;
             settings.validate()?;
             Some(settings)
         }
@@ -129,56 +142,48 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
 
     let camera = Vec3::new(0.0, 0.0, model.bottom_radius_m + args.altitude_m);
     let up = Vec3::Z;
-    let sun = direction_from_zenith_azimuth(
-        args.sun_zenith_deg.to_radians(),
-        args.sun_azimuth_deg.to_radians(),
-    );
+    let sun = sun_direction(args.sun_zenith_deg, args.sun_azimuth_deg);
 
-    let depths = model.optical_depths_vertical(args.altitude_m);
-    let e_toa = model.solar_irradiance.clone();
-    let mut sun_t = vec![0.0; n];
+    let optical_depths = model.optical_depths_vertical(args.altitude_m);
+    let mut sun_transmittance = vec![0.0; n];
     let light = Light::sun(model, sun, false);
-    let view = sky.view(camera, &light);
-    view.transmittance_to_light(camera, &mut sun_t);
-    let (mut e_sun, mut e_sky) = (vec![0.0; n], vec![0.0; n]);
+    let sky_view = sky.view(camera, &light);
+    sky_view.transmittance_to_light(camera, &mut sun_transmittance);
+    let (mut sun_irradiance, mut sky_irradiance) = (vec![0.0; n], vec![0.0; n]);
     if args.altitude_m <= model.height_m() {
-        view.sun_and_sky_irradiance(camera, up, &mut e_sun, &mut e_sky);
+        sky_view.sun_and_sky_irradiance(camera, up, &mut sun_irradiance, &mut sky_irradiance);
     } else {
         // In space: the direct beam only (no sky below a horizontal surface facing up).
         let cos = sun[2].max(0.0);
         for k in 0..n {
-            e_sun[k] = e_toa[k] * sun_t[k] * cos;
+            sun_irradiance[k] = model.solar_irradiance[k] * sun_transmittance[k] * cos;
         }
     }
-    let lux = |v: &[f64]| spectrum_to_xyz(&nm, v)[1];
+    let lux = |v: &[f64]| luminance_from_spectrum(&nm, v);
 
-    let mut view_json = Vec::new();
-    for (i, &(z, a)) in views.iter().enumerate() {
-        let dir = direction_from_zenith_azimuth(z.to_radians(), a.to_radians());
-        let (mut radiance, mut t) = (vec![0.0; n], vec![0.0; n]);
-        view.sky_radiance(dir, Shadow::None, &mut radiance, &mut t);
+    let mut answers = Vec::new();
+    for (i, &(zenith_deg, azimuth_deg)) in views.iter().enumerate() {
+        let dir = direction_from_zenith_azimuth(zenith_deg.to_radians(), azimuth_deg.to_radians());
+        let (mut radiance, mut transmittance) = (vec![0.0; n], vec![0.0; n]);
+        sky_view.sky_radiance(dir, Shadow::None, &mut radiance, &mut transmittance);
         let estimate = reference.as_ref().map(|settings| {
             let e = reference::sky_radiance_keyed(model, camera, dir, sun, settings, i as u64);
             radiance.copy_from_slice(&e.radiance);
             e
         });
         let xyz = spectrum_to_xyz(&nm, &radiance);
-        let mut entry = json!({
-            "zenith_deg": z,
-            "azimuth_deg": a,
-            "radiance": radiance,
-            "luminance_cd_m2": xyz[1],
-            "xyz": xyz,
-            "srgb_linear": xyz_to_linear_srgb(xyz),
-            "transmittance": t,
+        answers.push(ViewAnswer {
+            zenith_deg,
+            azimuth_deg,
+            luminance_cd_m2: xyz[1],
+            xyz,
+            srgb_linear: xyz_to_linear_srgb(xyz),
+            radiance,
+            transmittance,
+            luminance_cd_m2_stderr: estimate.as_ref().map(|e| e.luminance(&nm).1),
+            samples: estimate.as_ref().map(|e| e.samples),
+            radiance_stderr: estimate.map(|e| e.stderr),
         });
-        if let Some(e) = estimate {
-            let (_, y_err) = e.luminance(&nm);
-            entry["radiance_stderr"] = json!(e.stderr);
-            entry["luminance_cd_m2_stderr"] = json!(y_err);
-            entry["samples"] = json!(e.samples);
-        }
-        view_json.push(entry);
     }
     let notes = match &reference {
         None => json!([]),
@@ -200,17 +205,17 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
         },
         "altitude_m": args.altitude_m,
         "sun": { "zenith_deg": args.sun_zenith_deg, "azimuth_deg": args.sun_azimuth_deg },
-        "optical_depth_zenith": depths,
-        "solar_irradiance_toa": e_toa,
+        "optical_depth_zenith": optical_depths,
+        "solar_irradiance_toa": model.solar_irradiance,
         "solar_illuminance_toa_lux": lux(&model.solar_irradiance),
-        "sun_transmittance": sun_t,
+        "sun_transmittance": sun_transmittance,
         "irradiance": {
-            "sun": e_sun,
-            "sky": e_sky,
-            "sun_lux": lux(&e_sun),
-            "sky_lux": lux(&e_sky),
+            "sun": sun_irradiance,
+            "sky": sky_irradiance,
+            "sun_lux": lux(&sun_irradiance),
+            "sky_lux": lux(&sky_irradiance),
         },
-        "views": view_json,
+        "views": answers,
         "notes": notes,
     }))
 }

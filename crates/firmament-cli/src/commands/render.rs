@@ -7,16 +7,19 @@ use anyhow::{Context, Result};
 use clap::Args;
 use firmament::atmosphere::Model;
 use firmament::io::{self, ExrPrecision, OutputFormat};
+use firmament::math::Vec3;
 use firmament::reference::{self, ReferenceSettings};
 use firmament::render::{self, tonemap, RenderSettings, ToneCurve};
 use firmament::scene::{sun_direction, Light, Projection, SceneFile as Scene};
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
-use crate::common::{cancel_flag, check_output_dir, progress_bar, AtmosphereArgs};
+use crate::common::{
+    cancel_flag, check_output_dir, check_reference_samples, progress_bar, AtmosphereArgs,
+};
 
 /// Arguments of `firmament render`; flags override the scene file, which overrides the
 /// built-in default scene.
-#[derive(Args, Debug, Default)]
+#[derive(Args, Debug)]
 pub struct RenderArgs {
     /// Scene file (TOML; see scenes/ for examples).
     #[arg(long, value_name = "FILE")]
@@ -117,7 +120,7 @@ fn parse_projection(s: &str) -> Result<Projection> {
 }
 
 /// The scene after applying flags.
-pub fn scene_from_args(args: &RenderArgs) -> Result<Scene> {
+fn scene_from_args(args: &RenderArgs) -> Result<Scene> {
     let mut scene = match &args.scene {
         Some(path) => Scene::from_file(path)?,
         None => Scene::default(),
@@ -214,29 +217,45 @@ pub fn atmosphere_args(scene: &Scene, tables: Option<PathBuf>, table_size: &str)
         atmosphere: scene.atmosphere.file.clone(),
         wavelengths: scene.atmosphere.wavelengths.clone(),
         tables,
-        orders: 4,
         table_size: table_size.to_string(),
-        mie: "separate".into(),
-        order_tail: true,
+        ..AtmosphereArgs::default()
     }
 }
 
-/// Render the scene with a sky on its backend; returns the frame and the EV100 used.
-pub fn render_scene(sky: &RenderSky, scene: &Scene, quiet: bool) -> Result<(render::Frame, f64)> {
-    let settings = RenderSettings {
+/// The render settings of the scene's camera and image.
+fn render_settings(scene: &Scene) -> RenderSettings<'_> {
+    RenderSettings {
         camera: &scene.camera,
         width: scene.image.width,
         height: scene.image.height,
         white_balance: scene.output.white_balance,
-    };
-    let sun = sun_direction(scene.sun.zenith_deg, scene.sun.azimuth_deg);
-    let frame = sky
-        .render(&settings, sun, scene.sun.disk, quiet)
-        .context("rendering")?;
-    let ev100 = scene
+    }
+}
+
+/// The direction of the scene's sun.
+fn sun_direction_of(scene: &Scene) -> Vec3 {
+    sun_direction(scene.sun.zenith_deg, scene.sun.azimuth_deg)
+}
+
+/// The scene's EV100, or the automatic exposure of the frame.
+fn ev100(scene: &Scene, frame: &render::Frame) -> f64 {
+    scene
         .output
         .ev100
-        .unwrap_or_else(|| tonemap::auto_ev100(frame.log_average_luminance()));
+        .unwrap_or_else(|| tonemap::auto_ev100(frame.log_average_luminance()))
+}
+
+/// Render the scene with a sky on its backend; returns the frame and the EV100 used.
+pub fn render_scene(sky: &RenderSky, scene: &Scene, quiet: bool) -> Result<(render::Frame, f64)> {
+    let frame = sky
+        .render(
+            &render_settings(scene),
+            sun_direction_of(scene),
+            scene.sun.disk,
+            quiet,
+        )
+        .context("rendering")?;
+    let ev100 = ev100(scene, &frame);
     Ok((frame, ev100))
 }
 
@@ -280,31 +299,19 @@ pub fn write_outputs(
 
 /// Render the scene with the Monte Carlo reference (`reference::render_frame`); returns the
 /// frame and the EV100 used. Ctrl-C stops it between batches of pixels.
-pub fn render_scene_reference(
+fn render_scene_reference(
     model: &Model,
     scene: &Scene,
     samples: usize,
     quiet: bool,
 ) -> Result<(render::Frame, f64)> {
-    if samples < 2 {
-        anyhow::bail!("invalid value for `--samples`: {samples} (accepted: an integer ≥ 2)");
-    }
-    let settings = RenderSettings {
-        camera: &scene.camera,
-        width: scene.image.width,
-        height: scene.image.height,
-        white_balance: scene.output.white_balance,
-    };
-    let sun = Light::sun(
-        model,
-        sun_direction(scene.sun.zenith_deg, scene.sun.azimuth_deg),
-        scene.sun.disk,
-    );
+    check_reference_samples(samples)?;
+    let sun = Light::sun(model, sun_direction_of(scene), scene.sun.disk);
     let bar = progress_bar(1000, quiet);
     bar.set_message(format!("reference, {samples} paths/λ"));
     let result = reference::render_frame(
         model,
-        &settings,
+        &render_settings(scene),
         &sun,
         &ReferenceSettings::with_samples(samples),
         &|f| bar.set_position((f * 1000.0) as u64),
@@ -318,10 +325,7 @@ pub fn render_scene_reference(
             100.0 * mean_stderr
         );
     }
-    let ev100 = scene
-        .output
-        .ev100
-        .unwrap_or_else(|| tonemap::auto_ev100(frame.log_average_luminance()));
+    let ev100 = ev100(scene, &frame);
     Ok((frame, ev100))
 }
 
@@ -333,7 +337,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         OutputFormat::from_path(f)?;
     }
     match args.method.as_str() {
-        // "" is `RenderArgs::default()` built in code: the default method.
+        // An empty `--method` is taken as the default.
         "lut" | "" => {}
         "reference" => {
             if args.tables.is_some() {

@@ -2,6 +2,7 @@
 //! as PNGs with an index.html contact sheet.
 
 use std::fmt::Write as _;
+use std::io::Write as _;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -11,7 +12,7 @@ use firmament::scene::camera::orbit_fit_fov_deg;
 use firmament::scene::{Camera, Projection, SceneFile as Scene};
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
-use crate::render::{atmosphere_args, render_scene, write_outputs};
+use crate::commands::render::{atmosphere_args, render_scene, write_outputs};
 
 /// Arguments of `firmament gallery`.
 #[derive(Args, Debug)]
@@ -127,9 +128,8 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
         );
     }
     let index = args.out.join("index.html");
-    let tmp = args.out.join(".index.html.tmp");
-    std::fs::write(&tmp, html)?;
-    std::fs::rename(&tmp, &index)?;
+    firmament::io::write_atomic(&index, |out| Ok(out.write_all(html.as_bytes())?))
+        .with_context(|| format!("writing {}", index.display()))?;
     if !args.quiet {
         eprintln!("wrote {}", index.display());
     }

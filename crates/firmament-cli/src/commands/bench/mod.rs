@@ -1,0 +1,133 @@
+//! `firmament bench`: medians of the main costs, printed as text or one JSON object.
+//!
+//! Imports run one way: the leaves [`timing`] (runs and medians), [`scenes`] (the frames
+//! measured) and [`report`] (what is printed) import nothing of bench; [`cpu`] and [`gpu`]
+//! measure with them and take plain values, not the arguments; this module chooses what to
+//! measure and prints the report.
+
+mod cpu;
+mod gpu;
+mod report;
+mod scenes;
+mod timing;
+
+use anyhow::Result;
+use clap::{Args, ValueEnum};
+
+use crate::backend::{Gpu, Probe};
+use crate::common::AtmosphereArgs;
+use report::{BenchReport, Machine};
+
+/// What `firmament bench` measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum BenchBackend {
+    /// The CPU, and the GPU when wgpu finds a hardware adapter (software rasterisers are
+    /// skipped: see `all`).
+    Auto,
+    /// The CPU and the GPU on whatever adapter wgpu finds, software rasterisers included.
+    All,
+    /// The CPU only.
+    Cpu,
+    /// The GPU only (any adapter).
+    Gpu,
+}
+
+/// Arguments of `firmament bench`.
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    #[command(flatten)]
+    pub atmosphere: AtmosphereArgs,
+    /// Repetitions per measurement (the median is reported).
+    #[arg(long, default_value_t = 5)]
+    pub runs: usize,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// Also time the spectral (16-wavelength) precomputation.
+    #[arg(long)]
+    pub spectral: bool,
+    /// Which backends to measure. GPU: the precompute (same sizes, wavelengths and orders as
+    /// the CPU's) and the CPU's 1080p frame, on the adapter wgpu opens. A software
+    /// rasteriser (Mesa lavapipe) is measured only with `all` or `gpu`: on the 2-core
+    /// machine of BENCHMARKS.md one default-size precompute on lavapipe takes about two
+    /// minutes (the CPU path: seconds), so use `--gpu-runs 1` (and `--table-size small` for
+    /// a quick look).
+    #[arg(long, value_enum, value_name = "auto|all|cpu|gpu", default_value_t = BenchBackend::Auto)]
+    pub backend: BenchBackend,
+    /// Repetitions per GPU measurement (default: --runs).
+    #[arg(long, value_name = "N")]
+    pub gpu_runs: Option<usize>,
+}
+
+/// Run the benchmarks.
+pub fn run(args: &BenchArgs) -> Result<()> {
+    let model = args.atmosphere.model()?;
+    let config = args.atmosphere.table_config()?;
+    let spectral_model = if args.spectral {
+        let mut spectral_args = args.atmosphere.clone();
+        spectral_args.wavelengths = "spectral".into();
+        Some(spectral_args.model()?)
+    } else {
+        None
+    };
+    let machine = Machine::this();
+    // The GPU to measure, or why none.
+    let (gpu, gpu_skipped) = match args.backend {
+        BenchBackend::Cpu => (None, Some("not requested (--backend cpu)".to_string())),
+        BenchBackend::Gpu | BenchBackend::All => (Some(Gpu::open()?), None),
+        BenchBackend::Auto => match Gpu::probe_hardware() {
+            Probe::Hardware(gpu) => (Some(*gpu), None),
+            Probe::NoHardware(why) => (
+                None,
+                Some(format!("{why} (--backend all measures a software adapter)")),
+            ),
+        },
+    };
+    let measure_cpu = args.backend != BenchBackend::Gpu;
+    if !args.json {
+        eprintln!(
+            "machine: {}, {} threads; {} runs per measurement",
+            machine.cpu, machine.threads, args.runs
+        );
+        match (&gpu, &gpu_skipped) {
+            (Some(gpu), _) => eprintln!("backend: gpu ({})", gpu.describe()),
+            (None, Some(why)) => eprintln!("backend: gpu not measured: {why}"),
+            (None, None) => {}
+        }
+        if !measure_cpu {
+            eprintln!("backend: cpu not measured (--backend gpu)");
+        }
+    }
+    let mut report = BenchReport {
+        machine,
+        runs: args.runs,
+        cpu_precompute: Default::default(),
+        cpu_frames: Default::default(),
+        gpu_skipped,
+        gpu: Default::default(),
+    };
+    if measure_cpu {
+        report.cpu_precompute =
+            cpu::precompute_timings(&model, &config, args.runs, spectral_model.as_ref())?;
+        report.cpu_frames = cpu::frame_timings(&args.atmosphere.sky(true)?, args.runs)?;
+    }
+    if let Some(gpu) = &gpu {
+        let runs = args.gpu_runs.unwrap_or(args.runs).max(1);
+        report.gpu = gpu::timings(
+            gpu,
+            &model,
+            &config,
+            spectral_model.as_ref(),
+            runs,
+            !args.json,
+        )?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report.to_json())?);
+    } else {
+        for line in report.lines() {
+            println!("{line}");
+        }
+    }
+    Ok(())
+}

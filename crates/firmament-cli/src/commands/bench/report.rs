@@ -1,0 +1,109 @@
+//! What `firmament bench` reports: one object whose fields are the keys of `--json` (and of
+//! the `key: value` lines of the text output). Every key is always there, `null` when it was
+//! not measured; the groups measured together are flattened into the one object. Printed
+//! through [`serde_json::Value`], whose map keeps the keys in alphabetical order.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+/// The whole report.
+#[derive(Serialize, Debug)]
+pub struct BenchReport {
+    /// The machine the figures were taken on.
+    pub machine: Machine,
+    /// `--runs`: repetitions per CPU measurement.
+    pub runs: usize,
+    #[serde(flatten)]
+    pub cpu_precompute: CpuPrecompute,
+    #[serde(flatten)]
+    pub cpu_frames: CpuFrames,
+    /// Why the GPU was not measured; `null` when it was.
+    pub gpu_skipped: Option<String>,
+    #[serde(flatten)]
+    pub gpu: GpuTimings,
+}
+
+/// The CPU's model name and the threads the CPU work ran on.
+#[derive(Serialize, Debug)]
+pub struct Machine {
+    pub cpu: String,
+    pub threads: usize,
+}
+
+/// The CPU precomputation of the tables: seconds (medians) and what was computed.
+#[derive(Serialize, Debug, Default)]
+pub struct CpuPrecompute {
+    pub cpu_precompute_s: Option<f64>,
+    pub cpu_precompute_wavelengths: Option<usize>,
+    pub cpu_precompute_orders: Option<usize>,
+    /// Seconds of one run per stage (transmittance, single scattering, …).
+    pub cpu_precompute_stages_s: Option<BTreeMap<String, f64>>,
+    /// With `--spectral`.
+    pub cpu_precompute_spectral_s: Option<f64>,
+    pub cpu_precompute_spectral_wavelengths: Option<usize>,
+}
+
+/// The CPU renderer's frames, seconds (medians; tone mapping to 8 bits included).
+#[derive(Serialize, Debug, Default)]
+pub struct CpuFrames {
+    pub cpu_frame_1080p_perspective_s: Option<f64>,
+    pub cpu_frame_1024_fisheye_s: Option<f64>,
+    pub cpu_frame_4096x2048_equirect_s: Option<f64>,
+}
+
+/// The GPU: the adapter, the precomputation and the 1080p frame.
+#[derive(Serialize, Debug, Default)]
+pub struct GpuTimings {
+    pub gpu_adapter: Option<String>,
+    pub gpu_backend: Option<String>,
+    pub gpu_adapter_software: Option<bool>,
+    /// `--gpu-runs`: repetitions per GPU measurement.
+    pub gpu_runs: Option<usize>,
+    pub gpu_pipeline_creation_s: Option<f64>,
+    pub gpu_precompute_s: Option<f64>,
+    pub gpu_precompute_timing_method: Option<String>,
+    pub gpu_precompute_spectral_s: Option<f64>,
+    pub gpu_precompute_wavelengths: Option<usize>,
+    pub gpu_precompute_orders: Option<usize>,
+    pub gpu_frame_1080p_perspective_s: Option<f64>,
+    pub gpu_frame_timing_method: Option<String>,
+    pub gpu_frame_1080p_perspective_with_readback_s: Option<f64>,
+}
+
+impl Machine {
+    /// This machine: the CPU model from /proc/cpuinfo (Linux; "unknown" elsewhere) and
+    /// rayon's threads.
+    pub fn this() -> Machine {
+        let cpu = std::fs::read_to_string("/proc/cpuinfo")
+            .ok()
+            .and_then(|s| {
+                s.lines()
+                    .find(|l| l.starts_with("model name"))
+                    .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+            })
+            .unwrap_or_else(|| "unknown".into());
+        Machine {
+            cpu,
+            threads: rayon::current_num_threads(),
+        }
+    }
+}
+
+impl BenchReport {
+    /// The report as one JSON object (keys in alphabetical order).
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::to_value(self).expect("a report serialises")
+    }
+
+    /// The text output: a `key: value` line per key, the value as compact JSON.
+    pub fn lines(&self) -> Vec<String> {
+        match self.to_json() {
+            serde_json::Value::Object(map) => map
+                .iter()
+                .map(|(key, value)| format!("{key}: {value}"))
+                .collect(),
+            _ => unreachable!("a report is an object"),
+        }
+    }
+}

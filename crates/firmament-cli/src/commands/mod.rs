@@ -1,0 +1,10 @@
+//! One module per subcommand: its arguments (clap) and its `run`. What several share lives
+//! in [`crate::common`] (atmosphere and tables) and [`crate::backend`] (CPU or GPU).
+
+pub mod atmosphere;
+pub mod bake;
+pub mod bench;
+pub mod gallery;
+pub mod query;
+pub mod render;
+pub mod validate;

@@ -1,0 +1,83 @@
+//! Helpers shared by the integration tests: the binary, a temporary directory per test
+//! binary, running a command and reading its stderr, the checks on success and failure, and
+//! small RGB tables baked once.
+//!
+//! Each test file compiles its own copy (`mod common;`) and uses only some of these.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+
+/// The `firmament` binary under test.
+pub fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_firmament"))
+}
+
+/// A directory of this test binary (`backend`, `cli`, `validate`) and process, created once.
+pub fn tmp() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let d = std::env::temp_dir().join(format!(
+            "firmament-cli-{}-test-{}",
+            env!("CARGO_CRATE_NAME"),
+            std::process::id()
+        ));
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    })
+}
+
+/// A fresh subdirectory `name` of [`tmp`].
+pub fn tmp_subdir(name: &str) -> PathBuf {
+    let dir = tmp().join(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Run the binary with `args` and wait for it.
+pub fn run(args: &[&str]) -> Output {
+    bin().args(args).output().expect("run the firmament binary")
+}
+
+/// What the command printed on stderr.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// The command succeeded without a panic.
+pub fn succeeds(o: &Output) {
+    assert!(o.status.success(), "{}", stderr(o));
+    assert!(!stderr(o).contains("panicked"), "{}", stderr(o));
+}
+
+/// The command failed, without a panic, with every one of `words` in its message.
+pub fn fails_with(o: &Output, words: &[&str]) {
+    assert!(!o.status.success(), "should fail: {}", stderr(o));
+    let e = stderr(o);
+    for w in words {
+        assert!(e.contains(w), "missing {w:?} in: {e}");
+    }
+    assert!(!e.contains("panicked"), "{e}");
+}
+
+/// Small RGB tables for the earth preset (3 orders), baked once on the CPU.
+pub fn tables() -> &'static Path {
+    static T: OnceLock<PathBuf> = OnceLock::new();
+    T.get_or_init(|| {
+        let p = tmp().join("earth-small.lut");
+        let o = bin()
+            .args(["bake", "--backend", "cpu", "--table-size", "small"])
+            .args(["--orders", "3", "--out"])
+            .arg(&p)
+            .output()
+            .unwrap();
+        succeeds(&o);
+        p
+    })
+}
+
+/// [`tables`] as a command-line argument.
+pub fn tables_arg() -> &'static str {
+    tables().to_str().unwrap()
+}
