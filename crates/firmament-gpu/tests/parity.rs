@@ -1,9 +1,10 @@
-//! CPU–GPU parity of the precomputed tables (issue 5 acceptance): every table texel by
+//! CPU–GPU parity of the precomputed tables: every table texel by
 //! texel within a relative tolerance over texels with non-negligible values (above 1e-4 of
 //! the table's largest value), on whatever adapter is found (lavapipe in CI).
 
-use std::sync::{Mutex, OnceLock};
+mod common;
 
+use common::serial;
 use firmament::atmosphere::{Atmosphere, Model};
 use firmament::sky::bruneton4d::{MieStorage, Table4, TableConfig, TableSizes, Tables};
 use firmament::spectrum::Wavelengths;
@@ -12,27 +13,9 @@ use firmament_gpu::{GpuContext, GpuError};
 /// Texels below this fraction of the table maximum are not compared.
 const NEGLIGIBLE: f64 = 1e-4;
 
-fn context() -> Option<&'static GpuContext> {
-    static CTX: OnceLock<Option<GpuContext>> = OnceLock::new();
-    CTX.get_or_init(|| {
-        let ctx = firmament_gpu::test_context();
-        if let Some(c) = &ctx {
-            eprintln!(
-                "GPU adapter: {} ({}, software: {})",
-                c.adapter_name(),
-                c.backend(),
-                c.is_software()
-            );
-        }
-        ctx
-    })
-    .as_ref()
-}
-
-/// One GPU test at a time: the machine is small and lavapipe uses every core.
-fn serial() -> std::sync::MutexGuard<'static, ()> {
-    static LOCK: Mutex<()> = Mutex::new(());
-    LOCK.lock().unwrap_or_else(|e| e.into_inner())
+/// The device, or None where there is none (saying that `test` is skipped).
+fn context(test: &str) -> Option<&'static GpuContext> {
+    common::gpu(test).map(|g| &g.ctx)
 }
 
 struct Stats {
@@ -135,8 +118,8 @@ fn model(preset: &str, wavelengths: Wavelengths) -> Model {
         .unwrap()
 }
 
-fn both(model: &Model, config: &TableConfig) -> Option<(Tables, Tables)> {
-    let ctx = context()?;
+fn both(test: &str, model: &Model, config: &TableConfig) -> Option<(Tables, Tables)> {
+    let ctx = context(test)?;
     let _guard = serial();
     let cpu = Tables::compute(model, config).unwrap();
     let gpu = firmament_gpu::precompute(ctx, model, config).unwrap();
@@ -233,7 +216,11 @@ fn transmittance_and_single_scattering_match_the_cpu() {
         mie: MieStorage::Separate,
         order_tail: true,
     };
-    let Some((cpu, gpu)) = both(&model, &config) else {
+    let Some((cpu, gpu)) = both(
+        "transmittance_and_single_scattering_match_the_cpu",
+        &model,
+        &config,
+    ) else {
         return;
     };
     check_layout(&cpu, &gpu);
@@ -265,7 +252,7 @@ fn all_orders_match_the_cpu() {
         mie: MieStorage::Separate,
         order_tail: true,
     };
-    let Some((cpu, gpu)) = both(&model, &config) else {
+    let Some((cpu, gpu)) = both("all_orders_match_the_cpu", &model, &config) else {
         return;
     };
     check_layout(&cpu, &gpu);
@@ -311,7 +298,11 @@ fn channel_groups_and_red_only_mie_match_the_cpu() {
         mie: MieStorage::RedOnly,
         order_tail: true,
     };
-    let Some((cpu, gpu)) = both(&model, &config) else {
+    let Some((cpu, gpu)) = both(
+        "channel_groups_and_red_only_mie_match_the_cpu",
+        &model,
+        &config,
+    ) else {
         return;
     };
     check_layout(&cpu, &gpu);
@@ -345,7 +336,9 @@ fn channel_groups_and_red_only_mie_match_the_cpu() {
 
 #[test]
 fn tables_beyond_the_device_limits_are_refused() {
-    let Some(ctx) = context() else { return };
+    let Some(ctx) = context("tables_beyond_the_device_limits_are_refused") else {
+        return;
+    };
     let _guard = serial();
     // 64 wavelengths and 64 Mi scattering texels: 16 GiB per table, valid for the CPU path.
     let nm: Vec<f64> = (0..64).map(|k| 380.0 + 6.0 * k as f64).collect();
@@ -387,7 +380,9 @@ fn tables_beyond_the_device_limits_are_refused() {
 
 #[test]
 fn what_the_cpu_refuses_the_gpu_refuses() {
-    let Some(ctx) = context() else { return };
+    let Some(ctx) = context("what_the_cpu_refuses_the_gpu_refuses") else {
+        return;
+    };
     let model = model("earth", Wavelengths::rgb());
     let bad_orders = TableConfig {
         sizes: TableSizes::small(),

@@ -1,4 +1,4 @@
-//! CPU–GPU parity of whole frames (issue 5 item 3): the same scenes rendered by
+//! CPU–GPU parity of whole frames: the same scenes rendered by
 //! `firmament::render::render` and `firmament_gpu::GpuRenderer`, compared pixel by pixel in
 //! luminance (Y of the linear sRGB, cd/m²). Criteria: mean relative difference ≤ 1 %, no
 //! pixel above 5 %, over the pixels inside the projection, leaving out
@@ -9,97 +9,18 @@
 //!
 //! Tables are the CPU's (`Tables::compute`, small sizes), shared by both renderers.
 
-use std::sync::{Mutex, OnceLock};
+mod common;
 
 use firmament::atmosphere::Atmosphere;
 use firmament::math::Vec3;
-use firmament::render::{render, Frame, RenderSettings};
+use firmament::render::{render, RenderSettings};
 use firmament::scene::camera::orbit_fit_fov_deg;
 use firmament::scene::{sun_direction, Camera, Light, Projection, Scene};
-use firmament::sky::bruneton4d::{Bruneton4d, MieStorage, TableConfig, TableSizes, Tables};
+use firmament::sky::bruneton4d::{Bruneton4d, MieStorage, TableConfig, TableSizes};
 use firmament::spectrum::Wavelengths;
-use firmament_gpu::{GpuContext, GpuError, GpuRenderer, GpuSky};
+use firmament_gpu::{GpuError, GpuRenderer, GpuSky};
 
-const MEAN_TOLERANCE: f64 = 0.01;
-const PIXEL_TOLERANCE: f64 = 0.05;
-/// Pixels darker than this fraction of the frame's brightest are not compared.
-const NEGLIGIBLE: f64 = 1e-6;
-/// Pixel footprints around the sun disk's edge left out.
-const DISK_EDGE_FOOTPRINTS: f64 = 2.0;
-
-struct Gpu {
-    ctx: GpuContext,
-    renderer: GpuRenderer,
-}
-
-fn gpu() -> Option<&'static Gpu> {
-    static GPU: OnceLock<Option<Gpu>> = OnceLock::new();
-    GPU.get_or_init(|| {
-        let ctx = firmament_gpu::test_context()?;
-        eprintln!(
-            "GPU adapter: {} ({}, software: {})",
-            ctx.adapter_name(),
-            ctx.backend(),
-            ctx.is_software()
-        );
-        let renderer = GpuRenderer::new(&ctx).expect("render pipeline");
-        Some(Gpu { ctx, renderer })
-    })
-    .as_ref()
-}
-
-/// One GPU test at a time: the machine is small and lavapipe uses every core.
-fn serial() -> std::sync::MutexGuard<'static, ()> {
-    static LOCK: Mutex<()> = Mutex::new(());
-    LOCK.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-fn sky(preset: &str, wavelengths: Wavelengths, orders: usize, mie: MieStorage) -> Bruneton4d {
-    let model = Atmosphere::preset(preset)
-        .unwrap()
-        .resolve(&wavelengths)
-        .unwrap();
-    let config = TableConfig {
-        sizes: TableSizes::small(),
-        orders,
-        mie,
-        order_tail: true,
-    };
-    let tables = Tables::compute(&model, &config).unwrap();
-    Bruneton4d::new(model, tables).unwrap()
-}
-
-/// The earth preset in RGB with 4 orders, computed once for the RGB scenes.
-fn earth_rgb() -> &'static Bruneton4d {
-    static SKY: OnceLock<Bruneton4d> = OnceLock::new();
-    SKY.get_or_init(|| sky("earth", Wavelengths::rgb(), 4, MieStorage::Separate))
-}
-
-fn camera(projection: Projection, altitude_m: f64, heading: f64, pitch: f64, fov: f64) -> Camera {
-    Camera {
-        projection,
-        altitude_m,
-        heading_deg: heading,
-        pitch_deg: pitch,
-        roll_deg: 0.0,
-        fov_deg: fov,
-    }
-}
-
-fn luminance(p: &[f32; 3]) -> f64 {
-    0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64
-}
-
-fn angle(a: Vec3, b: Vec3) -> f64 {
-    a.cross(b).length().atan2(a.dot(b))
-}
-
-struct Parity {
-    mean: f64,
-    max: f64,
-    compared: usize,
-    worst: (usize, usize, f64, f64),
-}
+use common::*;
 
 /// Render `settings` on both sides and compare as the file header says.
 fn compare(
@@ -109,7 +30,7 @@ fn compare(
     sun: Vec3,
     sun_disk: bool,
 ) -> Option<Parity> {
-    let gpu = gpu()?;
+    let gpu = gpu(name)?;
     let _guard = serial();
     let scene = Scene::clear_sky(sky, sun, sun_disk);
     let cpu_frame = render(&scene, settings, &|_| {}, None).unwrap();
@@ -124,124 +45,11 @@ fn compare(
         name,
         sky,
         settings,
-        &scene.lights[0],
+        &scene.lights,
         &cpu_frame,
         &gpu_frame,
         gpu_seconds,
     ))
-}
-
-fn measure(
-    name: &str,
-    sky: &Bruneton4d,
-    settings: &RenderSettings,
-    sun: &Light,
-    cpu: &Frame,
-    gpu: &Frame,
-    gpu_seconds: f64,
-) -> Parity {
-    let (w, h) = (settings.width, settings.height);
-    let mask_mismatches = cpu
-        .mask
-        .iter()
-        .zip(&gpu.mask)
-        .filter(|(a, b)| a != b)
-        .count();
-    assert_eq!(mask_mismatches, 0, "{name}: projection masks differ");
-    let prepared = settings.camera.prepare(sky.model.bottom_radius_m, w, h);
-    let alpha = sky.model.sun_angular_radius_rad;
-    // Whether pixel (x, y) lies within the footprint margin of the sun disk's edge.
-    let near_disk_edge = |x: usize, y: usize| -> bool {
-        if !sun.visible_disk {
-            return false;
-        }
-        let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
-        let Some(ray) = prepared.ray(px, py) else {
-            return false;
-        };
-        let footprint = [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)]
-            .iter()
-            .filter_map(|(dx, dy)| prepared.ray(px + dx, py + dy))
-            .map(|n| angle(n.dir, ray.dir))
-            .fold(0.0, f64::max);
-        (angle(ray.dir, sun.direction) - alpha).abs() < DISK_EDGE_FOOTPRINTS * footprint
-    };
-    let candidates: Vec<usize> = (0..w * h)
-        .filter(|&i| cpu.mask[i] && !near_disk_edge(i % w, i / w))
-        .collect();
-    let max = candidates
-        .iter()
-        .map(|&i| luminance(&cpu.image.data[i]))
-        .fold(0.0, f64::max);
-    let floor = max * NEGLIGIBLE;
-    let (mut sum, mut worst_rel, mut compared) = (0.0, 0.0f64, 0usize);
-    let mut worst = (0, 0, 0.0, 0.0);
-    let mut over_one_percent = 0;
-    for &i in &candidates {
-        let c = luminance(&cpu.image.data[i]);
-        let g = luminance(&gpu.image.data[i]);
-        assert!(g.is_finite(), "{name}: non-finite GPU pixel {i}");
-        if c < floor {
-            // Not compared relatively, but dark on the GPU too.
-            assert!(
-                (g - c).abs() <= floor,
-                "{name}: pixel {i} is dark on the CPU ({c:e}) but not on the GPU ({g:e})"
-            );
-            continue;
-        }
-        let rel = (g - c).abs() / c;
-        sum += rel;
-        compared += 1;
-        if rel > 0.01 {
-            over_one_percent += 1;
-        }
-        if rel > worst_rel {
-            worst_rel = rel;
-            worst = (i % w, i / w, c, g);
-        }
-    }
-    let mean = if compared > 0 {
-        sum / compared as f64
-    } else {
-        0.0
-    };
-    eprintln!(
-        "{name}: {w}×{h}, {compared} of {} pixels compared ({} near the disk edge, {} below {NEGLIGIBLE:e} of max {max:.4e} cd/m²); mean rel {:.2e}, max rel {:.2e} at ({}, {}) cpu {:.5e} gpu {:.5e}; {over_one_percent} over 1 %; GPU frame {:.0} ms",
-        w * h,
-        (0..w * h).filter(|&i| cpu.mask[i]).count() - candidates.len(),
-        candidates.len() - compared,
-        mean,
-        worst_rel,
-        worst.0,
-        worst.1,
-        worst.2,
-        worst.3,
-        gpu_seconds * 1e3,
-    );
-    Parity {
-        mean,
-        max: worst_rel,
-        compared,
-        worst,
-    }
-}
-
-fn assert_parity(name: &str, p: &Parity) {
-    assert!(p.compared > 0, "{name}: nothing compared");
-    assert!(
-        p.mean <= MEAN_TOLERANCE,
-        "{name}: mean relative luminance difference {:.3e} > {MEAN_TOLERANCE}",
-        p.mean
-    );
-    assert!(
-        p.max <= PIXEL_TOLERANCE,
-        "{name}: pixel ({}, {}) differs by {:.3e} (cpu {:e}, gpu {:e}) > {PIXEL_TOLERANCE}",
-        p.worst.0,
-        p.worst.1,
-        p.max,
-        p.worst.2,
-        p.worst.3
-    );
 }
 
 fn check(name: &str, sky: &Bruneton4d, settings: &RenderSettings, sun: Vec3, sun_disk: bool) {
@@ -417,7 +225,9 @@ fn red_only_mie_cubemap_with_five_wavelengths() {
 fn bands_of_rows_give_the_same_frame() {
     // A frame drawn in bands of 16 rows (as frames larger than one storage binding are)
     // equals the frame drawn at once.
-    let Some(gpu) = gpu() else { return };
+    let Some(gpu) = gpu("bands_of_rows_give_the_same_frame") else {
+        return;
+    };
     let _guard = serial();
     let sky = earth_rgb();
     let cam = camera(Projection::Fisheye, 2.0, 0.0, 0.0, 60.0);
@@ -454,7 +264,9 @@ fn bands_of_rows_give_the_same_frame() {
 
 #[test]
 fn oversized_frames_and_invalid_cameras_are_refused() {
-    let Some(gpu) = gpu() else { return };
+    let Some(gpu) = gpu("oversized_frames_and_invalid_cameras_are_refused") else {
+        return;
+    };
     let _guard = serial();
     let sky = earth_rgb();
     let gpu_sky = GpuSky::from_sky(&gpu.ctx, sky).unwrap();
@@ -541,7 +353,9 @@ fn oversized_frames_and_invalid_cameras_are_refused() {
 
 #[test]
 fn timing_reports_its_method() {
-    let Some(gpu) = gpu() else { return };
+    let Some(gpu) = gpu("timing_reports_its_method") else {
+        return;
+    };
     let _guard = serial();
     let gpu_sky = GpuSky::from_sky(&gpu.ctx, earth_rgb()).unwrap();
     let cam = camera(Projection::Fisheye, 2.0, 0.0, 0.0, 60.0);
@@ -574,7 +388,9 @@ fn timing_reports_its_method() {
 fn tables_kept_on_the_device_render_like_tables_read_back() {
     // GpuSky::precompute (no readback; red-only Mie stays in the full layout on the device)
     // against the same GPU tables read back into a Sky and uploaded again: the same frame.
-    let Some(gpu) = gpu() else { return };
+    let Some(gpu) = gpu("tables_kept_on_the_device_render_like_tables_read_back") else {
+        return;
+    };
     let _guard = serial();
     let model = Atmosphere::preset("bruneton2008")
         .unwrap()

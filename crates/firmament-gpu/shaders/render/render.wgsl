@@ -73,7 +73,8 @@ fn shade(dir: vec3<f32>, shadow_length_km: f32) -> vec3<f32> {
                 let scale = light_scale(light, k);
                 let t = transmittance_to_point(g, k);
                 let e = sun_and_sky_irradiance(gl, k);
-                let direct = e.direct * light_irradiance(light, k);
+                // A shadowed length on a ray to the ground ends at the ground point: in shadow.
+                let direct = select(e.direct * light_irradiance(light, k), vec4<f32>(0.0), shadow_length_km > 0.0);
                 let l = sky_radiance_to_point(v, g, k) * scale
                     + ground_albedo(k) / PI * (direct + e.sky * scale) * t;
                 rgb += to_srgb(l, k);
