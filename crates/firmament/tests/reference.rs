@@ -396,9 +396,12 @@ fn reference_is_deterministic_given_a_seed() {
     assert_eq!(a, b);
     let pixels = reference::render_pixels(
         &model,
+        &[],
         &[(camera, view), (camera, Vec3::new(0.0, 0.0, 1.0))],
+        0,
         sun,
         &s,
+        &|| {},
     );
     assert_eq!(pixels[0], a, "pixel 0 of render_pixels is sky_radiance");
     let c = reference::sky_radiance(
@@ -657,32 +660,5 @@ fn reference_agrees_with_table_method_for_earth_daylight() {
         "reference, 5 views × 3 λ × {} paths: {:.2} s",
         s.samples,
         start.elapsed().as_secs_f64()
-    );
-}
-
-/// Throughput figure for the report (not an assertion).
-#[test]
-fn reference_timing_earth_zenith_pixel() {
-    let model = earth_rgb();
-    let camera = Vec3::new(0.0, 0.0, model.bottom_radius_m + 1.0);
-    let s = ReferenceSettings {
-        samples: 8192,
-        ..Default::default()
-    };
-    let start = Instant::now();
-    let est = reference::render_pixels(
-        &model,
-        &[(camera, Vec3::new(0.0, 0.0, 1.0))],
-        sun_at_elevation(30.0),
-        &s,
-    );
-    let dt = start.elapsed().as_secs_f64();
-    println!(
-        "earth zenith pixel, RGB, {} paths/λ: {:.3} s single-threaded ({:.0} paths/s/core), radiance {:?}, rel. stderr {:.2}%",
-        s.samples,
-        dt,
-        3.0 * s.samples as f64 / dt,
-        est[0].radiance,
-        100.0 * est[0].max_relative_stderr()
     );
 }

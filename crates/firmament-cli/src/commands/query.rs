@@ -150,15 +150,7 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
     let sky_view = sky.view(camera, &light);
     sky_view.transmittance_to_light(camera, &mut sun_transmittance);
     let (mut sun_irradiance, mut sky_irradiance) = (vec![0.0; n], vec![0.0; n]);
-    if args.altitude_m <= model.height_m() {
-        sky_view.sun_and_sky_irradiance(camera, up, &mut sun_irradiance, &mut sky_irradiance);
-    } else {
-        // In space: the direct beam only (no sky below a horizontal surface facing up).
-        let cos = sun[2].max(0.0);
-        for k in 0..n {
-            sun_irradiance[k] = model.solar_irradiance[k] * sun_transmittance[k] * cos;
-        }
-    }
+    sky_view.sun_and_sky_irradiance(camera, up, &mut sun_irradiance, &mut sky_irradiance);
     let lux = |v: &[f64]| luminance_from_spectrum(&nm, v);
 
     let mut answers = Vec::new();

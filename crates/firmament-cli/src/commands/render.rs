@@ -311,6 +311,7 @@ fn render_scene_reference(
     bar.set_message(format!("reference, {samples} paths/λ"));
     let result = reference::render_frame(
         model,
+        &[],
         &render_settings(scene),
         &sun,
         &ReferenceSettings::with_samples(samples),

@@ -54,7 +54,7 @@ fn pack_phase(p: &PhaseFunction, data: &mut Vec<f32>) -> [u32; 6] {
 pub fn pack(model: &Model, sizes: &TableSizes) -> Packed {
     let groups_info = &model.groups;
     let n = model.channels();
-    let g = groups(n);
+    let n_groups = groups(n);
     let km = 1e-3;
     let (bottom, top) = (model.bottom_radius_m, model.top_radius_m);
     let h = (top * top - bottom * bottom).sqrt();
@@ -65,7 +65,7 @@ pub fn pack(model: &Model, sizes: &TableSizes) -> Packed {
 
     let mut data: Vec<f32> = Vec::new();
     let per_wavelength = |data: &mut Vec<f32>, values: &[f64], scale: f64| {
-        for k in 0..g * GROUP {
+        for k in 0..n_groups * GROUP {
             data.push(if k < n {
                 (values[k] * scale) as f32
             } else {
@@ -127,7 +127,7 @@ pub fn pack(model: &Model, sizes: &TableSizes) -> Packed {
         f(big_a),
         f(model.sun_angular_radius_rad),
         u(n),
-        u(g),
+        u(n_groups),
         u(model.constituents.len()),
         u(sizes.transmittance_mu),
         u(sizes.transmittance_r),

@@ -169,20 +169,21 @@ impl Precomputer {
         let n = model.channels();
         firmament::spectrum::check_channels(n, "the precomputed tables")?;
         let s = config.sizes;
-        let g = groups(n);
+        let n_groups = groups(n);
         let orders = config.orders;
         let t_texels = s.transmittance_mu * s.transmittance_r;
         let e_texels = s.irradiance_mu_s * s.irradiance_r;
         let s_texels = s.scattering_r * s.scattering_mu * s.scattering_mu_s * s.scattering_nu;
         let rows = s.scattering_r * s.scattering_mu;
         let vec4 = (GROUP * 4) as u64;
-        let bytes_t = (t_texels * g) as u64 * vec4;
-        let bytes_e = (e_texels * g) as u64 * vec4;
-        let bytes_s = (s_texels * g) as u64 * vec4;
+        let bytes_t = (t_texels * n_groups) as u64 * vec4;
+        let bytes_e = (e_texels * n_groups) as u64 * vec4;
+        let bytes_s = (s_texels * n_groups) as u64 * vec4;
         let bytes_kernels = (rows * DENSITY_THETA * 2 * HARMONICS * 4) as u64;
         let bytes_coefficients =
-            (s.scattering_r * s.scattering_mu_s * DENSITY_THETA * HARMONICS * g) as u64 * vec4;
-        let bytes_rows = (orders * rows * g) as u64 * vec4;
+            (s.scattering_r * s.scattering_mu_s * DENSITY_THETA * HARMONICS * n_groups) as u64
+                * vec4;
+        let bytes_rows = (orders * rows * n_groups) as u64 * vec4;
         self.check_limits(
             ctx,
             &[
@@ -259,7 +260,14 @@ impl Precomputer {
                 let bg = self
                     .transmittance
                     .bind(device, common(1), &[&transmittance]);
-                dispatch(&mut cpass, &self.transmittance, &bg, t_texels, g, max_dim);
+                dispatch(
+                    &mut cpass,
+                    &self.transmittance,
+                    &bg,
+                    t_texels,
+                    n_groups,
+                    max_dim,
+                );
                 let bg = self.direct_irradiance.bind(
                     device,
                     common(1),
@@ -270,7 +278,7 @@ impl Precomputer {
                     &self.direct_irradiance,
                     &bg,
                     e_texels,
-                    g,
+                    n_groups,
                     max_dim,
                 );
                 let bg = self.single_scattering.bind(
@@ -283,13 +291,13 @@ impl Precomputer {
                     &self.single_scattering,
                     &bg,
                     s_texels,
-                    g,
+                    n_groups,
                     max_dim,
                 );
                 let bg = self
                     .order_sums
                     .bind(device, common(1), &[&rayleigh, &mie, &row_sums]);
-                dispatch(&mut cpass, &self.order_sums, &bg, rows, g, max_dim);
+                dispatch(&mut cpass, &self.order_sums, &bg, rows, n_groups, max_dim);
                 if order_passes {
                     let bg = self.phase_kernels.bind(device, common(1), &[&kernels]);
                     dispatch(
@@ -317,7 +325,7 @@ impl Precomputer {
                         &self.density_field,
                         &bg,
                         s.scattering_r * s.scattering_mu_s * DENSITY_THETA,
-                        g,
+                        n_groups,
                         max_dim,
                     );
                     let bg = self.scattering_density.bind(
@@ -330,7 +338,7 @@ impl Precomputer {
                         &self.scattering_density,
                         &bg,
                         rows * s.scattering_mu_s,
-                        g,
+                        n_groups,
                         max_dim,
                     );
                     let bg = self.indirect_irradiance.bind(
@@ -343,7 +351,7 @@ impl Precomputer {
                         &self.indirect_irradiance,
                         &bg,
                         e_texels,
-                        g,
+                        n_groups,
                         max_dim,
                     );
                     let bg = self.multiple_scattering.bind(
@@ -356,7 +364,7 @@ impl Precomputer {
                         &self.multiple_scattering,
                         &bg,
                         s_texels,
-                        g,
+                        n_groups,
                         max_dim,
                     );
                     let bg = self.order_sums.bind(
@@ -364,16 +372,23 @@ impl Precomputer {
                         common(order),
                         &[&delta_multiple, &delta_multiple, &row_sums],
                     );
-                    dispatch(&mut cpass, &self.order_sums, &bg, rows, g, max_dim);
+                    dispatch(&mut cpass, &self.order_sums, &bg, rows, n_groups, max_dim);
                 }
                 if config.order_tail && orders >= 3 {
-                    let factors = storage(device, "order tail factors", g as u64 * vec4);
+                    let factors = storage(device, "order tail factors", n_groups as u64 * vec4);
                     let bg = self.order_tail_factors.bind(
                         device,
                         common(orders),
                         &[&row_sums, &factors],
                     );
-                    dispatch(&mut cpass, &self.order_tail_factors, &bg, 1, g, max_dim);
+                    dispatch(
+                        &mut cpass,
+                        &self.order_tail_factors,
+                        &bg,
+                        1,
+                        n_groups,
+                        max_dim,
+                    );
                     let bg = self.order_tail.bind(
                         device,
                         common(orders),
@@ -390,7 +405,7 @@ impl Precomputer {
                         &self.order_tail,
                         &bg,
                         s_texels.max(e_texels),
-                        g,
+                        n_groups,
                         max_dim,
                     );
                 }
@@ -454,7 +469,7 @@ impl GpuTables {
     ) -> Result<Tables, GpuError> {
         let n = model.channels();
         let s = config.sizes;
-        let g = groups(n);
+        let n_groups = groups(n);
         let orders = config.orders;
         let t_texels = s.transmittance_mu * s.transmittance_r;
         let e_texels = s.irradiance_mu_s * s.irradiance_r;
@@ -494,7 +509,7 @@ impl GpuTables {
         let unpad = |v: &[f32], texels: usize| -> Vec<f32> {
             let mut out = Vec::with_capacity(texels * n);
             for t in 0..texels {
-                out.extend_from_slice(&v[t * g * GROUP..t * g * GROUP + n]);
+                out.extend_from_slice(&v[t * n_groups * GROUP..t * n_groups * GROUP + n]);
             }
             out
         };
@@ -516,15 +531,18 @@ impl GpuTables {
         };
         let single_mie = match config.mie {
             MieStorage::Separate => table4(unpad(&m_data, s_texels), n),
-            MieStorage::RedOnly => {
-                table4((0..s_texels).map(|t| m_data[t * g * GROUP]).collect(), 1)
-            }
+            MieStorage::RedOnly => table4(
+                (0..s_texels)
+                    .map(|t| m_data[t * n_groups * GROUP])
+                    .collect(),
+                1,
+            ),
         };
         let order_means = (0..orders)
             .map(|o| {
                 let mut sum = vec![0.0f64; n];
                 for row in 0..rows {
-                    let base = ((o * rows + row) * g) * GROUP;
+                    let base = ((o * rows + row) * n_groups) * GROUP;
                     for (k, acc) in sum.iter_mut().enumerate() {
                         *acc += rows_data[base + k] as f64;
                     }

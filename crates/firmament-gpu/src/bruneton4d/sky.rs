@@ -74,16 +74,16 @@ impl GpuSky {
         let tables = &sky.tables;
         let n = sky.channels();
         firmament::spectrum::check_channels(n, "rendering")?;
-        let g = groups(n);
+        let n_groups = groups(n);
         let red_only = tables.config.mie == MieStorage::RedOnly;
-        let transmittance = pad_channels(&tables.optical_depth.data, n, g);
-        let irradiance = pad_channels(&tables.irradiance.data, n, g);
-        let single_rayleigh = pad_channels(&tables.single_rayleigh.data, n, g);
-        let multiple = pad_channels(&tables.multiple.data, n, g);
+        let transmittance = pad_channels(&tables.optical_depth.data, n, n_groups);
+        let irradiance = pad_channels(&tables.irradiance.data, n, n_groups);
+        let single_rayleigh = pad_channels(&tables.single_rayleigh.data, n, n_groups);
+        let multiple = pad_channels(&tables.multiple.data, n, n_groups);
         let single_mie = if red_only {
             pad_channels(&tables.single_mie.data, 1, 1)
         } else {
-            pad_channels(&tables.single_mie.data, n, g)
+            pad_channels(&tables.single_mie.data, n, n_groups)
         };
         let bytes = |v: &[f32]| (v.len() * 4) as u64;
         let sizes = tables.config.sizes;
@@ -92,7 +92,7 @@ impl GpuSky {
             &[
                 ("scattering table", bytes(&single_rayleigh)),
                 ("multiple scattering table", bytes(&multiple)),
-                ("camera slice", slice_bytes(&sizes, g)),
+                ("camera slice", slice_bytes(&sizes, n_groups)),
                 ("single Mie table", bytes(&single_mie)),
                 ("transmittance table", bytes(&transmittance)),
                 ("irradiance table", bytes(&irradiance)),
@@ -162,7 +162,7 @@ impl GpuSky {
         tables: GpuTables,
     ) -> GpuSky {
         let n = model.channels();
-        let g = groups(n);
+        let n_groups = groups(n);
         let colour = ColourMatrix::new(model.wavelengths.nm());
         let mie_ratio = model.groups.mie_ratio();
         // The uniform's full size (the shader declares a fixed-size array); lanes of
@@ -188,7 +188,7 @@ impl GpuSky {
                 bytemuck::cast_slice(&constants),
                 wgpu::BufferUsages::UNIFORM,
             ),
-            slice: storage(device, "camera slice", slice_bytes(&sizes, g)),
+            slice: storage(device, "camera slice", slice_bytes(&sizes, n_groups)),
             tables,
             mie_layout,
             channels: n,

@@ -44,6 +44,7 @@ use rayon::prelude::*;
 use crate::atmosphere::Model;
 use crate::math::sphere::ray_sphere;
 use crate::math::Vec3;
+use crate::scene::Volume;
 pub use render::render_frame;
 pub use results::{FluxBudget, IrradianceEstimate, RadianceEstimate, Tally};
 use sampler::{estimate, Stats};
@@ -71,6 +72,7 @@ fn ray_start(model: &Model, camera: Vec3, view: Vec3) -> Option<Vec3> {
 
 fn radiance_pixel(
     model: &Model,
+    volumes: &[Box<dyn Volume + '_>],
     camera: Vec3,
     view: Vec3,
     sun: Vec3,
@@ -92,11 +94,17 @@ fn radiance_pixel(
     let o = frame.offset(start);
     let primaries: Vec<tracer::Primary> = (0..n)
         .map(|k| {
-            Channel::new(model, k, settings).primary(&frame, o, view, tracer::PRIMARY_INTERVALS)
+            Channel::new(model, volumes, k, settings).primary(
+                &frame,
+                o,
+                view,
+                tracer::PRIMARY_INTERVALS,
+            )
         })
         .collect();
     let stats = estimate::<1, _>(
         model,
+        volumes,
         settings,
         DOMAIN_RADIANCE ^ key,
         parallel,
@@ -127,7 +135,7 @@ pub fn sky_radiance(
     sun: Vec3,
     settings: &ReferenceSettings,
 ) -> RadianceEstimate {
-    radiance_pixel(model, camera, view, sun, settings, 0, true)
+    radiance_pixel(model, &[], camera, view, sun, settings, 0, true)
 }
 
 /// [`sky_radiance`] with the random streams keyed by `key` (estimates with different keys
@@ -140,36 +148,31 @@ pub fn sky_radiance_keyed(
     settings: &ReferenceSettings,
     key: u64,
 ) -> RadianceEstimate {
-    radiance_pixel(model, camera, view, sun, settings, key, true)
+    radiance_pixel(model, &[], camera, view, sun, settings, key, true)
 }
 
-/// [`sky_radiance`] for many (camera, view) rays, in parallel over pixels; pixel `i` uses
-/// the random streams of index `i` (so the first pixel equals [`sky_radiance`]).
+/// [`sky_radiance_keyed`] through the scene's `volumes` too (clouds and other media besides
+/// the atmosphere's constituents): their extinction in delta tracking and towards the sun,
+/// their scattering and phase functions at collisions.
+pub fn scene_radiance(
+    model: &Model,
+    volumes: &[Box<dyn Volume + '_>],
+    camera: Vec3,
+    view: Vec3,
+    sun: Vec3,
+    settings: &ReferenceSettings,
+    key: u64,
+) -> RadianceEstimate {
+    radiance_pixel(model, volumes, camera, view, sun, settings, key, true)
+}
+
+/// [`scene_radiance`] for many (camera, view) rays, in parallel over pixels; pixel
+/// `first + i` uses the random streams of that index (so pixel 0 equals [`sky_radiance`]
+/// without volumes, and an image rendered in batches equals one rendered at once).
+/// `progress` is called once per finished pixel (from any thread).
 pub fn render_pixels(
     model: &Model,
-    rays: &[(Vec3, Vec3)],
-    sun: Vec3,
-    settings: &ReferenceSettings,
-) -> Vec<RadianceEstimate> {
-    render_pixels_with_progress(model, rays, sun, settings, &|| {})
-}
-
-/// [`render_pixels`], calling `progress` once per finished pixel (from any thread).
-pub fn render_pixels_with_progress(
-    model: &Model,
-    rays: &[(Vec3, Vec3)],
-    sun: Vec3,
-    settings: &ReferenceSettings,
-    progress: &(dyn Fn() + Sync),
-) -> Vec<RadianceEstimate> {
-    render_pixels_from(model, rays, 0, sun, settings, progress)
-}
-
-/// [`render_pixels_with_progress`] for a batch of pixels that starts at pixel index
-/// `first` (pixel `first + i` uses the streams of that index), so an image rendered in
-/// batches (e.g. to check for cancellation between them) equals one rendered at once.
-pub fn render_pixels_from(
-    model: &Model,
+    volumes: &[Box<dyn Volume + '_>],
     rays: &[(Vec3, Vec3)],
     first: u64,
     sun: Vec3,
@@ -179,7 +182,8 @@ pub fn render_pixels_from(
     rays.par_iter()
         .enumerate()
         .map(|(i, &(camera, view))| {
-            let e = radiance_pixel(model, camera, view, sun, settings, first + i as u64, false);
+            let key = first + i as u64;
+            let e = radiance_pixel(model, volumes, camera, view, sun, settings, key, false);
             progress();
             e
         })
@@ -203,6 +207,7 @@ pub fn irradiance(
     let stats =
         estimate::<1, _>(
             model,
+            &[],
             settings,
             DOMAIN_IRRADIANCE,
             true,
@@ -255,6 +260,7 @@ pub fn flux_budget(
             let o = frame.offset(start);
             estimate::<BUDGET_TALLIES, _>(
                 model,
+                &[],
                 settings,
                 DOMAIN_BUDGET,
                 true,

@@ -4,17 +4,18 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use super::{render_pixels_from, ReferenceSettings};
+use super::{render_pixels, ReferenceSettings};
 use crate::atmosphere::Model;
 use crate::io::ImageRgbF32;
 use crate::math::sphere::ray_sphere;
 use crate::math::Vec3;
 use crate::render::{Frame, RenderSettings};
-use crate::scene::Light;
+use crate::scene::{Light, Volume};
 use crate::spectrum::ColourMatrix;
 use crate::{Error, Result};
 
-/// The frame of `settings` lit by `sun` (the model's sun in a direction), every pixel traced
+/// The frame of `settings` lit by `sun` (the model's sun in a direction) through the
+/// atmosphere and `volumes`, every pixel traced
 /// with `reference.samples` paths per wavelength (`include_ground` is forced on: a picture
 /// shows the ground). Colour and white balance as [`crate::render::render`]; the sun's disk
 /// is added where a view ray does not meet the ground, attenuated by the transmittance of
@@ -23,6 +24,7 @@ use crate::{Error, Result};
 /// pixels' luminance.
 pub fn render_frame(
     model: &Model,
+    volumes: &[Box<dyn Volume + '_>],
     settings: &RenderSettings,
     sun: &Light,
     reference: &ReferenceSettings,
@@ -54,8 +56,9 @@ pub fn render_frame(
         if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
             return Err(Error::Interrupted);
         }
-        estimates.extend(render_pixels_from(
+        estimates.extend(render_pixels(
             model,
+            volumes,
             chunk,
             (b * batch) as u64,
             sun.direction,

@@ -7,6 +7,7 @@ use super::rng::Rng;
 use super::tracer::{self, Channel};
 use super::ReferenceSettings;
 use crate::atmosphere::Model;
+use crate::scene::Volume;
 
 /// Samples per block: the unit of parallel work and of the fixed-order reduction.
 const BLOCK: usize = 256;
@@ -58,6 +59,7 @@ impl Stats {
 /// reduced in the same order.
 pub(super) fn estimate<const M: usize, F>(
     model: &Model,
+    volumes: &[Box<dyn Volume + '_>],
     settings: &ReferenceSettings,
     key: u64,
     parallel: bool,
@@ -70,7 +72,7 @@ where
     let samples = settings.samples;
     let blocks = samples.div_ceil(BLOCK).max(1);
     let channels: Vec<Channel> = (0..n_ch)
-        .map(|k| Channel::new(model, k, settings))
+        .map(|k| Channel::new(model, volumes, k, settings))
         .collect();
     let run = |job: usize| -> [Stats; M] {
         let (k, blk) = (job / blocks, job % blocks);

@@ -5,12 +5,20 @@
 //! (the sky method's transmittance to the light) and through the volumes (their optical
 //! depth towards the light), and seen through the air between it and the observer.
 //!
+//! Each sample is also lit by the sky from above and the ground from below, taken as
+//! isotropic (an ambient term, as the engines' clouds do): with hemispheric irradiances E↓
+//! (the sky's, from the view) and E↑ (the ground's reflection of its own irradiance below
+//! the sample), the in-scattered radiance is σ_s·(E↓ + E↑)/(2π) (a uniform hemisphere of
+//! irradiance E has radiance E/π, fluence 2E). Neither the volumes' shadowing of that light
+//! nor multiple scattering inside them is included (the clouds' octaves and height gradient
+//! will add them); `docs/accuracy.md` gives the error against the reference.
+//!
 //! Composition: the air in front of the volumes is left unattenuated, everything behind
 //! their front (including the air within and beyond them) is attenuated by their
 //! transmittance, and their own light is added:
 //! L = S_air(0 → a) + T_vol·(L_behind − S_air(0 → a)) + L_vol.
-//! Multiple scattering inside the volumes and their ambient sky light are not included yet
-//! (the clouds' octaves and ambient term will add them).
+
+use std::f64::consts::PI;
 
 use crate::math::Vec3;
 use crate::scene::{Ray, Scene};
@@ -57,6 +65,8 @@ pub(super) fn composite(
 
     let mut buf = [[0.0f64; MAX_CHANNELS]; 9];
     let [front, l, t_vol, l_vol, sigma_t, e_v, s_v, source, t_air] = &mut buf;
+    let mut ambient = [[0.0f64; MAX_CHANNELS]; 2];
+    let mut e = [[0.0f64; MAX_CHANNELS]; 2];
     let (front, l, t_vol, l_vol) = (
         &mut front[..n],
         &mut l[..n],
@@ -93,8 +103,10 @@ pub(super) fn composite(
                 let light = view.light();
                 let p = volume.phase(x).eval(ray.dir.dot(light.direction));
                 light_transmittance(scene, view.as_ref(), x, t_light);
+                ambient_irradiance(scene, view.as_ref(), x, &mut ambient, &mut e, n);
                 for k in 0..n {
                     source[k] += s_v[k] * p * light.irradiance[k] * t_light[k];
+                    source[k] += s_v[k] * (ambient[0][k] + ambient[1][k]) / (2.0 * PI);
                 }
             }
         }
@@ -115,6 +127,28 @@ pub(super) fn composite(
     }
     for k in 0..n {
         out[k] = front[k] + t_vol[k] * (out[k] - front[k]) + l_vol[k];
+    }
+}
+
+/// The ambient hemispheric irradiances at `x` under the view's light: [E↓ from the sky
+/// above, E↑ reflected by the ground below] (the ground's albedo times its direct and sky
+/// irradiance, the air between not counted). `e` is scratch.
+fn ambient_irradiance(
+    scene: &Scene,
+    view: &dyn SkyView,
+    x: Vec3,
+    out: &mut [[f64; MAX_CHANNELS]; 2],
+    e: &mut [[f64; MAX_CHANNELS]; 2],
+    n: usize,
+) {
+    let up = x.normalize_or_zero();
+    let [direct, sky] = e;
+    view.sun_and_sky_irradiance(x, up, &mut direct[..n], &mut out[0][..n]);
+    let model = scene.sky.model();
+    let ground = up * model.bottom_radius_m;
+    view.sun_and_sky_irradiance(ground, up, &mut direct[..n], &mut sky[..n]);
+    for k in 0..n {
+        out[1][k] = model.ground_albedo[k] * (direct[k] + sky[k]);
     }
 }
 

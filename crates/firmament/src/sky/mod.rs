@@ -22,7 +22,7 @@ pub use bruneton4d::Bruneton4d;
 
 use crate::atmosphere::Model;
 use crate::math::Vec3;
-use crate::scene::Light;
+use crate::scene::light::Light;
 
 /// Which parts of a view ray the light reaches (Bruneton & Neyret 2008 §5, eq. 17–18).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -92,7 +92,8 @@ pub trait SkyView: Send + Sync {
     fn transmittance_to_light(&self, point: Vec3, out: &mut [f64]);
 
     /// The light's direct irradiance and the sky's irradiance on a surface at `point` with
-    /// unit `normal` (the sky term with the (1 + n·n̄)/2 occlusion factor of paper eq. 16).
+    /// unit `normal` (the sky term with the (1 + n·n̄)/2 occlusion factor of paper eq. 16;
+    /// above the atmosphere the direct beam only).
     fn sun_and_sky_irradiance(
         &self,
         point: Vec3,

@@ -1,5 +1,6 @@
 //! CPU timings for `firmament bench`: the precomputation of the tables (with the seconds of
-//! each stage) and the renderer's frames from precomputed tables.
+//! each stage), the renderer's frames from precomputed tables, and the reference path
+//! tracer's throughput.
 
 use std::collections::BTreeMap;
 use std::sync::Mutex;
@@ -7,12 +8,14 @@ use std::time::Instant;
 
 use anyhow::Result;
 use firmament::atmosphere::Model;
+use firmament::math::Vec3;
+use firmament::reference::{self, ReferenceSettings};
 use firmament::render::{self, ToneCurve};
-use firmament::scene::Scene;
+use firmament::scene::{sun_direction, Scene};
 use firmament::sky::bruneton4d::precompute::precompute;
 use firmament::sky::bruneton4d::{Bruneton4d, TableConfig};
 
-use super::report::{CpuFrames, CpuPrecompute};
+use super::report::{CpuFrames, CpuPrecompute, CpuReference};
 use super::scenes::{self, BenchFrame};
 use super::timing::{median, time_runs};
 
@@ -99,4 +102,22 @@ fn frame_seconds(sky: &Bruneton4d, frame: &BenchFrame, runs: usize) -> Result<f6
         Ok(())
     })?;
     Ok(median(seconds))
+}
+
+/// Paths per wavelength of the reference throughput pixel.
+const REFERENCE_PATHS: usize = 8192;
+
+/// Median seconds of the reference path tracer on one pixel ([`CpuReference`]) of `model`.
+pub fn reference_timings(model: &Model, runs: usize) -> Result<CpuReference> {
+    let camera = Vec3::new(0.0, 0.0, model.bottom_radius_m + 1.0);
+    let sun = sun_direction(60.0, 180.0);
+    let settings = ReferenceSettings::with_samples(REFERENCE_PATHS);
+    let seconds = median(time_runs(runs, || {
+        reference::sky_radiance(model, camera, Vec3::Z, sun, &settings);
+        Ok(())
+    })?);
+    Ok(CpuReference {
+        cpu_reference_zenith_pixel_s: Some(seconds),
+        cpu_reference_paths_per_s: Some((REFERENCE_PATHS * model.channels()) as f64 / seconds),
+    })
 }

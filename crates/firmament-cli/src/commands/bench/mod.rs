@@ -103,6 +103,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         runs: args.runs,
         cpu_precompute: Default::default(),
         cpu_frames: Default::default(),
+        cpu_reference: Default::default(),
         gpu_skipped,
         gpu: Default::default(),
     };
@@ -110,6 +111,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         report.cpu_precompute =
             cpu::precompute_timings(&model, &config, args.runs, spectral_model.as_ref())?;
         report.cpu_frames = cpu::frame_timings(&args.atmosphere.sky(true)?, args.runs)?;
+        report.cpu_reference = cpu::reference_timings(&model, args.runs)?;
     }
     if let Some(gpu) = &gpu {
         let runs = args.gpu_runs.unwrap_or(args.runs).max(1);

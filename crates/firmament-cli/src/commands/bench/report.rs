@@ -18,6 +18,8 @@ pub struct BenchReport {
     pub cpu_precompute: CpuPrecompute,
     #[serde(flatten)]
     pub cpu_frames: CpuFrames,
+    #[serde(flatten)]
+    pub cpu_reference: CpuReference,
     /// Why the GPU was not measured; `null` when it was.
     pub gpu_skipped: Option<String>,
     #[serde(flatten)]
@@ -50,6 +52,14 @@ pub struct CpuFrames {
     pub cpu_frame_1080p_perspective_s: Option<f64>,
     pub cpu_frame_1024_fisheye_s: Option<f64>,
     pub cpu_frame_4096x2048_equirect_s: Option<f64>,
+}
+
+/// The reference path tracer's throughput: one earth RGB pixel (the zenith from 1 m, the
+/// sun 30° high), 8192 paths per wavelength on every thread (median of the runs).
+#[derive(Serialize, Debug, Default)]
+pub struct CpuReference {
+    pub cpu_reference_zenith_pixel_s: Option<f64>,
+    pub cpu_reference_paths_per_s: Option<f64>,
 }
 
 /// The GPU: the adapter, the precomputation and the 1080p frame.

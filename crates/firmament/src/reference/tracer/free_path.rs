@@ -1,7 +1,9 @@
 //! Free paths: delta (Woodcock) tracking with a piecewise-constant majorant over chunks of
 //! the ray whose altitude changes by a bounded amount.
 
-use super::Channel;
+use super::geometry::Frame;
+use super::{Channel, Scratch};
+use crate::math::Vec3;
 use crate::medium::DensityProfile;
 use crate::reference::rng::Rng;
 
@@ -127,11 +129,26 @@ impl Channel<'_> {
         }
     }
 
-    /// Delta tracking along [0, t_end]: the distance of the first real collision, if any.
-    pub(super) fn collide(&self, x0: f64, b: f64, t_end: f64, rng: &mut Rng) -> Option<f64> {
+    /// Delta tracking along [0, t_end] of the flight from offset `o` along `d` (x₀, b its
+    /// invariants): the distance of the first real collision, if any. The volumes'
+    /// extinction joins the atmosphere's where there are any.
+    pub(super) fn collide(
+        &self,
+        frame: &Frame,
+        o: Vec3,
+        d: Vec3,
+        t_end: f64,
+        rng: &mut Rng,
+        scratch: &mut Scratch,
+    ) -> Option<f64> {
+        let (x0, b) = (frame.x(o), frame.b(o, d));
+        let volumes = self.has_volumes();
         let mut t0 = 0.0;
         while t0 < t_end {
-            let (t1, maj) = self.chunk(x0, b, t0, t_end);
+            let (t1, mut maj) = self.chunk(x0, b, t0, t_end);
+            if volumes {
+                maj += self.volume_majorant(frame, o, d, t0, t1);
+            }
             if maj > 0.0 {
                 let mut t = t0;
                 loop {
@@ -139,7 +156,10 @@ impl Channel<'_> {
                     if t >= t1 {
                         break;
                     }
-                    let sigma = self.extinction(self.alt(x0, b, t));
+                    let mut sigma = self.extinction(self.alt(x0, b, t));
+                    if volumes {
+                        sigma += self.volume_extinction(frame.point(o + t * d), scratch);
+                    }
                     if rng.next_f64() * maj < sigma {
                         return Some(t);
                     }

@@ -29,6 +29,12 @@ impl Frame {
         p - self.anchor
     }
 
+    /// The planet-centred point at offset `o`.
+    #[inline]
+    pub(crate) fn point(&self, o: Vec3) -> Vec3 {
+        self.anchor + o
+    }
+
     /// r² − R_g² at offset `o`.
     #[inline]
     pub(crate) fn x(&self, o: Vec3) -> f64 {

@@ -31,6 +31,7 @@ mod optical_depth;
 mod paths;
 #[cfg(test)]
 mod tests;
+mod volumes;
 
 use std::f64::consts::PI;
 
@@ -40,6 +41,7 @@ use crate::atmosphere::{LimbDarkening, Model};
 use crate::math::Vec3;
 use crate::medium::{DensityProfile, PhaseFunction};
 use crate::scene::light::{disk_solid_angle_weighted, limb_darkening};
+use crate::scene::Volume;
 use geometry::rotate;
 pub(crate) use geometry::{cosine_direction, Frame};
 
@@ -81,6 +83,10 @@ pub(crate) struct Channel<'a> {
     segments: usize,
     max_bounces: usize,
     roulette_after: usize,
+    /// The scene's volumes (non-atmospheric media), sampled in world coordinates.
+    volumes: &'a [Box<dyn Volume + 'a>],
+    /// Wavelengths of the model (the volumes' coefficients come for all at once).
+    channels: usize,
 }
 
 /// Graded intervals per monotone piece of a camera ray in [`Primary`].
@@ -96,11 +102,27 @@ pub(crate) struct Primary {
     ground: bool,
 }
 
-/// Scratch space for one path (densities of each constituent at the current collision).
-pub(crate) type Scratch = Vec<f64>;
+/// Scratch space for one path: what a collision leaves for the phase function and the
+/// choice of scatterer.
+pub(crate) struct Scratch {
+    /// Density of each constituent at the current collision.
+    pub(crate) dens: Vec<f64>,
+    /// Each volume's scattering coefficient of this channel at the current collision.
+    pub(crate) volume_scattering: Vec<f64>,
+    /// The current collision (planet-centred), where the volumes' phase functions are read.
+    pub(crate) point: Vec3,
+    /// Per-channel buffers for `Volume::coefficients`.
+    pub(crate) extinction: Vec<f64>,
+    pub(crate) scattering: Vec<f64>,
+}
 
 impl<'a> Channel<'a> {
-    pub(crate) fn new(model: &'a Model, k: usize, settings: &ReferenceSettings) -> Channel<'a> {
+    pub(crate) fn new(
+        model: &'a Model,
+        volumes: &'a [Box<dyn Volume + 'a>],
+        k: usize,
+        settings: &ReferenceSettings,
+    ) -> Channel<'a> {
         let parts: Vec<Part> = model
             .constituents
             .iter()
@@ -164,6 +186,8 @@ impl<'a> Channel<'a> {
             segments: settings.transmittance_segments.max(1),
             max_bounces: settings.max_bounces,
             roulette_after: settings.roulette_after,
+            volumes,
+            channels: model.channels(),
         }
     }
 
@@ -173,7 +197,13 @@ impl<'a> Channel<'a> {
     }
 
     pub(crate) fn scratch(&self) -> Scratch {
-        vec![0.0; self.parts.len()]
+        Scratch {
+            dens: vec![0.0; self.parts.len()],
+            volume_scattering: vec![0.0; self.volumes.len()],
+            point: Vec3::ZERO,
+            extinction: vec![0.0; self.channels],
+            scattering: vec![0.0; self.channels],
+        }
     }
 
     /// A direction in the sun disk and its weight E·ld·Ω_cone/Ω_w (W·m⁻²·nm⁻¹).
@@ -195,49 +225,75 @@ impl<'a> Channel<'a> {
         (dir, weight)
     }
 
-    /// Densities at `h` into `dens`; returns (σ_t, σ_s).
+    /// The coefficients at a collision at altitude `h` and offset `o`, the constituents'
+    /// densities and the volumes' scattering left in `scratch`; returns (σ_t, σ_s).
     #[inline]
-    pub(super) fn coefficients(&self, h: f64, dens: &mut [f64]) -> (f64, f64) {
+    pub(super) fn coefficients(
+        &self,
+        frame: &Frame,
+        o: Vec3,
+        h: f64,
+        scratch: &mut Scratch,
+    ) -> (f64, f64) {
         let (mut st, mut ss) = (0.0, 0.0);
-        for (p, d) in self.parts.iter().zip(dens.iter_mut()) {
+        for (p, d) in self.parts.iter().zip(scratch.dens.iter_mut()) {
             *d = p.density.density(h);
             st += *d * p.extinction;
             ss += *d * p.scattering;
+        }
+        if !self.volumes.is_empty() {
+            let (vt, vs) = self.volume_coefficients(frame.point(o), scratch);
+            st += vt;
+            ss += vs;
         }
         (st, ss)
     }
 
     /// Mixed phase function at a collision.
     #[inline]
-    pub(super) fn phase(&self, dens: &[f64], sigma_s: f64, cos: f64) -> f64 {
+    pub(super) fn phase(&self, scratch: &Scratch, sigma_s: f64, cos: f64) -> f64 {
         let mut p = 0.0;
-        for (part, d) in self.parts.iter().zip(dens) {
+        for (part, d) in self.parts.iter().zip(&scratch.dens) {
             let s = d * part.scattering;
             if s > 0.0 {
                 p += s * part.phase.eval(cos);
             }
         }
+        for (volume, &s) in self.volumes.iter().zip(&scratch.volume_scattering) {
+            if s > 0.0 {
+                p += s * volume.phase(scratch.point).eval(cos);
+            }
+        }
         p / sigma_s
     }
 
-    /// New direction after scattering: constituent chosen ∝ its scattering coefficient,
-    /// then its phase function importance-sampled.
+    /// New direction after scattering: constituent or volume chosen ∝ its scattering
+    /// coefficient, then its phase function importance-sampled.
     #[inline]
-    pub(super) fn scatter(&self, d: Vec3, dens: &[f64], sigma_s: f64, rng: &mut Rng) -> Vec3 {
+    pub(super) fn scatter(&self, d: Vec3, scratch: &Scratch, sigma_s: f64, rng: &mut Rng) -> Vec3 {
         let mut u = rng.next_f64() * sigma_s;
         let mut chosen = None;
-        for (part, dd) in self.parts.iter().zip(dens) {
-            let s = dd * part.scattering;
+        let parts = self
+            .parts
+            .iter()
+            .zip(&scratch.dens)
+            .map(|(part, dd)| (part.phase, dd * part.scattering));
+        let volumes = self
+            .volumes
+            .iter()
+            .zip(&scratch.volume_scattering)
+            .map(|(v, &s)| (v.phase(scratch.point), s));
+        for (phase, s) in parts.chain(volumes) {
             if s > 0.0 {
-                chosen = Some(part);
+                chosen = Some(phase);
                 if u < s {
                     break;
                 }
                 u -= s;
             }
         }
-        let part = chosen.expect("a collision with σ_s > 0 has a scatterer");
-        let (cos, phi) = part.phase.sample(rng.next_f64(), rng.next_f64());
+        let phase = chosen.expect("a collision with σ_s > 0 has a scatterer");
+        let (cos, phi) = phase.sample(rng.next_f64(), rng.next_f64());
         rotate(d, cos, phi)
     }
 

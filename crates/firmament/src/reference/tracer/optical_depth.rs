@@ -9,7 +9,7 @@ use crate::math::Vec3;
 
 impl Channel<'_> {
     /// Deterministic transmittance from offset `o` along unit `d` to the top of the
-    /// atmosphere; 0 if the ray meets the ground.
+    /// atmosphere, through the volumes too; 0 if the ray meets the ground.
     pub(crate) fn transmittance(&self, frame: &Frame, o: Vec3, d: Vec3) -> f64 {
         let x0 = frame.x(o);
         let b = frame.b(o, d);
@@ -17,7 +17,11 @@ impl Channel<'_> {
         if ground {
             return 0.0;
         }
-        (-self.optical_depth(x0, b, t_end)).exp()
+        let mut tau = self.optical_depth(x0, b, t_end);
+        if self.has_volumes() {
+            tau += self.volume_optical_depth(frame, o, d);
+        }
+        (-tau).exp()
     }
 
     /// Optical depth along [0, t_end] (composite Gauss–Legendre). The ray is cut where its

@@ -23,6 +23,7 @@ impl Channel<'_> {
     /// σ_s(t)·(1 − e^{−τ_L})/σ̄(interval); the uncollided part (probability e^{−τ_L}) is
     /// followed too when it reaches a ground that counts. This removes the variance of
     /// "did the path collide at all", which dominates in thin air (zenith views, space).
+    /// Through volumes the first flight is plain delta tracking.
     pub(crate) fn radiance_sample(
         &self,
         frame: &Frame,
@@ -30,8 +31,18 @@ impl Channel<'_> {
         sun: Vec3,
         primary_ground: bool,
         rng: &mut Rng,
-        dens: &mut Scratch,
+        scratch: &mut Scratch,
     ) -> f64 {
+        if self.has_volumes() {
+            return self.radiance_sample_with_volumes(
+                frame,
+                primary,
+                sun,
+                primary_ground,
+                rng,
+                scratch,
+            );
+        }
         let mut radiance = 0.0;
         let tau_l = *primary.tau.last().unwrap();
         if tau_l > 0.0 {
@@ -51,18 +62,48 @@ impl Channel<'_> {
                 let o = advance(primary.o, t, primary.d);
                 let x0 = frame.x(primary.o);
                 let b = frame.b(primary.o, primary.d);
-                let (_, ss) = self.coefficients(self.alt(x0, b, t), dens);
+                let (_, ss) = self.coefficients(frame, o, self.alt(x0, b, t), scratch);
                 if ss > 0.0 {
                     let w = ss * (1.0 - escape) / mean_sigma;
-                    radiance += self.after_collision(frame, o, primary.d, w, ss, sun, rng, dens);
+                    radiance += self.after_collision(frame, o, primary.d, w, ss, sun, rng, scratch);
                 }
             }
         }
         if primary.ground && primary_ground && self.ground_albedo > 0.0 {
             let o = advance(primary.o, primary.t_end, primary.d);
-            radiance += self.after_ground(frame, o, (-tau_l).exp(), 0, sun, rng, dens);
+            radiance += self.after_ground(frame, o, (-tau_l).exp(), 0, sun, rng, scratch);
         }
         radiance
+    }
+
+    /// [`Channel::radiance_sample`] through the scene's volumes: the first flight by plain
+    /// delta tracking (the primary ray's tabulated optical depth holds the air only).
+    fn radiance_sample_with_volumes(
+        &self,
+        frame: &Frame,
+        primary: &Primary,
+        sun: Vec3,
+        primary_ground: bool,
+        rng: &mut Rng,
+        scratch: &mut Scratch,
+    ) -> f64 {
+        let (o, d) = (primary.o, primary.d);
+        match self.collide(frame, o, d, primary.t_end, rng, scratch) {
+            Some(t) => {
+                let x = advance(o, t, d);
+                let h = self.alt(frame.x(o), frame.b(o, d), t);
+                let (st, ss) = self.coefficients(frame, x, h, scratch);
+                if st <= 0.0 || ss <= 0.0 {
+                    return 0.0;
+                }
+                self.after_collision(frame, x, d, ss / st, ss, sun, rng, scratch)
+            }
+            None if primary.ground && primary_ground && self.ground_albedo > 0.0 => {
+                let x = advance(o, primary.t_end, d);
+                self.after_ground(frame, x, 1.0, 0, sun, rng, scratch)
+            }
+            None => 0.0,
+        }
     }
 
     /// NEE at a real collision at `o` (densities in `dens`, weight `w` already including
@@ -76,12 +117,12 @@ impl Channel<'_> {
         ss: f64,
         sun: Vec3,
         rng: &mut Rng,
-        dens: &mut Scratch,
+        scratch: &mut Scratch,
     ) -> f64 {
         let (ls, e) = self.sample_sun(sun, rng);
         let tr = self.transmittance(frame, o, ls);
         let mut radiance = if tr > 0.0 {
-            w * self.phase(dens, ss, d.dot(ls)) * tr * e
+            w * self.phase(scratch, ss, d.dot(ls)) * tr * e
         } else {
             0.0
         };
@@ -89,8 +130,8 @@ impl Channel<'_> {
         if events >= self.max_bounces || !self.roulette(events, &mut w, rng) {
             return radiance;
         }
-        let d = self.scatter(d, dens, ss, rng);
-        radiance += self.trace(frame, o, d, w, events, sun, rng, dens);
+        let d = self.scatter(d, scratch, ss, rng);
+        radiance += self.trace(frame, o, d, w, events, sun, rng, scratch);
         radiance
     }
 
@@ -104,7 +145,7 @@ impl Channel<'_> {
         mut events: usize,
         sun: Vec3,
         rng: &mut Rng,
-        dens: &mut Scratch,
+        scratch: &mut Scratch,
     ) -> f64 {
         let n = frame.up(o);
         events += 1;
@@ -120,7 +161,7 @@ impl Channel<'_> {
             return radiance;
         }
         let d = cosine_direction(n, rng);
-        radiance + self.trace(frame, o, d, w, events, sun, rng, dens)
+        radiance + self.trace(frame, o, d, w, events, sun, rng, scratch)
     }
 
     /// The path from `o` along `d` with weight `w` after `events` events (delta tracking).
@@ -133,17 +174,17 @@ impl Channel<'_> {
         mut events: usize,
         sun: Vec3,
         rng: &mut Rng,
-        dens: &mut Scratch,
+        scratch: &mut Scratch,
     ) -> f64 {
         let mut radiance = 0.0;
         loop {
             let x0 = frame.x(o);
             let b = frame.b(o, d);
             let (t_end, ground) = self.boundary(x0, b);
-            if let Some(t) = self.collide(x0, b, t_end, rng) {
+            if let Some(t) = self.collide(frame, o, d, t_end, rng, scratch) {
                 o = advance(o, t, d);
                 let h = self.alt(x0, b, t);
-                let (st, ss) = self.coefficients(h, dens);
+                let (st, ss) = self.coefficients(frame, o, h, scratch);
                 if st <= 0.0 || ss <= 0.0 {
                     break;
                 }
@@ -152,12 +193,12 @@ impl Channel<'_> {
                 let (ls, e) = self.sample_sun(sun, rng);
                 let tr = self.transmittance(frame, o, ls);
                 if tr > 0.0 {
-                    radiance += w * self.phase(dens, ss, d.dot(ls)) * tr * e;
+                    radiance += w * self.phase(scratch, ss, d.dot(ls)) * tr * e;
                 }
                 if events >= self.max_bounces || !self.roulette(events, &mut w, rng) {
                     break;
                 }
-                d = self.scatter(d, dens, ss, rng);
+                d = self.scatter(d, scratch, ss, rng);
             } else {
                 if !ground || self.ground_albedo <= 0.0 {
                     break;
@@ -189,7 +230,7 @@ impl Channel<'_> {
         mut o: Vec3,
         mut d: Vec3,
         rng: &mut Rng,
-        dens: &mut Scratch,
+        scratch: &mut Scratch,
     ) -> [f64; BUDGET_TALLIES] {
         let mut tally = [0.0; BUDGET_TALLIES];
         let mut w = 1.0;
@@ -199,9 +240,9 @@ impl Channel<'_> {
             let x0 = frame.x(o);
             let b = frame.b(o, d);
             let (t_end, ground) = self.boundary(x0, b);
-            if let Some(t) = self.collide(x0, b, t_end, rng) {
+            if let Some(t) = self.collide(frame, o, d, t_end, rng, scratch) {
                 o = advance(o, t, d);
-                let (st, ss) = self.coefficients(self.alt(x0, b, t), dens);
+                let (st, ss) = self.coefficients(frame, o, self.alt(x0, b, t), scratch);
                 let albedo = if st > 0.0 { ss / st } else { 0.0 };
                 tally[T_MEDIUM_ABSORBED] += w * (1.0 - albedo);
                 w *= albedo;
@@ -217,7 +258,7 @@ impl Channel<'_> {
                 if !self.roulette(events, &mut w, rng) {
                     break;
                 }
-                d = self.scatter(d, dens, ss, rng);
+                d = self.scatter(d, scratch, ss, rng);
             } else {
                 if !ground {
                     tally[T_REFLECTED] += w;

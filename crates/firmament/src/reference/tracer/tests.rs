@@ -28,7 +28,7 @@ fn optical_depth_matches_exact_vertical_and_dense_slant_columns() {
     let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
     let settings = ReferenceSettings::default();
     for k in 0..3 {
-        let ch = Channel::new(&model, k, &settings);
+        let ch = Channel::new(&model, &[], k, &settings);
         let frame = Frame::below(
             Vec3::new(0.0, 0.0, model.bottom_radius_m),
             model.bottom_radius_m,
@@ -73,8 +73,8 @@ fn optical_depth_converges_with_the_default_segments() {
         let mut rng = Rng::for_key(1, 2, 3, 4);
         for k in 0..3 {
             let (chf, ch) = (
-                Channel::new(&model, k, &fine),
-                Channel::new(&model, k, &ReferenceSettings::default()),
+                Channel::new(&model, &[], k, &fine),
+                Channel::new(&model, &[], k, &ReferenceSettings::default()),
             );
             let mut worst: f64 = 0.0;
             for _ in 0..3000 {

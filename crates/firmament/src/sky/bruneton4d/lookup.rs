@@ -68,8 +68,8 @@ impl<'a> Lookup<'a> {
     /// stand-in for T = 0.
     #[inline]
     pub fn transmittance(&self, r: f64, mu: f64, d: f64, ground: bool, out: &mut [f64]) {
-        let g = &self.radii;
-        let r_d = safe_sqrt(d * d + 2.0 * r * mu * d + r * r).clamp(g.bottom, g.top);
+        let radii = &self.radii;
+        let r_d = safe_sqrt(d * d + 2.0 * r * mu * d + r * r).clamp(radii.bottom, radii.top);
         let mu_d = ((r * mu + d) / r_d).clamp(-1.0, 1.0);
         let n = out.len();
         let mut a = [0.0f64; MAX_CHANNELS];

@@ -21,7 +21,7 @@ pub use view::Bruneton4dView;
 use super::{SkyMethod, SkyView};
 use crate::atmosphere::Model;
 use crate::math::Vec3;
-use crate::scene::Light;
+use crate::scene::light::Light;
 use crate::Result;
 
 /// The 4D-table sky method: a model with its precomputed tables.

@@ -5,7 +5,8 @@
 
 use crate::math::sphere::{clamp_cosine, distance_to_top_atmosphere_boundary, safe_sqrt};
 
-/// Table sizes. Defaults from Bruneton 2017 / SPEC §3.
+/// Table sizes. Defaults from Bruneton 2017 (transmittance 256×64, scattering 32×128×32×8,
+/// irradiance 64×16).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TableSizes {
@@ -132,11 +133,11 @@ impl Radii {
 
 /// (u, v) ∈ [0,1]² of the transmittance table for (r, μ) (paper §4, Bruneton 2017).
 #[inline]
-pub fn transmittance_uv(g: &Radii, r: f64, mu: f64, nu_: usize, nr: usize) -> (f64, f64) {
-    let h = g.h();
-    let rho = safe_sqrt(r * r - g.bottom * g.bottom);
-    let d = distance_to_top_atmosphere_boundary(r, mu, g.top);
-    let d_min = g.top - r;
+pub fn transmittance_uv(radii: &Radii, r: f64, mu: f64, nmu: usize, nr: usize) -> (f64, f64) {
+    let h = radii.h();
+    let rho = safe_sqrt(r * r - radii.bottom * radii.bottom);
+    let d = distance_to_top_atmosphere_boundary(r, mu, radii.top);
+    let d_min = radii.top - r;
     let d_max = rho + h;
     let x_mu = if d_max > d_min {
         (d - d_min) / (d_max - d_min)
@@ -144,18 +145,18 @@ pub fn transmittance_uv(g: &Radii, r: f64, mu: f64, nu_: usize, nr: usize) -> (f
         0.0
     };
     let x_r = rho / h;
-    (texcoord_from_unit(x_mu, nu_), texcoord_from_unit(x_r, nr))
+    (texcoord_from_unit(x_mu, nmu), texcoord_from_unit(x_r, nr))
 }
 
 /// Inverse of [`transmittance_uv`].
 #[inline]
-pub fn transmittance_r_mu(g: &Radii, u: f64, v: f64, nmu: usize, nr: usize) -> (f64, f64) {
-    let h = g.h();
+pub fn transmittance_r_mu(radii: &Radii, u: f64, v: f64, nmu: usize, nr: usize) -> (f64, f64) {
+    let h = radii.h();
     let x_mu = unit_from_texcoord(u, nmu);
     let x_r = unit_from_texcoord(v, nr);
     let rho = h * x_r;
-    let r = (rho * rho + g.bottom * g.bottom).sqrt();
-    let d_min = g.top - r;
+    let r = (rho * rho + radii.bottom * radii.bottom).sqrt();
+    let d_min = radii.top - r;
     let d_max = rho + h;
     let d = d_min + x_mu * (d_max - d_min);
     let mu = if d == 0.0 {
@@ -168,8 +169,8 @@ pub fn transmittance_r_mu(g: &Radii, u: f64, v: f64, nmu: usize, nr: usize) -> (
 
 /// (u, v) of the irradiance table for (r, μ_s): linear in both.
 #[inline]
-pub fn irradiance_uv(g: &Radii, r: f64, mu_s: f64, nmu_s: usize, nr: usize) -> (f64, f64) {
-    let x_r = (r - g.bottom) / (g.top - g.bottom);
+pub fn irradiance_uv(radii: &Radii, r: f64, mu_s: f64, nmu_s: usize, nr: usize) -> (f64, f64) {
+    let x_r = (r - radii.bottom) / (radii.top - radii.bottom);
     let x_mu_s = mu_s * 0.5 + 0.5;
     (
         texcoord_from_unit(x_mu_s, nmu_s),
@@ -179,11 +180,11 @@ pub fn irradiance_uv(g: &Radii, r: f64, mu_s: f64, nmu_s: usize, nr: usize) -> (
 
 /// Inverse of [`irradiance_uv`].
 #[inline]
-pub fn irradiance_r_mu_s(g: &Radii, u: f64, v: f64, nmu_s: usize, nr: usize) -> (f64, f64) {
+pub fn irradiance_r_mu_s(radii: &Radii, u: f64, v: f64, nmu_s: usize, nr: usize) -> (f64, f64) {
     let x_mu_s = unit_from_texcoord(u, nmu_s);
     let x_r = unit_from_texcoord(v, nr);
     (
-        g.bottom + x_r * (g.top - g.bottom),
+        radii.bottom + x_r * (radii.top - radii.bottom),
         clamp_cosine(2.0 * x_mu_s - 1.0),
     )
 }
@@ -191,7 +192,7 @@ pub fn irradiance_r_mu_s(g: &Radii, u: f64, v: f64, nmu_s: usize, nr: usize) -> 
 /// The four coordinates (u_ν, u_μs, u_μ, u_r) ∈ [0,1]⁴ of the scattering table.
 #[inline]
 pub fn scattering_uvwz(
-    g: &Radii,
+    radii: &Radii,
     s: &TableSizes,
     r: f64,
     mu: f64,
@@ -199,32 +200,32 @@ pub fn scattering_uvwz(
     nu: f64,
     ray_r_mu_intersects_ground: bool,
 ) -> [f64; 4] {
-    let rho = safe_sqrt(r * r - g.bottom * g.bottom);
-    let u_r = texcoord_from_unit(rho / g.h(), s.scattering_r);
-    let u_mu = scattering_u_mu(g, s, r, mu, ray_r_mu_intersects_ground);
-    let u_mu_s = texcoord_from_unit(x_mu_s(g, mu_s), s.scattering_mu_s);
+    let rho = safe_sqrt(r * r - radii.bottom * radii.bottom);
+    let u_r = texcoord_from_unit(rho / radii.h(), s.scattering_r);
+    let u_mu = scattering_u_mu(radii, s, r, mu, ray_r_mu_intersects_ground);
+    let u_mu_s = texcoord_from_unit(x_mu_s(radii, mu_s), s.scattering_mu_s);
     [u_nu(mu, mu_s, nu), u_mu_s, u_mu, u_r]
 }
 
 /// The u_μ coordinate of [`scattering_uvwz`] alone (for lookups at a known (r, μ_s)).
 #[inline]
 pub fn scattering_u_mu(
-    g: &Radii,
+    radii: &Radii,
     s: &TableSizes,
     r: f64,
     mu: f64,
     ray_r_mu_intersects_ground: bool,
 ) -> f64 {
-    let h = g.h();
-    let rho = safe_sqrt(r * r - g.bottom * g.bottom);
+    let h = radii.h();
+    let rho = safe_sqrt(r * r - radii.bottom * radii.bottom);
     let r_mu = r * mu;
-    let discriminant = r_mu * r_mu - r * r + g.bottom * g.bottom;
+    let discriminant = r_mu * r_mu - r * r + radii.bottom * radii.bottom;
     let half = s.scattering_mu / 2;
     if ray_r_mu_intersects_ground {
         // Distance to the ground, mapped to the lower half [0, 0.5] by
         // [`ground_x_from_distance_fraction`].
         let d = -r_mu - safe_sqrt(discriminant);
-        let d_min = r - g.bottom;
+        let d_min = r - radii.bottom;
         let d_max = rho;
         let x = if d_max == d_min {
             0.0
@@ -235,7 +236,7 @@ pub fn scattering_u_mu(
     } else {
         // Distance to the top, mapped to the upper half [0.5, 1].
         let d = -r_mu + safe_sqrt(discriminant + h * h);
-        let d_min = g.top - r;
+        let d_min = radii.top - r;
         let d_max = rho + h;
         let x = if d_max > d_min {
             ((d - d_min) / (d_max - d_min)).clamp(0.0, 1.0)
@@ -272,13 +273,13 @@ pub struct MuSMap {
 
 impl MuSMap {
     /// Constants for these radii.
-    pub fn new(g: &Radii) -> MuSMap {
-        let d_min = g.top - g.bottom;
-        let d_max = g.h();
-        let big_d = distance_to_top_atmosphere_boundary(g.bottom, g.mu_s_min, g.top);
+    pub fn new(radii: &Radii) -> MuSMap {
+        let d_min = radii.top - radii.bottom;
+        let d_max = radii.h();
+        let big_d = distance_to_top_atmosphere_boundary(radii.bottom, radii.mu_s_min, radii.top);
         MuSMap {
-            top: g.top,
-            bottom: g.bottom,
+            top: radii.top,
+            bottom: radii.bottom,
             d_min,
             inv_range: 1.0 / (d_max - d_min),
             big_a: (big_d - d_min) / (d_max - d_min),
@@ -304,8 +305,8 @@ pub struct MuSPositions {
 
 impl MuSPositions {
     /// For `n` μ_s texels.
-    pub fn new(g: &Radii, n: usize) -> MuSPositions {
-        let map = MuSMap::new(g);
+    pub fn new(radii: &Radii, n: usize) -> MuSPositions {
+        let map = MuSMap::new(radii);
         let k = 4096;
         let table = (0..=k)
             .map(|j| {
@@ -366,41 +367,41 @@ pub fn nu_from_u_nu(mu: f64, mu_s: f64, u_nu: f64) -> f64 {
 /// The non-linear μ_s coordinate in [0,1] (Bruneton 2017): from the distance to the top
 /// along the sun ray from the ground, with the configurable minimum sun elevation.
 #[inline]
-pub fn x_mu_s(g: &Radii, mu_s: f64) -> f64 {
-    MuSMap::new(g).x(mu_s)
+pub fn x_mu_s(radii: &Radii, mu_s: f64) -> f64 {
+    MuSMap::new(radii).x(mu_s)
 }
 
 /// Inverse of [`x_mu_s`].
 #[inline]
-pub fn mu_s_from_x(g: &Radii, x: f64) -> f64 {
-    let h = g.h();
-    let d_min = g.top - g.bottom;
+pub fn mu_s_from_x(radii: &Radii, x: f64) -> f64 {
+    let h = radii.h();
+    let d_min = radii.top - radii.bottom;
     let d_max = h;
-    let big_d = distance_to_top_atmosphere_boundary(g.bottom, g.mu_s_min, g.top);
+    let big_d = distance_to_top_atmosphere_boundary(radii.bottom, radii.mu_s_min, radii.top);
     let big_a = (big_d - d_min) / (d_max - d_min);
     let a = (big_a - x * big_a) / (1.0 + x * big_a);
     let d = d_min + a.min(big_a) * (d_max - d_min);
     if d == 0.0 {
         1.0
     } else {
-        clamp_cosine((h * h - d * d) / (2.0 * g.bottom * d))
+        clamp_cosine((h * h - d * d) / (2.0 * radii.bottom * d))
     }
 }
 
 /// Inverse of [`scattering_uvwz`]: (r, μ, μ_s, ν, ray hits ground).
 #[inline]
 pub fn scattering_r_mu_mu_s_nu(
-    g: &Radii,
+    radii: &Radii,
     s: &TableSizes,
     uvwz: [f64; 4],
 ) -> (f64, f64, f64, f64, bool) {
     let [u_nu, u_mu_s, u_mu, u_r] = uvwz;
-    let h = g.h();
+    let h = radii.h();
     let rho = h * unit_from_texcoord(u_r, s.scattering_r);
-    let r = (rho * rho + g.bottom * g.bottom).sqrt();
+    let r = (rho * rho + radii.bottom * radii.bottom).sqrt();
     let half = s.scattering_mu / 2;
     let (mu, ground) = if u_mu < 0.5 {
-        let d_min = r - g.bottom;
+        let d_min = r - radii.bottom;
         let d_max = rho;
         let x = unit_from_texcoord(1.0 - 2.0 * u_mu, half);
         let d = d_min + (d_max - d_min) * x * x;
@@ -411,7 +412,7 @@ pub fn scattering_r_mu_mu_s_nu(
         };
         (mu, true)
     } else {
-        let d_min = g.top - r;
+        let d_min = radii.top - r;
         let d_max = rho + h;
         let d = d_min + (d_max - d_min) * unit_from_texcoord(2.0 * u_mu - 1.0, half);
         let mu = if d == 0.0 {
@@ -421,7 +422,7 @@ pub fn scattering_r_mu_mu_s_nu(
         };
         (mu, false)
     };
-    let mu_s = mu_s_from_x(g, unit_from_texcoord(u_mu_s, s.scattering_mu_s));
+    let mu_s = mu_s_from_x(radii, unit_from_texcoord(u_mu_s, s.scattering_mu_s));
     let nu = nu_from_u_nu(mu, mu_s, u_nu);
     (r, mu, mu_s, nu, ground)
 }
@@ -430,7 +431,7 @@ pub fn scattering_r_mu_mu_s_nu(
 /// z = r); ν is clamped to the range allowed by μ and μ_s (Bruneton 2017
 /// `GetRMuMuSNuFromScatteringTextureFragCoord`; the ν grid includes −1 and 1).
 pub fn scattering_texel(
-    g: &Radii,
+    radii: &Radii,
     s: &TableSizes,
     x: usize,
     y: usize,
@@ -439,7 +440,7 @@ pub fn scattering_texel(
     let i_nu = x / s.scattering_mu_s;
     let i_mu_s = x % s.scattering_mu_s;
     let uvwz = texel_uvwz(s, i_nu, i_mu_s, y, z);
-    let (r, mu, mu_s, nu, ground) = scattering_r_mu_mu_s_nu(g, s, uvwz);
+    let (r, mu, mu_s, nu, ground) = scattering_r_mu_mu_s_nu(radii, s, uvwz);
     (r, mu, mu_s, clamp_nu(mu, mu_s, nu), ground)
 }
 
@@ -474,9 +475,10 @@ pub struct ScatteringGrid {
 
 impl ScatteringGrid {
     /// The grid of these sizes.
-    pub fn new(g: &Radii, s: &TableSizes) -> ScatteringGrid {
-        let at =
-            |i_nu, i_mu_s, y, z| scattering_r_mu_mu_s_nu(g, s, texel_uvwz(s, i_nu, i_mu_s, y, z));
+    pub fn new(radii: &Radii, s: &TableSizes) -> ScatteringGrid {
+        let at = |i_nu, i_mu_s, y, z| {
+            scattering_r_mu_mu_s_nu(radii, s, texel_uvwz(s, i_nu, i_mu_s, y, z))
+        };
         let (nr, nmu) = (s.scattering_r, s.scattering_mu);
         ScatteringGrid {
             nmu,

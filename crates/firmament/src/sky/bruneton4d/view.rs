@@ -14,7 +14,7 @@ use super::{params, Bruneton4d, MieStorage};
 use crate::atmosphere::groups::{AEROSOLS, MOLECULES};
 use crate::math::sphere::{advance, ray_intersects_ground};
 use crate::math::{smoothstep, Vec3};
-use crate::scene::Light;
+use crate::scene::light::Light;
 use crate::sky::{Shadow, SkyView};
 use crate::spectrum::MAX_CHANNELS;
 
@@ -147,7 +147,7 @@ impl<'a> Bruneton4dView<'a> {
     /// the ray's start, from the slice when the ray starts at the observer.
     fn combined_scattering(
         &self,
-        g: &RayGeometry,
+        ray: &RayGeometry,
         d: f64,
         at_start: bool,
         scat: &mut [f64],
@@ -158,22 +158,22 @@ impl<'a> Bruneton4dView<'a> {
         let lk = &self.lookup;
         let n = scat.len();
         let (r, mu, mu_s) = if at_start {
-            (g.r, g.mu, g.mu_s)
+            (ray.r, ray.mu, ray.mu_s)
         } else {
             let (bottom, top) = (sky.model.bottom_radius_m, sky.model.top_radius_m);
-            let (r_d, mu_d) = advance(g.r, g.mu, d, bottom, top);
+            let (r_d, mu_d) = advance(ray.r, ray.mu, d, bottom, top);
             (
                 r_d,
                 mu_d,
-                ((g.r * g.mu_s + d * g.nu) / r_d).clamp(-1.0, 1.0),
+                ((ray.r * ray.mu_s + d * ray.nu) / r_d).clamp(-1.0, 1.0),
             )
         };
         let mut both = [0.0f64; 2 * MAX_CHANNELS];
-        let at = match self.slice.as_ref().filter(|_| at_start && g.at_observer) {
+        let at = match self.slice.as_ref().filter(|_| at_start && ray.at_observer) {
             Some(s) => {
                 // The slice already filtered (μ_s, r): only u_ν and u_μ are needed.
-                let u_nu = params::u_nu(mu, mu_s, g.nu);
-                let u_mu = params::scattering_u_mu(&lk.radii, &lk.sizes, r, mu, g.ground);
+                let u_nu = params::u_nu(mu, mu_s, ray.nu);
+                let u_mu = params::scattering_u_mu(&lk.radii, &lk.sizes, r, mu, ray.ground);
                 tables.single_rayleigh.sample_slice_channels_into(
                     &s.scattering,
                     2 * n,
@@ -186,7 +186,7 @@ impl<'a> Bruneton4dView<'a> {
             }
             None => {
                 let uvwz =
-                    params::scattering_uvwz(&lk.radii, &lk.sizes, r, mu, mu_s, g.nu, g.ground);
+                    params::scattering_uvwz(&lk.radii, &lk.sizes, r, mu, mu_s, ray.nu, ray.ground);
                 tables.single_rayleigh.sample_into(uvwz, scat);
                 tables.multiple.sample_into(uvwz, &mut both[n..2 * n]);
                 At::Table(uvwz)
@@ -194,7 +194,7 @@ impl<'a> Bruneton4dView<'a> {
         };
         // Multiple scattering is stored as radiance; callers apply the molecular phase
         // function to `scat`, so it goes in divided by it.
-        let p = sky.model.groups.phase[MOLECULES].eval(g.nu).max(1e-30);
+        let p = sky.model.groups.phase[MOLECULES].eval(ray.nu).max(1e-30);
         for k in 0..n {
             scat[k] += both[n + k] / p;
         }
@@ -225,7 +225,7 @@ impl<'a> Bruneton4dView<'a> {
     /// beyond the boundary). Single Mie is multiplied by `mie_fade`.
     fn lit_radiance(
         &self,
-        g: &RayGeometry,
+        ray: &RayGeometry,
         intervals: &[(f64, f64)],
         end: f64,
         open_end: bool,
@@ -244,24 +244,24 @@ impl<'a> Bruneton4dView<'a> {
             &mut t[..n],
         );
         let phase = &self.sky.model.groups.phase;
-        let (pr, pm) = (phase[MOLECULES].eval(g.nu), phase[AEROSOLS].eval(g.nu));
+        let (pr, pm) = (phase[MOLECULES].eval(ray.nu), phase[AEROSOLS].eval(ray.nu));
         radiance[..n].iter_mut().for_each(|v| *v = 0.0);
         for &(a, b) in intervals {
             let (a, b) = (a.max(0.0), b.min(end));
             if b <= a {
                 continue;
             }
-            self.combined_scattering(g, a, a == 0.0, scat, mie);
+            self.combined_scattering(ray, a, a == 0.0, scat, mie);
             if a > 0.0 {
-                lk.transmittance(g.r, g.mu, a, g.ground, t);
+                lk.transmittance(ray.r, ray.mu, a, ray.ground, t);
                 for k in 0..n {
                     scat[k] *= t[k];
                     mie[k] *= t[k];
                 }
             }
             if b < end || !open_end {
-                self.combined_scattering(g, b, false, scat_b, mie_b);
-                lk.transmittance(g.r, g.mu, b, g.ground, t);
+                self.combined_scattering(ray, b, false, scat_b, mie_b);
+                lk.transmittance(ray.r, ray.mu, b, ray.ground, t);
                 for k in 0..n {
                     scat[k] = (scat[k] - t[k] * scat_b[k]).max(0.0);
                     mie[k] = (mie[k] - t[k] * mie_b[k]).max(0.0);
@@ -277,14 +277,14 @@ impl<'a> Bruneton4dView<'a> {
     }
 
     /// Distance from the start along the ray to the nearest boundary (ground or top).
-    fn boundary_distance(&self, g: &RayGeometry) -> f64 {
+    fn boundary_distance(&self, ray: &RayGeometry) -> f64 {
         let m = &self.sky.model;
         crate::math::sphere::distance_to_nearest_atmosphere_boundary(
-            g.r,
-            g.mu,
+            ray.r,
+            ray.mu,
             m.bottom_radius_m,
             m.top_radius_m,
-            g.ground,
+            ray.ground,
         )
     }
 }
@@ -311,30 +311,31 @@ impl SkyView for Bruneton4dView<'_> {
             transmittance.iter_mut().for_each(|v| *v = 1.0);
             return;
         };
-        let g = self.geometry(&start, dir);
+        let ray = self.geometry(&start, dir);
         // An empty `transmittance` asks for radiance only (saves a lookup per sky pixel).
         if transmittance.is_empty() {
-        } else if g.ground {
+        } else if ray.ground {
             transmittance[..n].iter_mut().for_each(|v| *v = 0.0);
         } else {
-            self.lookup.transmittance_to_top(g.r, g.mu, transmittance);
+            self.lookup
+                .transmittance_to_top(ray.r, ray.mu, transmittance);
         }
         // The start's offset: a camera in space starts where the ray enters the top.
         let offset = (start.point - self.observer).length();
         let end = f64::INFINITY;
         match shadow {
-            Shadow::None => self.lit_radiance(&g, &[(0.0, end)], end, true, 1.0, radiance),
+            Shadow::None => self.lit_radiance(&ray, &[(0.0, end)], end, true, 1.0, radiance),
             Shadow::Length(l) if l <= 0.0 => {
-                self.lit_radiance(&g, &[(0.0, end)], end, true, 1.0, radiance)
+                self.lit_radiance(&ray, &[(0.0, end)], end, true, 1.0, radiance)
             }
-            Shadow::Length(l) => self.lit_radiance(&g, &[(l, end)], end, true, 1.0, radiance),
+            Shadow::Length(l) => self.lit_radiance(&ray, &[(l, end)], end, true, 1.0, radiance),
             Shadow::Lit(intervals) => {
                 let shifted: Vec<(f64, f64)> = intervals
                     .iter()
                     .map(|&(a, b)| (a - offset, b - offset))
                     .collect();
-                let length = self.boundary_distance(&g);
-                self.lit_radiance(&g, &shifted, length, true, 1.0, radiance)
+                let length = self.boundary_distance(&ray);
+                self.lit_radiance(&ray, &shifted, length, true, 1.0, radiance)
             }
         }
     }
@@ -353,28 +354,28 @@ impl SkyView for Bruneton4dView<'_> {
             transmittance[..n].iter_mut().for_each(|v| *v = 1.0);
             return;
         };
-        let g = self.geometry(&start, dir);
+        let ray = self.geometry(&start, dir);
         let d_total = (point - start.point).length();
         self.lookup
-            .transmittance(g.r, g.mu, d_total, g.ground, transmittance);
+            .transmittance(ray.r, ray.mu, d_total, ray.ground, transmittance);
         // Bruneton 2017: fade single Mie when the light is below the horizon (table
         // artefacts).
-        let fade = smoothstep(0.0, 0.01, g.mu_s);
+        let fade = smoothstep(0.0, 0.01, ray.mu_s);
         let offset = (start.point - self.observer).length();
         match shadow {
             Shadow::None => {
-                self.lit_radiance(&g, &[(0.0, d_total)], d_total, false, fade, radiance)
+                self.lit_radiance(&ray, &[(0.0, d_total)], d_total, false, fade, radiance)
             }
             Shadow::Length(l) => {
                 let d = (d_total - l.max(0.0)).max(0.0);
-                self.lit_radiance(&g, &[(0.0, d)], d_total, false, fade, radiance)
+                self.lit_radiance(&ray, &[(0.0, d)], d_total, false, fade, radiance)
             }
             Shadow::Lit(intervals) => {
                 let shifted: Vec<(f64, f64)> = intervals
                     .iter()
                     .map(|&(a, b)| (a - offset, b - offset))
                     .collect();
-                self.lit_radiance(&g, &shifted, d_total, false, fade, radiance)
+                self.lit_radiance(&ray, &shifted, d_total, false, fade, radiance)
             }
         }
     }
@@ -385,9 +386,9 @@ impl SkyView for Bruneton4dView<'_> {
             out.iter_mut().for_each(|v| *v = 1.0);
             return;
         };
-        let g = self.geometry(&start, dir);
+        let ray = self.geometry(&start, dir);
         let d = (point - start.point).length();
-        self.lookup.transmittance(g.r, g.mu, d, g.ground, out);
+        self.lookup.transmittance(ray.r, ray.mu, d, ray.ground, out);
     }
 
     fn transmittance_to_light(&self, point: Vec3, out: &mut [f64]) {
@@ -423,7 +424,18 @@ impl SkyView for Bruneton4dView<'_> {
         let lk = &self.lookup;
         let light = self.light.direction;
         let length = point.length();
-        let r = length.clamp(model.bottom_radius_m, model.top_radius_m);
+        let cos = normal.dot(light).max(0.0);
+        if length > model.top_radius_m {
+            // In space: the light's direct beam only (the tables hold the sky's light from
+            // above, and there is no air above).
+            sky[..n].iter_mut().for_each(|v| *v = 0.0);
+            self.transmittance_to_light(point, direct);
+            for k in 0..n {
+                direct[k] *= self.light.irradiance[k] * cos;
+            }
+            return;
+        }
+        let r = length.max(model.bottom_radius_m);
         let mu_s = (point.dot(light) / length).clamp(-1.0, 1.0);
         lk.irradiance(&self.sky.tables.irradiance, r, mu_s, sky);
         let occlusion = (1.0 + normal.dot(point) / length) * 0.5;
@@ -431,7 +443,6 @@ impl SkyView for Bruneton4dView<'_> {
             *v *= occlusion * s;
         }
         lk.transmittance_to_sun(r, mu_s, direct);
-        let cos = normal.dot(light).max(0.0);
         for k in 0..n {
             direct[k] *= self.light.irradiance[k] * cos;
         }

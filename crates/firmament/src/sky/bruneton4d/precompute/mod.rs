@@ -4,7 +4,7 @@
 //! scattering ΔS.
 //!
 //! The scattering density, which dominates Bruneton's cost (512 incident directions per
-//! texel), is computed as a spherical convolution (SPEC §8): for a fixed (r, μ_s) the
+//! texel), is computed as a spherical convolution: for a fixed (r, μ_s) the
 //! incident radiance field is the same for every view direction, so it is sampled once on a
 //! (θ, φ) grid in the sun's frame, expanded as a cosine series in azimuth, and convolved
 //! with the phase functions' azimuthal harmonics (exact for the band-limited field), which

@@ -23,8 +23,8 @@ pub(super) fn compute_multiple_scattering(
     let mut out = Table4::for_sizes(&s, n);
     let row_len = out.row_len();
     let width = out.width();
-    let g = lookup.radii;
-    let mu_s_positions = params::MuSPositions::new(&g, s.scattering_mu_s);
+    let radii = lookup.radii;
+    let mu_s_positions = params::MuSPositions::new(&radii, s.scattering_mu_s);
     out.data
         .par_chunks_mut(row_len)
         .enumerate()
@@ -37,7 +37,7 @@ pub(super) fn compute_multiple_scattering(
             // total β_s·T.
             let mut beta = vec![0.0; count * n];
             for i in 0..count {
-                model.scattering_into(rays.r[i] - g.bottom, &mut beta[i * n..(i + 1) * n]);
+                model.scattering_into(rays.r[i] - radii.bottom, &mut beta[i * n..(i + 1) * n]);
             }
             let tw = rays.weights(&beta, n);
             // Each sample's (μ, r)-filtered row of ΔJ, so a texel's lookup is a bilinear
@@ -45,7 +45,8 @@ pub(super) fn compute_multiple_scattering(
             let row_len = density.row_len();
             let mut blended = Vec::with_capacity(count * row_len);
             for i in 0..count {
-                let uvwz = params::scattering_uvwz(&g, &s, rays.r[i], rays.mu[i], 0.0, 0.0, ground);
+                let uvwz =
+                    params::scattering_uvwz(&radii, &s, rays.r[i], rays.mu[i], 0.0, 0.0, ground);
                 let (y0, y1, ty) = lerp_weights(uvwz[2], s.scattering_mu);
                 let (z0, z1, tz) = lerp_weights(uvwz[3], s.scattering_r);
                 let (w0, w1, w2, w3) = (

@@ -14,7 +14,7 @@ use crate::sky::bruneton4d::params::ScatteringGrid;
 /// view zenith (table μ) and incident zenith: b_m with P(Δφ) = Σ b_m cos(mΔφ), times the
 /// solid angle of the incident zenith band's quadrature (dθ·sin θ_l).
 pub(super) struct PhaseKernels {
-    /// `[((z·nmu + y)·THETA + l)·2 + g]·HARMONICS + m`.
+    /// `[((z·nmu + y)·THETA + l)·2 + group]·HARMONICS + m`.
     pub b: Vec<f64>,
 }
 
@@ -44,13 +44,14 @@ impl PhaseKernels {
                     let theta = (l as f64 + 0.5) * dtheta;
                     let (sin_i, cos_i) = theta.sin_cos();
                     let solid = dtheta * theta.sin();
-                    for g in 0..2 {
-                        if groups.members[g].is_empty() {
+                    for group in 0..2 {
+                        if groups.members[group].is_empty() {
                             continue;
                         }
-                        let o = &mut out[(l * 2 + g) * HARMONICS..(l * 2 + g + 1) * HARMONICS];
+                        let o =
+                            &mut out[(l * 2 + group) * HARMONICS..(l * 2 + group + 1) * HARMONICS];
                         for (t, &cos_dphi) in cos_t.iter().enumerate() {
-                            let p = groups.phase[g]
+                            let p = groups.phase[group]
                                 .eval((mu_v * cos_i + sin_v * sin_i * cos_dphi).clamp(-1.0, 1.0));
                             let w = if t == 0 || t == KERNEL_STEPS {
                                 0.5

@@ -26,8 +26,9 @@ impl RaySamples {
     }
 
     pub fn new(lookup: &Lookup, r: f64, mu: f64, ground: bool, n: usize) -> RaySamples {
-        let g = &lookup.radii;
-        let length = distance_to_nearest_atmosphere_boundary(r, mu, g.bottom, g.top, ground);
+        let radii = &lookup.radii;
+        let length =
+            distance_to_nearest_atmosphere_boundary(r, mu, radii.bottom, radii.top, ground);
         let dx = length / RAY_INTERVALS as f64;
         let count = RAY_INTERVALS + 1;
         let mut rs = RaySamples {
@@ -40,7 +41,7 @@ impl RaySamples {
         let t = &mut rs.t;
         for i in 0..count {
             let d = i as f64 * dx;
-            let (r_d, mu_d) = crate::math::sphere::advance(r, mu, d, g.bottom, g.top);
+            let (r_d, mu_d) = crate::math::sphere::advance(r, mu, d, radii.bottom, radii.top);
             rs.d.push(d);
             rs.r.push(r_d);
             rs.mu.push(mu_d);

@@ -31,7 +31,7 @@ pub(super) fn compute_scattering_density(
     let mut out = Table4::for_sizes(&s, n);
     let slab = s.scattering_mu * out.row_len();
     let width = out.width();
-    let g = lookup.radii;
+    let radii = lookup.radii;
     let dtheta = PI / DENSITY_THETA as f64;
     let dphi = 2.0 * PI / DENSITY_PHI as f64;
     let half_phi = DENSITY_PHI / 2;
@@ -50,17 +50,17 @@ pub(super) fn compute_scattering_density(
         .enumerate()
         .for_each(|(z, slab_out)| {
             let (r, _, _, _, _) = grid.texel(0, 0, z);
-            let alt = r - g.bottom;
+            let alt = r - radii.bottom;
             let mut beta = [vec![0.0; n], vec![0.0; n]];
-            for gi in 0..2 {
-                groups.scattering_into(model, gi, alt, &mut beta[gi]);
+            for group in 0..2 {
+                groups.scattering_into(model, group, alt, &mut beta[group]);
             }
             let mut radiance = vec![0.0; n];
             let mut tmp = vec![0.0; n];
             let mut e_ground = vec![0.0; n];
             let mut t_ground = vec![0.0; n];
             // Coefficients `[l][k][m]`, harmonics innermost for the series and the
-            // convolution; convolved `[g][m][k]`, channels innermost for the evaluation.
+            // convolution; convolved `[group][m][k]`, channels innermost for the evaluation.
             let mut coeff = vec![0.0; DENSITY_THETA * n * HARMONICS];
             let mut k_acc = vec![0.0; 2 * HARMONICS * n];
             let mut j_out = [0.0f64; MAX_CHANNELS];
@@ -72,9 +72,9 @@ pub(super) fn compute_scattering_density(
                 for l in 0..DENSITY_THETA {
                     let theta = (l as f64 + 0.5) * dtheta;
                     let (sin_i, cos_i) = theta.sin_cos();
-                    let ground = ray_intersects_ground(r, cos_i, g.bottom);
+                    let ground = ray_intersects_ground(r, cos_i, radii.bottom);
                     let d_ground = if ground {
-                        distance_to_bottom_atmosphere_boundary(r, cos_i, g.bottom)
+                        distance_to_bottom_atmosphere_boundary(r, cos_i, radii.bottom)
                     } else {
                         0.0
                     };
@@ -104,7 +104,7 @@ pub(super) fn compute_scattering_density(
                             let mu_g = (p[0] * sin_s + p[2] * mu_s) / len;
                             lookup.irradiance(
                                 delta_irradiance,
-                                g.bottom,
+                                radii.bottom,
                                 mu_g.clamp(-1.0, 1.0),
                                 &mut e_ground,
                             );
@@ -127,8 +127,8 @@ pub(super) fn compute_scattering_density(
                 for y in 0..s.scattering_mu {
                     let kb =
                         &kernels.b[(z * s.scattering_mu + y) * DENSITY_THETA * 2 * HARMONICS..];
-                    for gi in 0..2 {
-                        if groups.members[gi].is_empty() {
+                    for group in 0..2 {
+                        if groups.members[group].is_empty() {
                             continue;
                         }
                         for k in 0..n {
@@ -136,14 +136,14 @@ pub(super) fn compute_scattering_density(
                             // accumulator stays in registers).
                             let mut acc = [0.0; HARMONICS];
                             for l in 0..DENSITY_THETA {
-                                let b = &kb[(l * 2 + gi) * HARMONICS..][..HARMONICS];
+                                let b = &kb[(l * 2 + group) * HARMONICS..][..HARMONICS];
                                 let c = &coeff[(l * n + k) * HARMONICS..][..HARMONICS];
                                 for ((a, b), c) in acc.iter_mut().zip(b).zip(c) {
                                     *a += b * c;
                                 }
                             }
                             for (m, a) in acc.into_iter().enumerate() {
-                                k_acc[(gi * HARMONICS + m) * n + k] = a;
+                                k_acc[(group * HARMONICS + m) * n + k] = a;
                             }
                         }
                     }
@@ -169,13 +169,13 @@ pub(super) fn compute_scattering_density(
                         }
                         let j = &mut j_out[..n];
                         j.iter_mut().for_each(|v| *v = 0.0);
-                        for gi in 0..2 {
-                            if groups.members[gi].is_empty() {
+                        for group in 0..2 {
+                            if groups.members[group].is_empty() {
                                 continue;
                             }
                             for (m, w) in harmonic.iter().enumerate() {
-                                let acc = &k_acc[(gi * HARMONICS + m) * n..][..n];
-                                for ((j, a), b) in j.iter_mut().zip(acc).zip(&beta[gi]) {
+                                let acc = &k_acc[(group * HARMONICS + m) * n..][..n];
+                                for ((j, a), b) in j.iter_mut().zip(acc).zip(&beta[group]) {
                                     *j += w * a * b;
                                 }
                             }

@@ -23,11 +23,11 @@ struct SunRow {
 
 impl SunRow {
     fn new(lookup: &Lookup, r: f64) -> SunRow {
-        let g = &lookup.radii;
+        let radii = &lookup.radii;
         let s = &lookup.sizes;
         let t = lookup.optical_depth;
-        let rho = crate::math::sphere::safe_sqrt(r * r - g.bottom * g.bottom);
-        let v = params::texcoord_from_unit(rho / g.h(), s.transmittance_r);
+        let rho = crate::math::sphere::safe_sqrt(r * r - radii.bottom * radii.bottom);
+        let v = params::texcoord_from_unit(rho / radii.h(), s.transmittance_r);
         let (y0, y1, ty) = lerp_weights(v, s.transmittance_r);
         let n = t.channels;
         let w = t.width * n;
@@ -37,9 +37,9 @@ impl SunRow {
             .zip(row1)
             .map(|(a, b)| (1.0 - ty) * *a as f64 + ty * *b as f64)
             .collect();
-        let sin_h = g.bottom / r;
+        let sin_h = radii.bottom / r;
         SunRow {
-            h: g.h(),
+            h: radii.h(),
             r,
             rho,
             cos_h: -crate::math::sphere::safe_sqrt(1.0 - sin_h * sin_h),
@@ -55,9 +55,9 @@ impl SunRow {
         if fraction <= 0.0 {
             return None;
         }
-        let g = &lookup.radii;
-        let d = crate::math::sphere::distance_to_top_atmosphere_boundary(self.r, mu_s, g.top);
-        let d_min = g.top - self.r;
+        let radii = &lookup.radii;
+        let d = crate::math::sphere::distance_to_top_atmosphere_boundary(self.r, mu_s, radii.top);
+        let d_min = radii.top - self.r;
         let d_max = self.rho + self.h;
         let x_mu = if d_max > d_min {
             (d - d_min) / (d_max - d_min)
@@ -112,8 +112,8 @@ pub(super) fn compute_single_scattering(
             let mut beta = [vec![0.0; count * n], vec![0.0; count * n]];
             for i in 0..count {
                 let alt = rays.r[i] - lookup.radii.bottom;
-                for g in 0..2 {
-                    groups.scattering_into(model, g, alt, &mut beta[g][i * n..(i + 1) * n]);
+                for group in 0..2 {
+                    groups.scattering_into(model, group, alt, &mut beta[group][i * n..(i + 1) * n]);
                 }
             }
             // Weights fitted to each group's own β·T.
