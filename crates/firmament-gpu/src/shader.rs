@@ -27,6 +27,14 @@ pub struct Module {
     pub source: &'static str,
 }
 
+impl Module {
+    /// The file's name without its folder and extension (the pipeline's label).
+    pub fn name(&self) -> &'static str {
+        let file = self.path.rsplit('/').next().unwrap_or(self.path);
+        file.strip_suffix(".wgsl").unwrap_or(file)
+    }
+}
+
 macro_rules! module {
     ($path:literal) => {
         Module {

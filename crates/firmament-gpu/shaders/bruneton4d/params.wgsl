@@ -153,6 +153,12 @@ fn scattering_texel(x: u32, y: u32, z: u32) -> ScatteringTexel {
     return t;
 }
 
+// The texel of flat scattering-table index i (x fastest, then y, then z).
+fn scattering_texel_at(i: u32) -> ScatteringTexel {
+    let width = scattering_width();
+    return scattering_texel(i % width, (i / width) % atm.scattering_mu, i / (width * atm.scattering_mu));
+}
+
 fn scattering_width() -> u32 {
     return atm.scattering_nu * atm.scattering_mu_s;
 }

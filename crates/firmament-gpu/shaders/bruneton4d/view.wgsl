@@ -146,6 +146,16 @@ fn start_u_mu(s: ViewStart, ground: bool) -> f32 {
     return 0.5 - 0.5 * texcoord_from_unit(x, atm.scattering_mu / 2u);
 }
 
+// The scattering-table coordinates at d_km along the ray from the start (the law of
+// cosines for r, μ and μ_s there: geometry::advance, Bruneton4dView::combined_scattering).
+fn uvwz_along(s: ViewStart, nu: f32, d_km: f32, ground: bool) -> vec4<f32> {
+    let rho_d_km = rho_at(s.r_km, s.rho_km, s.mu, d_km);
+    let r_d_km = radius_from_rho(rho_d_km);
+    let mu_d = clamp_cosine((s.r_km * s.mu + d_km) / r_d_km);
+    let mu_s_d = clamp_cosine((s.r_km * s.mu_s + d_km * nu) / r_d_km);
+    return scattering_uvwz(r_d_km, rho_d_km, mu_d, mu_s_d, nu, ground);
+}
+
 // ---------------------------------------------------------------------------------------
 // Table lookups with their filters computed once per ray and applied per channel group.
 
@@ -369,14 +379,9 @@ fn sky_ray(v: View, o: Observer, light: ViewLight, dir: vec3<f32>, shadow_length
     ray.t_top = transmittance_filter(s.r_km, s.rho_km, s.mu);
     ray.shadowed = shadow_length_km > 0.0;
     if (ray.shadowed) {
-        // The scattering beyond the shadow (geometry::advance), attenuated by T(0, l).
-        let l_km = shadow_length_km;
-        let rho_p_km = rho_at(s.r_km, s.rho_km, s.mu, l_km);
-        let r_p_km = radius_from_rho(rho_p_km);
-        let mu_p = clamp_cosine((s.r_km * s.mu + l_km) / r_p_km);
-        let mu_s_p = clamp_cosine((s.r_km * s.mu_s + l_km * nu) / r_p_km);
-        ray.at = at_table(scattering_uvwz(r_p_km, rho_p_km, mu_p, mu_s_p, nu, ray.ground));
-        ray.t_shadow = transmittance_filters(s.r_km, s.rho_km, s.mu, l_km, ray.ground);
+        // The scattering beyond the shadow, attenuated by T(0, l).
+        ray.at = at_table(uvwz_along(s, nu, shadow_length_km, ray.ground));
+        ray.t_shadow = transmittance_filters(s.r_km, s.rho_km, s.mu, shadow_length_km, ray.ground);
     } else {
         ray.at = at_start(s, light, nu, ray.ground);
     }
@@ -455,11 +460,7 @@ fn ground_ray(v: View, o: Observer, light: ViewLight, dir: vec3<f32>, shadow_len
     if (shadow_length_km > 0.0) {
         // The lit part ends `shadow_length_km` before the point.
         let e_km = max(d_km - shadow_length_km, 0.0);
-        let rho_e_km = rho_at(s.r_km, s.rho_km, s.mu, e_km);
-        let r_e_km = radius_from_rho(rho_e_km);
-        let mu_e = clamp_cosine((s.r_km * s.mu + e_km) / r_e_km);
-        let mu_s_e = clamp_cosine((s.r_km * s.mu_s + e_km * nu) / r_e_km);
-        ray.at_end = at_red(v, at_table(scattering_uvwz(r_e_km, rho_e_km, mu_e, mu_s_e, nu, true)), p_r);
+        ray.at_end = at_red(v, at_table(uvwz_along(s, nu, e_km, true)), p_r);
         ray.t_end = transmittance_filters(s.r_km, s.rho_km, s.mu, e_km, true);
     } else {
         ray.at_end = at_red(v, at_table(scattering_uvwz(atm.bottom_radius_km, 0.0, mu_p, ray.mu_s_ground, nu, true)), p_r);

@@ -18,8 +18,8 @@ use firmament::sky::bruneton4d::{MieStorage, Table2, Table4, TableConfig, Tables
 
 use super::atmosphere::{self, groups, GROUP};
 use crate::device::{check_buffers, f32s, read_back, scoped, staging_buffer};
-use crate::passes::{self, dispatch, init, storage, Pass, Slot};
-use crate::shader::{self, precompute_source};
+use crate::passes::{self as dispatches, dispatch, init, storage, Pass, Slot};
+use crate::shader::{passes, precompute_source, Module};
 use crate::{GpuContext, GpuError};
 
 /// Storage buffers bound at once by the widest pass (the density field).
@@ -73,71 +73,40 @@ impl Precomputer {
         use Slot::{Read, Write};
         let d = ctx.device();
         scoped(ctx, "shader compilation", || {
+            let pass = |module: Module, slots: &[(u32, Slot)]| {
+                Pass::new(d, module.name(), precompute_source(module), slots)
+            };
             Ok(Precomputer {
-                transmittance: Pass::new(
-                    d,
-                    "transmittance",
-                    precompute_source(shader::passes::TRANSMITTANCE),
-                    &[(7, Write)],
-                ),
-                direct_irradiance: Pass::new(
-                    d,
-                    "direct_irradiance",
-                    precompute_source(shader::passes::DIRECT_IRRADIANCE),
+                transmittance: pass(passes::TRANSMITTANCE, &[(7, Write)]),
+                direct_irradiance: pass(
+                    passes::DIRECT_IRRADIANCE,
                     &[(3, Read), (7, Write), (8, Write)],
                 ),
-                single_scattering: Pass::new(
-                    d,
-                    "single_scattering",
-                    precompute_source(shader::passes::SINGLE_SCATTERING),
+                single_scattering: pass(
+                    passes::SINGLE_SCATTERING,
                     &[(3, Read), (7, Write), (8, Write)],
                 ),
-                phase_kernels: Pass::new(
-                    d,
-                    "phase_kernels",
-                    precompute_source(shader::passes::PHASE_KERNELS),
-                    &[(7, Write)],
-                ),
-                density_field: Pass::new(
-                    d,
-                    "scattering_density_field",
-                    precompute_source(shader::passes::SCATTERING_DENSITY_FIELD),
+                phase_kernels: pass(passes::PHASE_KERNELS, &[(7, Write)]),
+                density_field: pass(
+                    passes::SCATTERING_DENSITY_FIELD,
                     &[(3, Read), (4, Read), (5, Read), (6, Read), (7, Write)],
                 ),
-                scattering_density: Pass::new(
-                    d,
-                    "scattering_density",
-                    precompute_source(shader::passes::SCATTERING_DENSITY),
+                scattering_density: pass(
+                    passes::SCATTERING_DENSITY,
                     &[(7, Read), (8, Read), (9, Write)],
                 ),
-                indirect_irradiance: Pass::new(
-                    d,
-                    "indirect_irradiance",
-                    precompute_source(shader::passes::INDIRECT_IRRADIANCE),
+                indirect_irradiance: pass(
+                    passes::INDIRECT_IRRADIANCE,
                     &[(5, Read), (6, Read), (7, Write), (8, Write)],
                 ),
-                multiple_scattering: Pass::new(
-                    d,
-                    "multiple_scattering",
-                    precompute_source(shader::passes::MULTIPLE_SCATTERING),
+                multiple_scattering: pass(
+                    passes::MULTIPLE_SCATTERING,
                     &[(3, Read), (5, Read), (7, Write), (8, Write)],
                 ),
-                order_sums: Pass::new(
-                    d,
-                    "order_sums",
-                    precompute_source(shader::passes::ORDER_SUMS),
-                    &[(5, Read), (6, Read), (7, Write)],
-                ),
-                order_tail_factors: Pass::new(
-                    d,
-                    "order_tail_factors",
-                    precompute_source(shader::passes::ORDER_TAIL_FACTORS),
-                    &[(5, Read), (7, Write)],
-                ),
-                order_tail: Pass::new(
-                    d,
-                    "order_tail",
-                    precompute_source(shader::passes::ORDER_TAIL),
+                order_sums: pass(passes::ORDER_SUMS, &[(5, Read), (6, Read), (7, Write)]),
+                order_tail_factors: pass(passes::ORDER_TAIL_FACTORS, &[(5, Read), (7, Write)]),
+                order_tail: pass(
+                    passes::ORDER_TAIL,
                     &[(4, Read), (5, Read), (6, Read), (7, Write), (8, Write)],
                 ),
             })
@@ -435,12 +404,12 @@ impl Precomputer {
         let limits = ctx.limits();
         let adapter = ctx.adapter_name().to_string();
         let max_dim = limits.max_compute_workgroups_per_dimension;
-        let (_, y) = passes::workgroups(largest_dispatch, max_dim);
+        let (_, y) = dispatches::workgroups(largest_dispatch, max_dim);
         if y > max_dim {
             return Err(GpuError::Limit {
                 what: "the scattering table".into(),
                 needed: format!("{largest_dispatch} invocations"),
-                limit: format!("{max_dim}² workgroups of {}", passes::WORKGROUP),
+                limit: format!("{max_dim}² workgroups of {}", dispatches::WORKGROUP),
                 limit_name: "max_compute_workgroups_per_dimension",
                 adapter,
             });

@@ -56,6 +56,14 @@ const DOMAIN_RADIANCE: u64 = 0;
 const DOMAIN_IRRADIANCE: u64 = 0x1_0000_0000;
 const DOMAIN_BUDGET: u64 = 0x2_0000_0000;
 
+/// The means and standard errors per wavelength of a one-tally estimate.
+fn means(stats: &[[Stats; 1]]) -> (Vec<f64>, Vec<f64>) {
+    (
+        stats.iter().map(|s| s[0].mean).collect(),
+        stats.iter().map(|s| s[0].stderr()).collect(),
+    )
+}
+
 /// Where a ray starts inside the atmosphere: the camera itself, or where the ray enters
 /// the atmosphere from space; None if it misses.
 fn ray_start(model: &Model, camera: Vec3, view: Vec3) -> Option<Vec3> {
@@ -119,9 +127,10 @@ fn radiance_pixel(
             )]
         },
     );
+    let (radiance, stderr) = means(&stats);
     RadianceEstimate {
-        radiance: stats.iter().map(|s| s[0].mean).collect(),
-        stderr: stats.iter().map(|s| s[0].stderr()).collect(),
+        radiance,
+        stderr,
         samples: settings.samples,
     }
 }
@@ -228,9 +237,10 @@ pub fn irradiance(
                 )]
             },
         );
+    let (irradiance, stderr) = means(&stats);
     IrradianceEstimate {
-        irradiance: stats.iter().map(|s| s[0].mean).collect(),
-        stderr: stats.iter().map(|s| s[0].stderr()).collect(),
+        irradiance,
+        stderr,
         samples: settings.samples,
     }
 }

@@ -101,19 +101,6 @@ impl Camera {
         Ok(())
     }
 
-    /// Rays for pixel centres of a `width`×`height` image (row 0 at the top); None for
-    /// pixels outside the projection (the corners of a fisheye).
-    pub fn ray(
-        &self,
-        bottom_radius_m: f64,
-        width: usize,
-        height: usize,
-        px: f64,
-        py: f64,
-    ) -> Option<Ray> {
-        self.prepare(bottom_radius_m, width, height).ray(px, py)
-    }
-
     /// Per-frame constants for [`PreparedCamera::ray`].
     pub fn prepare(&self, bottom_radius_m: f64, width: usize, height: usize) -> PreparedCamera {
         let (forward, right, up) = match self.projection {

@@ -42,18 +42,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         return;
     }
     let k = gid.z;
-    let width = scattering_width();
-    let x = i % width;
-    let y = (i / width) % atm.scattering_mu;
-    let z = i / (width * atm.scattering_mu);
-    let t = scattering_texel(x, y, z);
-    var ray_length_km: f32;
-    if (t.ground) {
-        ray_length_km = distance_to_bottom(t.r_km, t.rho_km, t.mu);
-    } else {
-        ray_length_km = distance_to_top(t.r_km, t.rho_km, t.mu);
-    }
-    let dx_km = ray_length_km / f32(RAY_INTERVALS);
+    let t = scattering_texel_at(i);
+    let dx_km = ray_step_km(t);
     var acc = vec4<f32>(0.0);
     // Samples 2p, 2p + 1, 2p + 2 of pair p; the last is the next pair's first.
     var s0 = multiple_sample(t, 0.0, k);

@@ -97,3 +97,15 @@ fn exponential_simpson_weights(t0: vec4<f32>, t1: vec4<f32>, t2: vec4<f32>, f0: 
     w.w2 = select(zero, exp(select(zero, l2 + 2.0 * a, p2)) * m.m2, p0 & p2);
     return w;
 }
+
+// The step between the RAY_INTERVALS + 1 samples of a texel's view ray, to the ground or the
+// top (RaySamples::new).
+fn ray_step_km(t: ScatteringTexel) -> f32 {
+    var length_km: f32;
+    if (t.ground) {
+        length_km = distance_to_bottom(t.r_km, t.rho_km, t.mu);
+    } else {
+        length_km = distance_to_top(t.r_km, t.rho_km, t.mu);
+    }
+    return length_km / f32(RAY_INTERVALS);
+}

@@ -248,14 +248,7 @@ impl Channel<'_> {
                 w *= albedo;
                 events += 1;
                 scattered = true;
-                if w <= 0.0 {
-                    break;
-                }
-                if events >= self.max_bounces {
-                    tally[T_TRUNCATED] += w;
-                    break;
-                }
-                if !self.roulette(events, &mut w, rng) {
+                if !self.photon_goes_on(events, &mut w, &mut tally, rng) {
                     break;
                 }
                 d = self.scatter(d, scratch, ss, rng);
@@ -274,19 +267,31 @@ impl Channel<'_> {
                 w *= self.ground_albedo;
                 events += 1;
                 scattered = true;
-                if w <= 0.0 {
-                    break;
-                }
-                if events >= self.max_bounces {
-                    tally[T_TRUNCATED] += w;
-                    break;
-                }
-                if !self.roulette(events, &mut w, rng) {
+                if !self.photon_goes_on(events, &mut w, &mut tally, rng) {
                     break;
                 }
                 d = cosine_direction(frame.up(o), rng);
             }
         }
         tally
+    }
+
+    /// After an event of a photon of weight `w`: false when it ends (absorbed, cut at
+    /// `max_bounces` with its weight tallied as truncated, or stopped by Russian roulette).
+    fn photon_goes_on(
+        &self,
+        events: usize,
+        w: &mut f64,
+        tally: &mut [f64; BUDGET_TALLIES],
+        rng: &mut Rng,
+    ) -> bool {
+        if *w <= 0.0 {
+            return false;
+        }
+        if events >= self.max_bounces {
+            tally[T_TRUNCATED] += *w;
+            return false;
+        }
+        self.roulette(events, w, rng)
     }
 }

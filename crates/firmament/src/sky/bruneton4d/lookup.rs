@@ -1,9 +1,9 @@
 //! Lookups shared by the precomputation passes and the evaluation API: transmittance
 //! between points and to the sun from the transmittance table (Bruneton 2017
-//! `GetTransmittance`, `GetTransmittanceToSun`), irradiance and scattering lookups.
+//! `GetTransmittance`, `GetTransmittanceToSun`) and irradiance lookups.
 
 use super::params::{self, Radii, TableSizes};
-use super::table::{Table2, Table4, MAX_OPTICAL_DEPTH};
+use super::table::{Table2, MAX_OPTICAL_DEPTH};
 use crate::atmosphere::Model;
 use crate::math::smoothstep;
 use crate::math::sphere::{distance_to_top_atmosphere_boundary, safe_sqrt};
@@ -125,22 +125,6 @@ impl<'a> Lookup<'a> {
             self.sizes.irradiance_r,
         );
         table.sample_into(u, v, out);
-    }
-
-    /// Scattering-table lookup at (r, μ, μ_s, ν).
-    #[inline]
-    pub fn scattering(
-        &self,
-        table: &Table4,
-        r: f64,
-        mu: f64,
-        mu_s: f64,
-        nu: f64,
-        ground: bool,
-        out: &mut [f64],
-    ) {
-        let uvwz = params::scattering_uvwz(&self.radii, &self.sizes, r, mu, mu_s, nu, ground);
-        table.sample_into(uvwz, out);
     }
 
     /// Distance to the top along (r, μ).

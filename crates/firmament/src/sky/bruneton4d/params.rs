@@ -189,6 +189,19 @@ pub fn irradiance_r_mu_s(radii: &Radii, u: f64, v: f64, nmu_s: usize, nr: usize)
     )
 }
 
+/// (r, μ_s) at the centre of irradiance texel (x, y) of tables of `sizes`.
+#[inline]
+pub fn irradiance_texel(radii: &Radii, sizes: &TableSizes, x: usize, y: usize) -> (f64, f64) {
+    let (nmu_s, nr) = (sizes.irradiance_mu_s, sizes.irradiance_r);
+    irradiance_r_mu_s(
+        radii,
+        (x as f64 + 0.5) / nmu_s as f64,
+        (y as f64 + 0.5) / nr as f64,
+        nmu_s,
+        nr,
+    )
+}
+
 /// The four coordinates (u_ν, u_μs, u_μ, u_r) ∈ [0,1]⁴ of the scattering table.
 #[inline]
 pub fn scattering_uvwz(

@@ -16,13 +16,7 @@ pub(super) fn compute_direct_irradiance(model: &Model, lookup: &Lookup) -> Table
     let mut tr = vec![0.0; n];
     for y in 0..s.irradiance_r {
         for x in 0..s.irradiance_mu_s {
-            let (r, mu_s) = params::irradiance_r_mu_s(
-                &lookup.radii,
-                (x as f64 + 0.5) / s.irradiance_mu_s as f64,
-                (y as f64 + 0.5) / s.irradiance_r as f64,
-                s.irradiance_mu_s,
-                s.irradiance_r,
-            );
+            let (r, mu_s) = params::irradiance_texel(&lookup.radii, s, x, y);
             let cos_factor = if mu_s < -alpha_s {
                 0.0
             } else if mu_s > alpha_s {

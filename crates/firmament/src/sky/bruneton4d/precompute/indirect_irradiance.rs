@@ -25,13 +25,7 @@ pub(super) fn compute_indirect_irradiance(
     let dphi = 2.0 * PI / IRRADIANCE_PHI as f64;
     e.data.par_chunks_mut(n).enumerate().for_each(|(i, out)| {
         let (x, y) = (i % s.irradiance_mu_s, i / s.irradiance_mu_s);
-        let (r, mu_s) = params::irradiance_r_mu_s(
-            &lookup.radii,
-            (x as f64 + 0.5) / s.irradiance_mu_s as f64,
-            (y as f64 + 0.5) / s.irradiance_r as f64,
-            s.irradiance_mu_s,
-            s.irradiance_r,
-        );
+        let (r, mu_s) = params::irradiance_texel(&lookup.radii, &s, x, y);
         let sin_s = (1.0 - mu_s * mu_s).max(0.0).sqrt();
         let mut radiance = vec![0.0; n];
         let mut tmp = vec![0.0; n];
