@@ -10,7 +10,7 @@ use firmament::math::Vec3;
 use firmament::render::{self, RenderSettings, ShadeScratch, Shader};
 use firmament::scene::{sun_direction, Camera, Light, Projection, Ray, Scene, Sphere, Surface};
 use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, TableSizes};
-use firmament::sky::{Shadow, SkyMethod, SkyView};
+use firmament::sky::{Shadow, SkyMethod};
 use firmament::spectrum::Wavelengths;
 
 fn earth(orders: usize) -> Bruneton4d {
