@@ -23,7 +23,7 @@ use crate::io::ImageRgbF32;
 use crate::scene::surface::lit_intervals;
 use crate::scene::{Camera, Projection, Ray, Scene};
 use crate::sky::{Shadow, SkyView};
-use crate::spectrum::{ColourMatrix, MAX_CHANNELS};
+use crate::spectrum::{with_channel_buffers, ColourMatrix, MAX_CHANNELS};
 use crate::{Error, Result};
 
 /// What to render: the camera and the image.
@@ -67,6 +67,8 @@ impl RenderSettings<'_> {
 pub struct Shader<'s> {
     scene: &'s Scene<'s>,
     views: Vec<Box<dyn SkyView + 's>>,
+    /// The lights whose disks images show, with the cosine of their angular radius.
+    disks: Vec<(usize, f64)>,
     channels: usize,
 }
 
@@ -87,9 +89,14 @@ impl<'s> Shader<'s> {
             .iter()
             .map(|light| scene.sky.view(observer, light))
             .collect();
+        let disks = (scene.lights.iter().enumerate())
+            .filter(|(_, light)| light.visible_disk)
+            .map(|(i, light)| (i, light.angular_radius_rad.cos()))
+            .collect();
         Ok(Shader {
             scene,
             views,
+            disks,
             channels,
         })
     }
@@ -102,14 +109,10 @@ impl<'s> Shader<'s> {
         let n = self.channels;
         let scene = self.scene;
         out[..n].iter_mut().for_each(|v| *v = 0.0);
-        let mut buf = [[0.0f64; MAX_CHANNELS]; 5];
-        let [l, t, albedo, direct, sky] = &mut buf;
-        let (l, t) = (&mut l[..n], &mut t[..n]);
         let hit = scene.nearest_hit(ray, f64::INFINITY);
         let end = hit.map_or(f64::INFINITY, |(_, h)| h.distance_m);
         match hit {
-            Some((i, hit)) => {
-                let (albedo, direct, sky) = (&mut albedo[..n], &mut direct[..n], &mut sky[..n]);
+            Some((i, hit)) => with_channel_buffers(n, |[l, t, albedo, direct, sky]| {
                 scene.surfaces[i].albedo(&hit, albedo);
                 for view in &self.views {
                     let (shadow, lit_at_end) = self.shadow(ray, view.light(), end, scratch);
@@ -123,12 +126,10 @@ impl<'s> Shader<'s> {
                         out[k] += albedo[k] / PI * (direct[k] + sky[k]) * t[k];
                     }
                 }
-            }
-            None => {
-                let disks = scene
-                    .lights
-                    .iter()
-                    .any(|light| light.visible_disk && light.in_disk(ray.dir));
+            }),
+            None => with_channel_buffers(n, |[l, t]| {
+                let disks = (self.disks.iter())
+                    .any(|&(i, cos)| ray.dir.dot(scene.lights[i].direction) > cos);
                 for (j, view) in self.views.iter().enumerate() {
                     let (shadow, _) = self.shadow(ray, view.light(), end, scratch);
                     // The transmittance along the ray (the same for every light) only for a
@@ -144,11 +145,11 @@ impl<'s> Shader<'s> {
                     }
                 }
                 if disks {
-                    for light in scene.lights.iter().filter(|light| light.visible_disk) {
-                        light.add_disk_radiance(ray.dir, t, &mut out[..n]);
+                    for &(i, _) in &self.disks {
+                        scene.lights[i].add_disk_radiance(ray.dir, t, &mut out[..n]);
                     }
                 }
-            }
+            }),
         }
         if !scene.volumes.is_empty() {
             volumes::composite(scene, &self.views, ray, end, &mut out[..n]);

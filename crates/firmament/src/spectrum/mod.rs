@@ -36,6 +36,29 @@ pub fn check_channels(channels: usize, what: &str) -> Result<()> {
     Ok(())
 }
 
+/// Runs `f` with `K` zeroed per-channel scratch buffers of length `n` (≤ [`MAX_CHANNELS`])
+/// on the stack, each the smallest of 4, 16 or `MAX_CHANNELS` values that holds `n`: the
+/// evaluators call this per pixel, where zeroing 64-value arrays for three channels cost a
+/// fifth of a sky pixel.
+#[inline]
+pub fn with_channel_buffers<const K: usize, R>(
+    n: usize,
+    f: impl FnOnce([&mut [f64]; K]) -> R,
+) -> R {
+    #[inline(always)]
+    fn run<const C: usize, const K: usize, R>(n: usize, f: impl FnOnce([&mut [f64]; K]) -> R) -> R {
+        let mut buffers = [[0.0f64; C]; K];
+        f(buffers.each_mut().map(|b| &mut b[..n]))
+    }
+    if n <= 4 {
+        run::<4, K, R>(n, f)
+    } else if n <= 16 {
+        run::<16, K, R>(n, f)
+    } else {
+        run::<MAX_CHANNELS, K, R>(n, f)
+    }
+}
+
 /// Maximum luminous efficacy of radiation for photopic vision, lm/W (SI definition of the
 /// candela: 683 lm/W at 540 THz ≈ 555 nm; CIE 015:2018).
 pub const LUMINOUS_EFFICACY_LM_W: f64 = 683.0;

@@ -7,7 +7,7 @@ use super::table::{Table2, MAX_OPTICAL_DEPTH};
 use crate::atmosphere::Model;
 use crate::math::smoothstep;
 use crate::math::sphere::{distance_to_top_atmosphere_boundary, safe_sqrt};
-use crate::spectrum::MAX_CHANNELS;
+use crate::spectrum::with_channel_buffers;
 
 /// What a lookup needs: the model's radii, the sizes and the transmittance table (as
 /// optical depth: lookups interpolate τ = −ln T bilinearly, then take e^{−τ}).
@@ -71,24 +71,23 @@ impl<'a> Lookup<'a> {
         let radii = &self.radii;
         let r_d = safe_sqrt(d * d + 2.0 * r * mu * d + r * r).clamp(radii.bottom, radii.top);
         let mu_d = ((r * mu + d) / r_d).clamp(-1.0, 1.0);
-        let n = out.len();
-        let mut a = [0.0f64; MAX_CHANNELS];
-        let mut b = [0.0f64; MAX_CHANNELS];
-        let (a, b) = (&mut a[..n], &mut b[..n]);
-        if ground {
-            self.optical_depth_to_top(r_d, -mu_d, a);
-            self.optical_depth_to_top(r, -mu, b);
-        } else {
-            self.optical_depth_to_top(r, mu, a);
-            self.optical_depth_to_top(r_d, mu_d, b);
-        }
-        for k in 0..n {
-            out[k] = if b[k] < MAX_OPTICAL_DEPTH as f64 {
-                (-(a[k] - b[k]).max(0.0)).exp()
+        // T = e^{−(τ_a − τ_b)}: τ_a into `out`, τ_b into `b`.
+        with_channel_buffers(out.len(), |[b]| {
+            if ground {
+                self.optical_depth_to_top(r_d, -mu_d, out);
+                self.optical_depth_to_top(r, -mu, b);
             } else {
-                0.0
-            };
-        }
+                self.optical_depth_to_top(r, mu, out);
+                self.optical_depth_to_top(r_d, mu_d, b);
+            }
+            for (o, &b) in out.iter_mut().zip(b.iter()) {
+                *o = if b < MAX_OPTICAL_DEPTH as f64 {
+                    (-(*o - b).max(0.0)).exp()
+                } else {
+                    0.0
+                };
+            }
+        });
     }
 
     /// Transmittance to the sun times the visible fraction of the solar disk above the

@@ -16,7 +16,7 @@ use crate::math::sphere::{advance, ray_intersects_ground};
 use crate::math::{smoothstep, Vec3};
 use crate::scene::light::Light;
 use crate::sky::{Shadow, SkyView};
-use crate::spectrum::MAX_CHANNELS;
+use crate::spectrum::with_channel_buffers;
 
 /// [`Bruneton4d`] prepared for views from one observer under one light.
 pub struct Bruneton4dView<'a> {
@@ -144,12 +144,14 @@ impl<'a> Bruneton4dView<'a> {
     /// Rayleigh + multiple scattering (divided by the molecular phase function) and single
     /// Mie scattering, without phase functions, at distance `d` (m) along the ray (Bruneton
     /// 2017 `GetCombinedScattering`; the ratio rule for red-only Mie). `at_start` (d = 0):
-    /// the ray's start, from the slice when the ray starts at the observer.
+    /// the ray's start, from the slice when the ray starts at the observer. `rayleigh_phase`:
+    /// the molecular phase function at the ray's ν.
     fn combined_scattering(
         &self,
         ray: &RayGeometry,
         d: f64,
         at_start: bool,
+        rayleigh_phase: f64,
         scat: &mut [f64],
         mie: &mut [f64],
     ) {
@@ -168,36 +170,39 @@ impl<'a> Bruneton4dView<'a> {
                 ((ray.r * ray.mu_s + d * ray.nu) / r_d).clamp(-1.0, 1.0),
             )
         };
-        let mut both = [0.0f64; 2 * MAX_CHANNELS];
-        let at = match self.slice.as_ref().filter(|_| at_start && ray.at_observer) {
-            Some(s) => {
-                // The slice already filtered (μ_s, r): only u_ν and u_μ are needed.
-                let u_nu = params::u_nu(mu, mu_s, ray.nu);
-                let u_mu = params::scattering_u_mu(&lk.radii, &lk.sizes, r, mu, ray.ground);
-                tables.single_rayleigh.sample_slice_channels_into(
-                    &s.scattering,
-                    2 * n,
-                    u_nu,
-                    u_mu,
-                    &mut both[..2 * n],
-                );
-                scat.copy_from_slice(&both[..n]);
-                At::Slice(s, u_nu, u_mu)
+        let at = with_channel_buffers(2 * n, |[both]| {
+            let at = match self.slice.as_ref().filter(|_| at_start && ray.at_observer) {
+                Some(s) => {
+                    // The slice already filtered (μ_s, r): only u_ν and u_μ are needed.
+                    let u_nu = params::u_nu(mu, mu_s, ray.nu);
+                    let u_mu = params::scattering_u_mu(&lk.radii, &lk.sizes, r, mu, ray.ground);
+                    tables.single_rayleigh.sample_slice_channels_into(
+                        &s.scattering,
+                        2 * n,
+                        u_nu,
+                        u_mu,
+                        both,
+                    );
+                    scat.copy_from_slice(&both[..n]);
+                    At::Slice(s, u_nu, u_mu)
+                }
+                None => {
+                    let uvwz = params::scattering_uvwz(
+                        &lk.radii, &lk.sizes, r, mu, mu_s, ray.nu, ray.ground,
+                    );
+                    tables.single_rayleigh.sample_into(uvwz, scat);
+                    tables.multiple.sample_into(uvwz, &mut both[n..2 * n]);
+                    At::Table(uvwz)
+                }
+            };
+            // Multiple scattering is stored as radiance; callers apply the molecular phase
+            // function to `scat`, so it goes in divided by it.
+            let p = rayleigh_phase.max(1e-30);
+            for k in 0..n {
+                scat[k] += both[n + k] / p;
             }
-            None => {
-                let uvwz =
-                    params::scattering_uvwz(&lk.radii, &lk.sizes, r, mu, mu_s, ray.nu, ray.ground);
-                tables.single_rayleigh.sample_into(uvwz, scat);
-                tables.multiple.sample_into(uvwz, &mut both[n..2 * n]);
-                At::Table(uvwz)
-            }
-        };
-        // Multiple scattering is stored as radiance; callers apply the molecular phase
-        // function to `scat`, so it goes in divided by it.
-        let p = sky.model.groups.phase[MOLECULES].eval(ray.nu).max(1e-30);
-        for k in 0..n {
-            scat[k] += both[n + k] / p;
-        }
+            at
+        });
         let single_mie = &tables.single_mie;
         let sample = |out: &mut [f64]| match at {
             At::Slice(s, u_nu, u_mu) => single_mie.sample_slice_into(&s.mie, u_nu, u_mu, out),
@@ -219,58 +224,60 @@ impl<'a> Bruneton4dView<'a> {
         }
     }
 
-    /// Σ over the lit intervals [a, b] of T(0, a)·S(a) − T(0, b)·S(b), with phase functions,
+    /// Σ over the lit intervals [a, b] (m from the ray's start) of T(0, a)·S(a) − T(0, b)·S(b),
+    /// with phase functions,
     /// into `radiance` (scaled to the light). `end` is the ray's length; an interval that
     /// reaches it subtracts nothing when `open_end` (a ray to the sky: nothing is scattered
-    /// beyond the boundary). Single Mie is multiplied by `mie_fade`.
+    /// beyond the boundary). `t_end`: T(0, end) when the caller has it (else empty), saving
+    /// a lookup for the interval that ends there. Single Mie is multiplied by `mie_fade`.
+    #[allow(clippy::too_many_arguments)]
     fn lit_radiance(
         &self,
         ray: &RayGeometry,
-        intervals: &[(f64, f64)],
+        intervals: impl IntoIterator<Item = (f64, f64)>,
         end: f64,
         open_end: bool,
+        t_end: &[f64],
         mie_fade: f64,
         radiance: &mut [f64],
     ) {
         let n = self.channels();
         let lk = &self.lookup;
-        let mut buf = [[0.0f64; MAX_CHANNELS]; 5];
-        let [scat, mie, scat_b, mie_b, t] = &mut buf;
-        let (scat, mie, scat_b, mie_b, t) = (
-            &mut scat[..n],
-            &mut mie[..n],
-            &mut scat_b[..n],
-            &mut mie_b[..n],
-            &mut t[..n],
-        );
         let phase = &self.sky.model.groups.phase;
         let (pr, pm) = (phase[MOLECULES].eval(ray.nu), phase[AEROSOLS].eval(ray.nu));
         radiance[..n].iter_mut().for_each(|v| *v = 0.0);
-        for &(a, b) in intervals {
-            let (a, b) = (a.max(0.0), b.min(end));
-            if b <= a {
-                continue;
-            }
-            self.combined_scattering(ray, a, a == 0.0, scat, mie);
-            if a > 0.0 {
-                lk.transmittance(ray.r, ray.mu, a, ray.ground, t);
+        with_channel_buffers(n, |[scat, mie, scat_b, mie_b, t]| {
+            for (a, b) in intervals {
+                let (a, b) = (a.max(0.0), b.min(end));
+                if b <= a {
+                    continue;
+                }
+                self.combined_scattering(ray, a, a == 0.0, pr, scat, mie);
+                if a > 0.0 {
+                    lk.transmittance(ray.r, ray.mu, a, ray.ground, t);
+                    for k in 0..n {
+                        scat[k] *= t[k];
+                        mie[k] *= t[k];
+                    }
+                }
+                if b < end || !open_end {
+                    self.combined_scattering(ray, b, false, pr, scat_b, mie_b);
+                    let t: &[f64] = if b == end && !t_end.is_empty() {
+                        t_end
+                    } else {
+                        lk.transmittance(ray.r, ray.mu, b, ray.ground, t);
+                        t
+                    };
+                    for k in 0..n {
+                        scat[k] = (scat[k] - t[k] * scat_b[k]).max(0.0);
+                        mie[k] = (mie[k] - t[k] * mie_b[k]).max(0.0);
+                    }
+                }
                 for k in 0..n {
-                    scat[k] *= t[k];
-                    mie[k] *= t[k];
+                    radiance[k] += scat[k] * pr + mie[k] * mie_fade * pm;
                 }
             }
-            if b < end || !open_end {
-                self.combined_scattering(ray, b, false, scat_b, mie_b);
-                lk.transmittance(ray.r, ray.mu, b, ray.ground, t);
-                for k in 0..n {
-                    scat[k] = (scat[k] - t[k] * scat_b[k]).max(0.0);
-                    mie[k] = (mie[k] - t[k] * mie_b[k]).max(0.0);
-                }
-            }
-            for k in 0..n {
-                radiance[k] += scat[k] * pr + mie[k] * mie_fade * pm;
-            }
-        }
+        });
         for (v, s) in radiance[..n].iter_mut().zip(&self.scale) {
             *v *= s;
         }
@@ -320,23 +327,19 @@ impl SkyView for Bruneton4dView<'_> {
             self.lookup
                 .transmittance_to_top(ray.r, ray.mu, transmittance);
         }
-        // The start's offset: a camera in space starts where the ray enters the top.
-        let offset = (start.point - self.observer).length();
         let end = f64::INFINITY;
         match shadow {
-            Shadow::None => self.lit_radiance(&ray, &[(0.0, end)], end, true, 1.0, radiance),
-            Shadow::Length(l) if l <= 0.0 => {
-                self.lit_radiance(&ray, &[(0.0, end)], end, true, 1.0, radiance)
+            Shadow::Length(l) if l > 0.0 => {
+                self.lit_radiance(&ray, [(l, end)], end, true, &[], 1.0, radiance)
             }
-            Shadow::Length(l) => self.lit_radiance(&ray, &[(l, end)], end, true, 1.0, radiance),
             Shadow::Lit(intervals) => {
-                let shifted: Vec<(f64, f64)> = intervals
-                    .iter()
-                    .map(|&(a, b)| (a - offset, b - offset))
-                    .collect();
+                // A camera in space starts where the ray enters the top.
+                let offset = (start.point - self.observer).length();
+                let shifted = intervals.iter().map(|&(a, b)| (a - offset, b - offset));
                 let length = self.boundary_distance(&ray);
-                self.lit_radiance(&ray, &shifted, length, true, 1.0, radiance)
+                self.lit_radiance(&ray, shifted, length, true, &[], 1.0, radiance)
             }
+            _ => self.lit_radiance(&ray, [(0.0, end)], end, true, &[], 1.0, radiance),
         }
     }
 
@@ -358,24 +361,22 @@ impl SkyView for Bruneton4dView<'_> {
         let d_total = (point - start.point).length();
         self.lookup
             .transmittance(ray.r, ray.mu, d_total, ray.ground, transmittance);
+        let t = &transmittance[..n];
         // Bruneton 2017: fade single Mie when the light is below the horizon (table
         // artefacts).
         let fade = smoothstep(0.0, 0.01, ray.mu_s);
-        let offset = (start.point - self.observer).length();
         match shadow {
             Shadow::None => {
-                self.lit_radiance(&ray, &[(0.0, d_total)], d_total, false, fade, radiance)
+                self.lit_radiance(&ray, [(0.0, d_total)], d_total, false, t, fade, radiance)
             }
             Shadow::Length(l) => {
                 let d = (d_total - l.max(0.0)).max(0.0);
-                self.lit_radiance(&ray, &[(0.0, d)], d_total, false, fade, radiance)
+                self.lit_radiance(&ray, [(0.0, d)], d_total, false, t, fade, radiance)
             }
             Shadow::Lit(intervals) => {
-                let shifted: Vec<(f64, f64)> = intervals
-                    .iter()
-                    .map(|&(a, b)| (a - offset, b - offset))
-                    .collect();
-                self.lit_radiance(&ray, &shifted, d_total, false, fade, radiance)
+                let offset = (start.point - self.observer).length();
+                let shifted = intervals.iter().map(|&(a, b)| (a - offset, b - offset));
+                self.lit_radiance(&ray, shifted, d_total, false, t, fade, radiance)
             }
         }
     }
