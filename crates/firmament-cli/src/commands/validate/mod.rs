@@ -408,7 +408,7 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
             "definitions": {
                 "relative_error": "table / reference - 1, per view; summaries over views of |relative error|",
                 "luminance": "CIE Y from the spectral samples (ColourMatrix), cd m-2",
-                "views": "sky only (Sky::sky_radiance vs reference::sky_radiance, include_ground = false): in-scattered radiance, the sun disk seen directly excluded; views within 1 deg of the sun skipped; azimuths relative to the sun",
+                "views": "sky only (SkyView::sky_radiance of the 4D tables vs reference::sky_radiance, include_ground = false): in-scattered radiance, the sun disk seen directly excluded; views within 1 deg of the sun skipped; azimuths relative to the sun",
                 "p95": "nearest-rank 95th percentile",
             },
             "thresholds": {
