@@ -1,7 +1,8 @@
 //! Table parameterisations of Bruneton & Neyret 2008 §4 as refined in Bruneton 2017
 //! (`functions.glsl`): texel-centre-exact mappings, `u_r = ρ/H`, a `u_μ` split at the
 //! horizon into rays that hit the ground and rays that do not, a non-linear `u_μs` with a
-//! minimum sun elevation, and a linear `u_ν`. All in f64; (r, μ) as in [`crate::geometry`].
+//! minimum sun elevation, and `u_ν` by the azimuth from the sun (see [`u_nu`]). All in f64;
+//! (r, μ) as in [`crate::math::sphere`].
 
 use crate::math::sphere::{clamp_cosine, distance_to_top_atmosphere_boundary, safe_sqrt};
 
@@ -308,44 +309,6 @@ impl MuSMap {
     }
 }
 
-/// [`x_mu_s`] tabulated as texel positions for fast filtering (multiple-scattering hot loop):
-/// `position(μ_s)` = u·n − 0.5 clamped to [0, n − 1], linear in a 4097-entry table over
-/// μ_s ∈ [−1, 1] (the mapping is smooth; the table error is below 10⁻⁵ texel).
-pub struct MuSPositions {
-    n: usize,
-    table: Vec<f64>,
-}
-
-impl MuSPositions {
-    /// For `n` μ_s texels.
-    pub fn new(radii: &Radii, n: usize) -> MuSPositions {
-        let map = MuSMap::new(radii);
-        let k = 4096;
-        let table = (0..=k)
-            .map(|j| {
-                let mu_s = -1.0 + 2.0 * j as f64 / k as f64;
-                (texcoord_from_unit(map.x(mu_s), n) * n as f64 - 0.5).clamp(0.0, (n - 1) as f64)
-            })
-            .collect();
-        MuSPositions { n, table }
-    }
-
-    /// (s0, s1, t): the two texels and the weight of s1.
-    #[inline]
-    pub fn filter(&self, mu_s: f64) -> (usize, usize, f64) {
-        let k = self.table.len() - 1;
-        let f = (mu_s.clamp(-1.0, 1.0) + 1.0) * 0.5 * k as f64;
-        // 0 ≤ f ≤ k and 0 ≤ p ≤ n − 1, far below 2³¹: truncating through i32 gives the same
-        // index as through usize, with a cheaper conversion on x86-64.
-        let j = (f as i32 as usize).min(k - 1);
-        let t = f - j as f64;
-        let (p0, p1) = (self.table[j], self.table[j + 1]);
-        let p = p0 + t * (p1 - p0);
-        let s0 = (p as i32 as usize).min(self.n - 1);
-        (s0, (s0 + 1).min(self.n - 1), p - s0 as f64)
-    }
-}
-
 /// The ν coordinate, relative to the range of ν that (μ, μ_s) allow. Bruneton uses
 /// u_ν = (ν + 1)/2 and clamps ν per texel to [μμ_s − s, μμ_s + s], s = √((1−μ²)(1−μ_s²)):
 /// most ν texels then hold clamped, repeated values, and interpolating in μ_s mixes
@@ -458,7 +421,13 @@ pub fn scattering_texel(
 }
 
 /// The texture coordinates of a scattering texel's centre (the ν grid includes its ends).
-fn texel_uvwz(s: &TableSizes, i_nu: usize, i_mu_s: usize, y: usize, z: usize) -> [f64; 4] {
+pub(crate) fn texel_uvwz(
+    s: &TableSizes,
+    i_nu: usize,
+    i_mu_s: usize,
+    y: usize,
+    z: usize,
+) -> [f64; 4] {
     [
         i_nu as f64 / (s.scattering_nu - 1) as f64,
         (i_mu_s as f64 + 0.5) / s.scattering_mu_s as f64,
@@ -469,56 +438,9 @@ fn texel_uvwz(s: &TableSizes, i_nu: usize, i_mu_s: usize, y: usize, z: usize) ->
 
 /// ν clamped to the range that view and sun directions with these μ and μ_s allow.
 #[inline]
-fn clamp_nu(mu: f64, mu_s: f64, nu: f64) -> f64 {
+pub(crate) fn clamp_nu(mu: f64, mu_s: f64, nu: f64) -> f64 {
     let spread = ((1.0 - mu * mu) * (1.0 - mu_s * mu_s)).max(0.0).sqrt();
     nu.clamp(mu * mu_s - spread, mu * mu_s + spread)
-}
-
-/// [`scattering_texel`] for every texel of the tables, from its separable parts computed
-/// once: r per z, (μ, ground) per (z, y), μ_s per μ_s index (each a function of its own
-/// texture coordinate only) and ν from them and u_ν, so the values are the same.
-pub struct ScatteringGrid {
-    nmu: usize,
-    nmu_s: usize,
-    r: Vec<f64>,
-    mu: Vec<(f64, bool)>,
-    mu_s: Vec<f64>,
-    u_nu: Vec<f64>,
-}
-
-impl ScatteringGrid {
-    /// The grid of these sizes.
-    pub fn new(radii: &Radii, s: &TableSizes) -> ScatteringGrid {
-        let at = |i_nu, i_mu_s, y, z| {
-            scattering_r_mu_mu_s_nu(radii, s, texel_uvwz(s, i_nu, i_mu_s, y, z))
-        };
-        let (nr, nmu) = (s.scattering_r, s.scattering_mu);
-        ScatteringGrid {
-            nmu,
-            nmu_s: s.scattering_mu_s,
-            r: (0..nr).map(|z| at(0, 0, 0, z).0).collect(),
-            mu: (0..nr * nmu)
-                .map(|i| {
-                    let (_, mu, _, _, ground) = at(0, 0, i % nmu, i / nmu);
-                    (mu, ground)
-                })
-                .collect(),
-            mu_s: (0..s.scattering_mu_s).map(|i| at(0, i, 0, 0).2).collect(),
-            u_nu: (0..s.scattering_nu)
-                .map(|i| texel_uvwz(s, i, 0, 0, 0)[0])
-                .collect(),
-        }
-    }
-
-    /// Same as [`scattering_texel`].
-    #[inline]
-    pub fn texel(&self, x: usize, y: usize, z: usize) -> (f64, f64, f64, f64, bool) {
-        let (mu, ground) = self.mu[z * self.nmu + y];
-        let mu_s = self.mu_s[x % self.nmu_s];
-        let nu = nu_from_u_nu(mu, mu_s, self.u_nu[x / self.nmu_s]);
-        let nu = clamp_nu(mu, mu_s, nu);
-        (self.r[z], mu, mu_s, nu, ground)
-    }
 }
 
 #[cfg(test)]
@@ -635,19 +557,5 @@ mod tests {
         assert!((texcoord_from_unit(0.0, 32) - 0.5 / 32.0).abs() < 1e-15);
         assert!((texcoord_from_unit(1.0, 32) - (1.0 - 0.5 / 32.0)).abs() < 1e-15);
         assert!((unit_from_texcoord(texcoord_from_unit(0.37, 7), 7) - 0.37).abs() < 1e-15);
-    }
-
-    #[test]
-    fn scattering_grid_is_scattering_texel() {
-        for s in [TableSizes::default(), TableSizes::small()] {
-            let grid = ScatteringGrid::new(&G, &s);
-            for z in 0..s.scattering_r {
-                for y in 0..s.scattering_mu {
-                    for x in 0..s.scattering_nu * s.scattering_mu_s {
-                        assert_eq!(grid.texel(x, y, z), scattering_texel(&G, &s, x, y, z));
-                    }
-                }
-            }
-        }
     }
 }

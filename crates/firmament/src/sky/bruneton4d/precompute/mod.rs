@@ -11,6 +11,7 @@
 //! are independent of the order and computed once.
 
 mod direct_irradiance;
+mod grid;
 mod indirect_irradiance;
 mod multiple_scattering;
 mod order_tail;
@@ -23,12 +24,13 @@ mod transmittance;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use super::lookup::Lookup;
-use super::params::{self, ScatteringGrid};
+use super::params;
 use super::table::{Table2, Table4};
 use super::{MieStorage, TableConfig, Tables};
 use crate::atmosphere::{Model, ScatteringGroups};
 use crate::{Error, Result};
 use direct_irradiance::compute_direct_irradiance;
+pub(crate) use grid::{MuSPositions, ScatteringGrid};
 use indirect_irradiance::compute_indirect_irradiance;
 use multiple_scattering::compute_multiple_scattering;
 pub use order_tail::order_tail_factors;

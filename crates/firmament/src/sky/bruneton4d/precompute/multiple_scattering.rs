@@ -4,9 +4,10 @@
 use rayon::prelude::*;
 
 use super::ray::RaySamples;
+use super::ScatteringGrid;
 use crate::atmosphere::Model;
 use crate::sky::bruneton4d::lookup::Lookup;
-use crate::sky::bruneton4d::params::{self, ScatteringGrid};
+use crate::sky::bruneton4d::params;
 use crate::sky::bruneton4d::table::{lerp_weights, Table4};
 
 /// Multiple scattering ΔS of order n from ΔJ (paper eq. 12 / Bruneton 2017
@@ -24,7 +25,7 @@ pub(super) fn compute_multiple_scattering(
     let row_len = out.row_len();
     let width = out.width();
     let radii = lookup.radii;
-    let mu_s_positions = params::MuSPositions::new(&radii, s.scattering_mu_s);
+    let mu_s_positions = super::MuSPositions::new(&radii, s.scattering_mu_s);
     out.data
         .par_chunks_mut(row_len)
         .enumerate()

@@ -2,8 +2,8 @@
 //! the GPU), the geometric tail's factors (`order_tail_factors`) and their application
 //! (`order_tail`).
 
+use super::ScatteringGrid;
 use crate::atmosphere::ScatteringGroups;
-use crate::sky::bruneton4d::params::ScatteringGrid;
 use crate::sky::bruneton4d::table::Table4;
 
 /// Factors q/(1 − q) per channel for the orders beyond the last computed one, N: with

@@ -5,10 +5,10 @@ use std::f64::consts::PI;
 
 use rayon::prelude::*;
 
+use super::ScatteringGrid;
 use super::{DENSITY_THETA, HARMONICS, KERNEL_STEPS};
 use crate::atmosphere::ScatteringGroups;
 use crate::sky::bruneton4d::lookup::Lookup;
-use crate::sky::bruneton4d::params::ScatteringGrid;
 
 /// Azimuthal harmonics of each scattering group's phase function, for every table radius,
 /// view zenith (table μ) and incident zenith: b_m with P(Δφ) = Σ b_m cos(mΔφ), times the

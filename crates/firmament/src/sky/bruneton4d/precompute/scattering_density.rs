@@ -8,11 +8,11 @@ use std::f64::consts::PI;
 use rayon::prelude::*;
 
 use super::phase_kernels::PhaseKernels;
+use super::ScatteringGrid;
 use super::{Previous, DENSITY_PHI, DENSITY_THETA, HARMONICS, MAX_CHANNELS};
 use crate::atmosphere::{Model, ScatteringGroups};
 use crate::math::sphere::{distance_to_bottom_atmosphere_boundary, ray_intersects_ground};
 use crate::sky::bruneton4d::lookup::Lookup;
-use crate::sky::bruneton4d::params::ScatteringGrid;
 use crate::sky::bruneton4d::table::{Table2, Table4};
 
 /// Scattering density ΔJ of order n (paper eq. 11 / Bruneton 2017

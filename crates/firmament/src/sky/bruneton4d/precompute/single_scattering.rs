@@ -4,10 +4,11 @@
 use rayon::prelude::*;
 
 use super::ray::RaySamples;
+use super::ScatteringGrid;
 use super::MAX_CHANNELS;
 use crate::atmosphere::{Model, ScatteringGroups};
 use crate::sky::bruneton4d::lookup::Lookup;
-use crate::sky::bruneton4d::params::{self, ScatteringGrid};
+use crate::sky::bruneton4d::params;
 use crate::sky::bruneton4d::table::{lerp_weights, Table4};
 
 /// The optical-depth table filtered to one radius, for lookups towards the sun from one
