@@ -2,12 +2,13 @@
 //! render loop does not change), and the parts of a ray in shadow are left out exactly
 //! (`Shadow::Lit`) against an independent quadrature of single scattering.
 
+mod common;
+
 use std::sync::OnceLock;
 
 use firmament::atmosphere::Atmosphere;
-use firmament::math::sphere::distance_to_top_atmosphere_boundary;
 use firmament::math::Vec3;
-use firmament::render::{self, RenderSettings, ShadeScratch, Shader};
+use firmament::render::{self, RenderSettings};
 use firmament::scene::{sun_direction, Camera, Light, Projection, Ray, Scene, Sphere, Surface};
 use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, TableSizes};
 use firmament::sky::{Shadow, SkyMethod};
@@ -64,16 +65,14 @@ fn scene<'a>(sky: &'a Bruneton4d, lights: &[Light], ball: bool) -> Scene<'a> {
     scene
 }
 
+/// The scene's radiance along `dir` from the observer.
 fn shade(scene: &Scene, dir: Vec3) -> [f64; 3] {
-    let sky = scene.sky.model();
-    let origin = Vec3::new(0.0, 0.0, sky.bottom_radius_m + CAMERA_ALTITUDE_M);
-    let mut l = [0.0; 3];
-    Shader::new(scene, origin).unwrap().shade(
-        &Ray { origin, dir },
-        &mut ShadeScratch::default(),
-        &mut l,
+    let origin = Vec3::new(
+        0.0,
+        0.0,
+        scene.sky.model().bottom_radius_m + CAMERA_ALTITUDE_M,
     );
-    l
+    common::shade(scene, origin, dir)
 }
 
 /// Frames are linear in the lights: the scene with both equals the sum of the scenes with
@@ -284,37 +283,15 @@ fn shadowed_single_scattering_matches_a_quadrature_of_the_lit_part() {
     view.sky_radiance(dir, Shadow::Lit(&[(a, b)]), &mut lit, &mut []);
     view.sky_radiance(dir, Shadow::None, &mut whole, &mut []);
     // ∫ Σ_c ρ_c β_c P_c(ν) · T(0, s) · T_sun(s) · E ds over the lit part and the whole ray.
-    let nu = dir.dot(sun.direction);
-    let length = distance_to_top_atmosphere_boundary(r0, dir.z, model.top_radius_m);
     let (mut brute_lit, mut brute_whole) = ([0.0f64; 3], [0.0f64; 3]);
-    let mut tau = [0.0f64; 3];
-    let mut extinction = [0.0; 3];
-    let mut s = 0.0;
-    while s < length {
-        let h = if s < 200e3 { 5.0f64 } else { 200.0 }.min(length - s);
-        let m = s + 0.5 * h;
-        let p = o + m * dir;
-        let rp = p.length();
-        let altitude = rp - model.bottom_radius_m;
-        model.extinction_into(altitude, &mut extinction);
-        let mu_s = p.dot(sun.direction) / rp;
-        let to_sun = distance_to_top_atmosphere_boundary(rp, mu_s, model.top_radius_m);
-        let tau_sun = model.optical_depth_along_ray(rp, mu_s, to_sun);
+    common::single_scattering_steps(model, o, dir, sun.direction, 5.0, |m, dl| {
         for k in 0..3 {
-            let mut j = 0.0;
-            for c in &model.constituents {
-                j += c.density.density(altitude) * c.scattering[k] * c.phase.eval(nu);
-            }
-            let t = (-(tau[k] + 0.5 * h * extinction[k]) - tau_sun[k]).exp();
-            let d = h * j * t * model.solar_irradiance[k];
-            brute_whole[k] += d;
+            brute_whole[k] += dl[k];
             if m > a && m < b {
-                brute_lit[k] += d;
+                brute_lit[k] += dl[k];
             }
-            tau[k] += h * extinction[k];
         }
-        s += h;
-    }
+    });
     for k in 0..3 {
         let e_lit = lit[k] / brute_lit[k] - 1.0;
         let e_whole = whole[k] / brute_whole[k] - 1.0;

@@ -1,5 +1,7 @@
 //! The precomputed tables against closed forms and independent quadratures.
 
+mod common;
+
 use firmament::atmosphere::Atmosphere;
 use firmament::math::sphere::{distance_to_top_atmosphere_boundary, safe_sqrt};
 use firmament::math::Vec3;
@@ -515,38 +517,13 @@ fn single_scattering_matches_brute_force(preset: &str, elevations: &[f64], toler
     let camera: Vec3 = Vec3::new(0.0, 0.0, r0);
     for &elevation_deg in elevations {
         let view = sun_direction(90.0 - elevation_deg, 0.0);
-        let nu = view.dot(sun);
-        let length = distance_to_top_atmosphere_boundary(
-            r0,
-            elevation_deg.to_radians().sin(),
-            model.top_radius_m,
-        );
         // Fine steps where the light comes from (the first 200 km), coarser beyond.
         let mut brute = [0.0f64; 3];
-        let mut tau = [0.0f64; 3];
-        let mut extinction = [0.0; 3];
-        let mut d = 0.0;
-        while d < length {
-            let h = if d < 200e3 { 10.0f64 } else { 200.0 }.min(length - d);
-            let m = d + 0.5 * h;
-            let p = Vec3::new(view[0] * m, view[1] * m, r0 + view[2] * m);
-            let rp = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-            let altitude = rp - model.bottom_radius_m;
-            model.extinction_into(altitude, &mut extinction);
-            let mu_s = p.dot(sun) / rp;
-            let to_sun = distance_to_top_atmosphere_boundary(rp, mu_s, model.top_radius_m);
-            let tau_sun = model.optical_depth_along_ray(rp, mu_s, to_sun);
+        common::single_scattering_steps(&model, camera, view, sun, 10.0, |_, dl| {
             for k in 0..3 {
-                let mut j = 0.0;
-                for c in &model.constituents {
-                    j += c.density.density(altitude) * c.scattering[k] * c.phase.eval(nu);
-                }
-                let t = (-(tau[k] + 0.5 * h * extinction[k]) - tau_sun[k]).exp();
-                brute[k] += h * j * t * model.solar_irradiance[k];
-                tau[k] += h * extinction[k];
+                brute[k] += dl[k];
             }
-            d += h;
-        }
+        });
         let (mut table, mut t) = (vec![0.0; 3], vec![0.0; 3]);
         sky.view(camera, &Light::sun(&sky.model, sun, false))
             .sky_radiance(view, Shadow::None, &mut table, &mut t);

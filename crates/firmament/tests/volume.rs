@@ -2,13 +2,14 @@
 //! marcher (render::Shader) and traced by the reference path tracer, which both sample it
 //! through the `Volume` trait; and its transmittance against the closed form.
 
+mod common;
+
 use std::sync::OnceLock;
 
 use firmament::atmosphere::Atmosphere;
 use firmament::math::Vec3;
 use firmament::medium::PhaseFunction;
 use firmament::reference::{self, ReferenceSettings};
-use firmament::render::{ShadeScratch, Shader};
 use firmament::scene::{sun_direction, HomogeneousSphere, Ray, Scene, Volume};
 use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, TableSizes};
 use firmament::sky::{Shadow, SkyMethod};
@@ -43,16 +44,6 @@ fn observer(sky: &Bruneton4d) -> Vec3 {
     Vec3::new(0.0, 0.0, sky.model.bottom_radius_m + 2.0)
 }
 
-fn shade(scene: &Scene, origin: Vec3, dir: Vec3) -> [f64; 3] {
-    let mut l = [0.0; 3];
-    Shader::new(scene, origin).unwrap().shade(
-        &Ray { origin, dir },
-        &mut ShadeScratch::default(),
-        &mut l,
-    );
-    l
-}
-
 /// Through a purely absorbing ball the marcher's transmittance is e^{−σ_t·chord}: what it
 /// sees behind (less the air in front) is attenuated by exactly that.
 #[test]
@@ -77,7 +68,10 @@ fn an_absorbing_ball_attenuates_by_beer_lambert() {
             view.sky_radiance_to_point(o + a * dir, Shadow::None, &mut l, &mut [0.0; 3]);
             l
         };
-        let (l_with, l_without) = (shade(&with, o, dir), shade(&without, o, dir));
+        let (l_with, l_without) = (
+            common::shade(&with, o, dir),
+            common::shade(&without, o, dir),
+        );
         for k in 0..3 {
             let want = front[k] + (-tau).exp() * (l_without[k] - front[k]);
             assert!(
@@ -112,7 +106,7 @@ fn a_scattering_ball_matches_the_reference() {
     {
         let target = ball.centre + Vec3::new(offset.0, 0.0, offset.1);
         let dir = (target - o).normalize();
-        let fast = colour.to_xyz(&shade(&scene, o, dir))[1];
+        let fast = colour.to_xyz(&common::shade(&scene, o, dir))[1];
         let e = reference::scene_radiance(model, &volumes, o, dir, sun, &settings, i as u64);
         let (truth, se) = colour.luminance_and_stderr(&e.radiance, &e.stderr);
         let clear = reference::sky_radiance_keyed(model, o, dir, sun, &settings, 100 + i as u64);
