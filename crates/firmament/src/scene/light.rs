@@ -62,12 +62,6 @@ impl Light {
         }
     }
 
-    /// Whether `dir` (unit) falls inside the disk.
-    #[inline]
-    pub fn in_disk(&self, dir: Vec3) -> bool {
-        dir.dot(self.direction) > self.angular_radius_rad.cos()
-    }
-
     /// Adds the disk's radiance seen along `dir`, attenuated by `transmittance`, when `dir`
     /// falls inside the disk.
     pub fn add_disk_radiance(&self, dir: Vec3, transmittance: &[f64], out: &mut [f64]) {
