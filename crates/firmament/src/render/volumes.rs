@@ -91,19 +91,27 @@ pub(super) fn composite(
         let x = ray.origin + (a + (i as f64 + 0.5) * dt) * ray.dir;
         sigma_t.iter_mut().for_each(|v| *v = 0.0);
         source.iter_mut().for_each(|v| *v = 0.0);
-        for volume in &scene.volumes {
-            volume.coefficients(x, e_v, s_v);
-            if s_v.iter().all(|&s| s == 0.0) && e_v.iter().all(|&e| e == 0.0) {
-                continue;
-            }
-            for k in 0..n {
-                sigma_t[k] += e_v[k];
-            }
-            for view in views {
-                let light = view.light();
+        // The light reaching x (through the air and every volume) and the ambient light there,
+        // once per light and step, for the volumes that scatter at x.
+        for (j, view) in views.iter().enumerate() {
+            let light = view.light();
+            let mut lit = false;
+            for volume in &scene.volumes {
+                volume.coefficients(x, e_v, s_v);
+                if j == 0 {
+                    for k in 0..n {
+                        sigma_t[k] += e_v[k];
+                    }
+                }
+                if s_v.iter().all(|&s| s == 0.0) {
+                    continue;
+                }
+                if !lit {
+                    light_transmittance(scene, view.as_ref(), x, t_light);
+                    ambient_irradiance(scene, view.as_ref(), x, &mut ambient, &mut e, n);
+                    lit = true;
+                }
                 let p = volume.phase(x).eval(ray.dir.dot(light.direction));
-                light_transmittance(scene, view.as_ref(), x, t_light);
-                ambient_irradiance(scene, view.as_ref(), x, &mut ambient, &mut e, n);
                 for k in 0..n {
                     source[k] += s_v[k] * p * light.irradiance[k] * t_light[k];
                     source[k] += s_v[k] * (ambient[0][k] + ambient[1][k]) / (2.0 * PI);
