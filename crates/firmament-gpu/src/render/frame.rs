@@ -144,6 +144,7 @@ pub(crate) fn light_words(sky: &GpuSky, lights: &[Light]) -> Vec<u32> {
         direction[l * 4..l * 4 + 4].copy_from_slice(&v4(light.direction, light.angular_radius_rad));
         disk[l * 4] = u32::from(light.visible_disk);
         disk[l * 4 + 1] = bits(light.angular_radius_rad.sin());
+        let scale = light.scale_against(&sky.solar_irradiance);
         for k in 0..sky.channels {
             let (group, lane) = (k / GROUP, k % GROUP);
             let mut set = |row: usize, v: f64| {
@@ -153,15 +154,7 @@ pub(crate) fn light_words(sky: &GpuSky, lights: &[Light]) -> Vec<u32> {
             for (j, a) in d.law[k].iter().enumerate() {
                 set(LIGHT_DISK + j, d.centre_radiance[k] * a);
             }
-            let solar = sky.solar_irradiance[k];
-            set(
-                LIGHT_SCALE,
-                if solar > 0.0 {
-                    light.irradiance[k] / solar
-                } else {
-                    0.0
-                },
-            );
+            set(LIGHT_SCALE, scale[k]);
             set(LIGHT_IRRADIANCE, light.irradiance[k]);
         }
     }

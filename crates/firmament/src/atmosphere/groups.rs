@@ -44,13 +44,7 @@ impl ScatteringGroups {
         }
         let ground_scattering = [MOLECULES, AEROSOLS].map(|group| {
             let mut s = vec![0.0; channels];
-            for &i in &members[group] {
-                let c = &constituents[i];
-                let rho = c.density.density(0.0);
-                for (s, b) in s.iter_mut().zip(&c.scattering) {
-                    *s += rho * b;
-                }
-            }
+            members_scattering(constituents, &members[group], 0.0, &mut s);
             s
         });
         ScatteringGroups {
@@ -81,16 +75,7 @@ impl ScatteringGroups {
     /// Scattering coefficient (m⁻¹) of `group` at `altitude_m`, into `out`.
     #[inline]
     pub fn scattering_into(&self, model: &Model, group: usize, altitude_m: f64, out: &mut [f64]) {
-        out.iter_mut().for_each(|o| *o = 0.0);
-        for &i in &self.members[group] {
-            let c = &model.constituents[i];
-            let rho = c.density.density(altitude_m);
-            if rho > 0.0 {
-                for (o, s) in out.iter_mut().zip(&c.scattering) {
-                    *o += rho * s;
-                }
-            }
-        }
+        members_scattering(&model.constituents, &self.members[group], altitude_m, out);
     }
 
     /// The ratio-rule factors (β_R[0]/β_M[0])·(β_M[k]/β_R[k]) at the ground, by which the
@@ -107,5 +92,25 @@ impl ScatteringGroups {
                 }
             })
             .collect()
+    }
+}
+
+/// Σ ρ·β (m⁻¹) over the constituents `members` at `altitude_m`, into `out`.
+#[inline]
+fn members_scattering(
+    constituents: &[ResolvedConstituent],
+    members: &[usize],
+    altitude_m: f64,
+    out: &mut [f64],
+) {
+    out.iter_mut().for_each(|o| *o = 0.0);
+    for &i in members {
+        let c = &constituents[i];
+        let rho = c.density.density(altitude_m);
+        if rho > 0.0 {
+            for (o, s) in out.iter_mut().zip(&c.scattering) {
+                *o += rho * s;
+            }
+        }
     }
 }

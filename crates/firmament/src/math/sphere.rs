@@ -71,6 +71,19 @@ pub fn horizon_mu(r: f64, bottom_m: f64) -> f64 {
     -safe_sqrt(1.0 - rho * rho)
 }
 
+/// Distance along a unit direction from a point at radius `r` outside the sphere of radius
+/// `top` (r·μ = `rmu`) to where the ray enters that sphere; None when it misses it or the
+/// sphere lies behind.
+#[inline]
+pub fn distance_to_enter_sphere(r: f64, rmu: f64, top: f64) -> Option<f64> {
+    let disc = rmu * rmu - r * r + top * top;
+    if disc < 0.0 {
+        return None;
+    }
+    let d = -rmu - disc.sqrt();
+    (d > 0.0).then_some(d)
+}
+
 /// Distances (near, far) along unit `dir` from `origin` to a sphere of `radius` centred at
 /// the origin, or None if the line misses it. `near` may be negative (origin inside).
 pub fn ray_sphere(origin: Vec3, dir: Vec3, radius: f64) -> Option<(f64, f64)> {

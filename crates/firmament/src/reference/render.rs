@@ -78,12 +78,7 @@ pub fn render_frame(
     let colour = ColourMatrix::new(nm);
     let balance = colour.white_balance(&model.solar_irradiance, settings.white_balance);
     // The tracer's source is the model's sun; another light's irradiance scales it.
-    let scale: Vec<f64> = sun
-        .irradiance
-        .iter()
-        .zip(&model.solar_irradiance)
-        .map(|(l, s)| if *s > 0.0 { l / s } else { 0.0 })
-        .collect();
+    let scale = sun.scale_against(&model.solar_irradiance);
     let mut image = ImageRgbF32::new(w, h);
     let mut mask = vec![false; w * h];
     let (mut stderr_sum, mut stderr_count) = (0.0, 0usize);

@@ -62,6 +62,17 @@ impl Light {
         }
     }
 
+    /// Its irradiance relative to `reference` (W·m⁻²·nm⁻¹ per channel; 0 where that is 0):
+    /// the factor by which results computed for the reference light (the model's sun, which
+    /// the tables hold) scale to this one.
+    pub fn scale_against(&self, reference: &[f64]) -> Vec<f64> {
+        self.irradiance
+            .iter()
+            .zip(reference)
+            .map(|(l, s)| if *s > 0.0 { l / s } else { 0.0 })
+            .collect()
+    }
+
     /// Adds the disk's radiance seen along `dir`, attenuated by `transmittance`, when `dir`
     /// falls inside the disk.
     pub fn add_disk_radiance(&self, dir: Vec3, transmittance: &[f64], out: &mut [f64]) {

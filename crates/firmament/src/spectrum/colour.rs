@@ -95,13 +95,7 @@ pub fn encode_srgb(linear: f32) -> u8 {
 
 /// 8-bit sRGB to linear [0, 1] (inverse of [`encode_srgb`] up to quantisation).
 pub fn decode_srgb(srgb: u8) -> f32 {
-    let v = srgb as f64 / 255.0;
-    let c = if v <= 0.04045 {
-        v / 12.92
-    } else {
-        ((v + 0.055) / 1.055).powf(2.4)
-    };
-    c as f32
+    srgb_to_linear(srgb as f64 / 255.0) as f32
 }
 
 /// [`encode_srgb`] for whole frames: a 2¹⁶-entry table of the 8-bit code of each value in

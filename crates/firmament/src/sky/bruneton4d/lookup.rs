@@ -6,7 +6,7 @@ use super::params::{self, Radii, TableSizes};
 use super::table::{Table2, MAX_OPTICAL_DEPTH};
 use crate::atmosphere::Model;
 use crate::math::smoothstep;
-use crate::math::sphere::{distance_to_top_atmosphere_boundary, safe_sqrt};
+use crate::math::sphere::{advance, safe_sqrt};
 use crate::spectrum::with_channel_buffers;
 
 /// What a lookup needs: the model's radii, the sizes and the transmittance table (as
@@ -68,9 +68,7 @@ impl<'a> Lookup<'a> {
     /// stand-in for T = 0.
     #[inline]
     pub fn transmittance(&self, r: f64, mu: f64, d: f64, ground: bool, out: &mut [f64]) {
-        let radii = &self.radii;
-        let r_d = safe_sqrt(d * d + 2.0 * r * mu * d + r * r).clamp(radii.bottom, radii.top);
-        let mu_d = ((r * mu + d) / r_d).clamp(-1.0, 1.0);
+        let (r_d, mu_d) = advance(r, mu, d, self.radii.bottom, self.radii.top);
         // T = e^{−(τ_a − τ_b)}: τ_a into `out`, τ_b into `b`.
         with_channel_buffers(out.len(), |[b]| {
             if ground {
@@ -124,11 +122,5 @@ impl<'a> Lookup<'a> {
             self.sizes.irradiance_r,
         );
         table.sample_into(u, v, out);
-    }
-
-    /// Distance to the top along (r, μ).
-    #[inline]
-    pub fn distance_to_top(&self, r: f64, mu: f64) -> f64 {
-        distance_to_top_atmosphere_boundary(r, mu, self.radii.top)
     }
 }

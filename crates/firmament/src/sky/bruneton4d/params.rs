@@ -350,13 +350,10 @@ pub fn x_mu_s(radii: &Radii, mu_s: f64) -> f64 {
 /// Inverse of [`x_mu_s`].
 #[inline]
 pub fn mu_s_from_x(radii: &Radii, x: f64) -> f64 {
+    let MuSMap { d_min, big_a, .. } = MuSMap::new(radii);
     let h = radii.h();
-    let d_min = radii.top - radii.bottom;
-    let d_max = h;
-    let big_d = distance_to_top_atmosphere_boundary(radii.bottom, radii.mu_s_min, radii.top);
-    let big_a = (big_d - d_min) / (d_max - d_min);
     let a = (big_a - x * big_a) / (1.0 + x * big_a);
-    let d = d_min + a.min(big_a) * (d_max - d_min);
+    let d = d_min + a.min(big_a) * (h - d_min);
     if d == 0.0 {
         1.0
     } else {

@@ -12,7 +12,7 @@
 use super::lookup::Lookup;
 use super::{params, Bruneton4d, MieStorage};
 use crate::atmosphere::groups::{AEROSOLS, MOLECULES};
-use crate::math::sphere::{advance, ray_intersects_ground};
+use crate::math::sphere::{advance, distance_to_enter_sphere, ray_intersects_ground};
 use crate::math::{smoothstep, Vec3};
 use crate::scene::light::Light;
 use crate::sky::{Shadow, SkyView};
@@ -77,12 +77,7 @@ impl<'a> Bruneton4dView<'a> {
             let mu_s = (observer.dot(light.direction) / r).clamp(-1.0, 1.0);
             Slice::new(sky, &lookup, r, mu_s)
         });
-        let scale = light
-            .irradiance
-            .iter()
-            .zip(&sky.model.solar_irradiance)
-            .map(|(l, s)| if *s > 0.0 { l / s } else { 0.0 })
-            .collect();
+        let scale = light.scale_against(&sky.model.solar_irradiance);
         Bruneton4dView {
             sky,
             light,
@@ -112,14 +107,7 @@ impl<'a> Bruneton4dView<'a> {
                 at_observer: true,
             });
         }
-        let disc = rmu * rmu - r * r + top * top;
-        if disc < 0.0 {
-            return None;
-        }
-        let d = -rmu - disc.sqrt();
-        if d <= 0.0 {
-            return None;
-        }
+        let d = distance_to_enter_sphere(r, rmu, top)?;
         Some(Start {
             point: camera + dir * d,
             r: top,
@@ -297,10 +285,6 @@ impl<'a> Bruneton4dView<'a> {
 }
 
 impl SkyView for Bruneton4dView<'_> {
-    fn observer(&self) -> Vec3 {
-        self.observer
-    }
-
     fn light(&self) -> &Light {
         self.light
     }
@@ -401,12 +385,9 @@ impl SkyView for Bruneton4dView<'_> {
             // Above the atmosphere: enter it along the light's ray, or see the light
             // unobstructed.
             let rmu = point.dot(light);
-            let disc = rmu * rmu - r * r + top * top;
-            let d = -rmu - disc.max(0.0).sqrt();
-            if disc >= 0.0 && d > 0.0 {
-                lk.transmittance_to_sun(top, ((rmu + d) / top).clamp(-1.0, 1.0), out);
-            } else {
-                out.iter_mut().for_each(|v| *v = 1.0);
+            match distance_to_enter_sphere(r, rmu, top) {
+                Some(d) => lk.transmittance_to_sun(top, ((rmu + d) / top).clamp(-1.0, 1.0), out),
+                None => out.iter_mut().for_each(|v| *v = 1.0),
             }
             return;
         }
