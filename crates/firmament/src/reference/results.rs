@@ -59,13 +59,4 @@ impl RadianceEstimate {
         crate::spectrum::ColourMatrix::new(wavelengths_nm)
             .luminance_and_stderr(&self.radiance, &self.stderr)
     }
-
-    /// Largest relative standard error over the wavelengths (0 where the radiance is 0).
-    pub fn max_relative_stderr(&self) -> f64 {
-        self.radiance
-            .iter()
-            .zip(&self.stderr)
-            .map(|(v, e)| if *v > 0.0 { e / v } else { 0.0 })
-            .fold(0.0, f64::max)
-    }
 }

@@ -46,9 +46,6 @@ pub trait SkyMethod: Send + Sync {
     /// The atmosphere it evaluates.
     fn model(&self) -> &Model;
 
-    /// A short name for messages ("bruneton4d").
-    fn name(&self) -> &'static str;
-
     /// The evaluation for views from `observer` (planet-centred, m; anywhere, in space too)
     /// lit by `light`: the method's per-view cache is built here, once per frame and light.
     fn view<'a>(&'a self, observer: Vec3, light: &'a Light) -> Box<dyn SkyView + 'a>;
@@ -57,9 +54,6 @@ pub trait SkyMethod: Send + Sync {
 /// A sky method prepared for one observer and one light. Outputs are per channel of the
 /// model's wavelength grid, overwritten.
 pub trait SkyView: Send + Sync {
-    /// The observer.
-    fn observer(&self) -> Vec3;
-
     /// The light.
     fn light(&self) -> &Light;
 

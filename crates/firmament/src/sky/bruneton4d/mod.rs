@@ -61,11 +61,6 @@ impl Bruneton4d {
             )
         }
     }
-
-    /// The view from `observer` under `light`, with its concrete type.
-    pub fn view_of<'a>(&'a self, observer: Vec3, light: &'a Light) -> Bruneton4dView<'a> {
-        Bruneton4dView::new(self, observer, light)
-    }
 }
 
 impl SkyMethod for Bruneton4d {
@@ -73,11 +68,7 @@ impl SkyMethod for Bruneton4d {
         &self.model
     }
 
-    fn name(&self) -> &'static str {
-        "bruneton4d"
-    }
-
     fn view<'a>(&'a self, observer: Vec3, light: &'a Light) -> Box<dyn SkyView + 'a> {
-        Box::new(self.view_of(observer, light))
+        Box::new(Bruneton4dView::new(self, observer, light))
     }
 }
