@@ -266,11 +266,17 @@ impl<'a> RenderSky<'a> {
             Backend::Cpu => return Ok(RenderSky::Cpu(Box::new(atmosphere.sky(quiet)?))),
             Backend::Gpu(gpu) => gpu,
         };
-        let sky_model = atmosphere.model()?;
-        let sky = match &atmosphere.tables {
-            Some(_) => GpuSky::from_sky(&gpu.ctx, &atmosphere.sky(quiet)?)
-                .map_err(|e| gpu_failure("uploading the tables", e))?,
-            None => gpu.sky(&sky_model, &atmosphere.table_config()?, quiet)?,
+        let (sky, sky_model) = match &atmosphere.tables {
+            Some(_) => {
+                let cpu = atmosphere.sky(quiet)?;
+                let sky = GpuSky::from_sky(&gpu.ctx, &cpu)
+                    .map_err(|e| gpu_failure("uploading the tables", e))?;
+                (sky, cpu.model)
+            }
+            None => {
+                let model = atmosphere.model()?;
+                (gpu.sky(&model, &atmosphere.table_config()?, quiet)?, model)
+            }
         };
         let renderer = GpuRenderer::new(&gpu.ctx)
             .map_err(|e| gpu_failure("compiling the render shader", e))?;
