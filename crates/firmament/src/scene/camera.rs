@@ -154,10 +154,14 @@ impl Camera {
                 if rho > 1.0 {
                     return None;
                 }
-                let zenith = rho * PI / 2.0;
-                // Looking up with north at the top of the image: east is on the left.
-                let azimuth = (-x).atan2(y);
-                direction_from_zenith_azimuth(zenith, azimuth)
+                // Looking up with north at the top of the image: east is on the left, so
+                // the azimuth θ has sin θ = −x/ρ, cos θ = y/ρ (no arctangent needed).
+                let (sin_z, cos_z) = (rho * PI / 2.0).sin_cos();
+                if rho > 0.0 {
+                    Vec3::new(-x / rho * sin_z, y / rho * sin_z, cos_z)
+                } else {
+                    Vec3::Z
+                }
             }
             Projection::Equirect => {
                 // Column: azimuth from −180° (south, left edge) through 0° (north, centre)

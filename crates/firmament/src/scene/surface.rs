@@ -71,8 +71,13 @@ impl Sphere {
 
 impl Surface for Sphere {
     fn intersect(&self, ray: &Ray, max_distance_m: f64) -> Option<SurfaceHit> {
-        // Seen from outside only: the near root, when in front of the origin.
-        let (near, _) = ray_sphere(ray.origin - self.centre, ray.dir, self.radius_m)?;
+        // Seen from outside only: the near root, when in front of the origin. An origin
+        // outside that looks away (o·d ≥ 0) cannot hit it: no square root for the sky.
+        let o = ray.origin - self.centre;
+        if o.dot(ray.dir) >= 0.0 {
+            return None;
+        }
+        let (near, _) = ray_sphere(o, ray.dir, self.radius_m)?;
         if !(near > 0.0 && near < max_distance_m) {
             return None;
         }
@@ -80,7 +85,8 @@ impl Surface for Sphere {
         Some(SurfaceHit {
             distance_m: near,
             position,
-            normal: (position - self.centre).normalize_or_zero(),
+            // On the sphere: |position − centre| = radius.
+            normal: (position - self.centre) / self.radius_m,
         })
     }
 

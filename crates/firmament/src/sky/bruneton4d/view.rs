@@ -24,6 +24,8 @@ pub struct Bruneton4dView<'a> {
     light: &'a Light,
     lookup: Lookup<'a>,
     observer: Vec3,
+    /// |observer| (m).
+    observer_r: f64,
     /// The tables at the observer's (r, μ_s), when it is inside the atmosphere.
     slice: Option<Slice>,
     /// The light's irradiance over the solar irradiance the tables were computed with.
@@ -83,6 +85,7 @@ impl<'a> Bruneton4dView<'a> {
             light,
             lookup,
             observer,
+            observer_r: r,
             slice,
             scale,
         }
@@ -97,7 +100,7 @@ impl<'a> Bruneton4dView<'a> {
     fn start(&self, dir: Vec3) -> Option<Start> {
         let top = self.sky.model.top_radius_m;
         let camera = self.observer;
-        let r = camera.length();
+        let r = self.observer_r;
         let rmu = camera.dot(dir);
         if r <= top {
             return Some(Start {
