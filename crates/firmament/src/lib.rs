@@ -8,6 +8,7 @@
 //! [`reference`] path tracer computes the same quantities by Monte Carlo, to measure every
 //! approximation against.
 
+pub mod astro;
 pub mod atmosphere;
 pub mod error;
 pub mod io;
