@@ -14,8 +14,8 @@ const EARTH_AXIS_RATIO: f64 = 1.0 - 1.0 / 298.257_223_563;
 /// (accurate to 0.5″ and 0.1″), at `t` Julian centuries TT from J2000.0.
 pub fn nutation(t: f64) -> (f64, f64) {
     let omega = (125.04452 - 1934.136261 * t).to_radians();
-    let l_sun = (280.4665 + 36_000.7698 * t).to_radians();
-    let l_moon = (218.3165 + 481_267.8813 * t).to_radians();
+    let l_sun = (280.4665 + 36_000.769_8 * t).to_radians();
+    let l_moon = (218.3165 + 481_267.881_3 * t).to_radians();
     let dpsi = -17.20 * omega.sin() - 1.32 * (2.0 * l_sun).sin() - 0.23 * (2.0 * l_moon).sin()
         + 0.21 * (2.0 * omega).sin();
     let deps = 9.20 * omega.cos() + 0.57 * (2.0 * l_sun).cos() + 0.10 * (2.0 * l_moon).cos()
