@@ -161,6 +161,14 @@ impl<'a> Bruneton4dView<'a> {
                 ((ray.r * ray.mu_s + d * ray.nu) / r_d).clamp(-1.0, 1.0),
             )
         };
+        // Below the tables' lowest sun (Bruneton 2017's μ_s,min) the light scatters
+        // nothing here: the tables end there, and clamping would give every deeper night
+        // the sky of the lowest tabulated sun.
+        if mu_s < sky.model.mu_s_min {
+            scat.iter_mut().for_each(|v| *v = 0.0);
+            mie.iter_mut().for_each(|v| *v = 0.0);
+            return;
+        }
         let at = with_channel_buffers(2 * n, |[both]| {
             let at = match self.slice.as_ref().filter(|_| at_start && ray.at_observer) {
                 Some(s) => {
