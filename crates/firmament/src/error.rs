@@ -61,4 +61,24 @@ impl Error {
             expected: expected.into(),
         }
     }
+
+    /// The same error with `prefix` before a parameter's field name (a table's name in a
+    /// file, e.g. `location.`).
+    pub fn prefixed(self, prefix: &str) -> Self {
+        match self {
+            Error::InvalidParameter {
+                field,
+                value,
+                expected,
+            } => Error::InvalidParameter {
+                field: format!(
+                    "{prefix}{}",
+                    field.trim_start_matches("--").replace('-', "_")
+                ),
+                value,
+                expected,
+            },
+            other => other,
+        }
+    }
 }

@@ -6,7 +6,7 @@
 use firmament::math::sphere::safe_sqrt;
 use firmament::math::Vec3;
 use firmament::render::RenderSettings;
-use firmament::scene::{Light, Projection};
+use firmament::scene::{DiskProfile, Light, Projection};
 use firmament::sky::bruneton4d::params::scattering_uvwz;
 use firmament::spectrum::MAX_CHANNELS;
 
@@ -150,9 +150,15 @@ pub(crate) fn light_words(sky: &GpuSky, lights: &[Light]) -> Vec<u32> {
             let mut set = |row: usize, v: f64| {
                 data[((l * groups + group) * LIGHT_STRIDE + row) * 4 + lane] = v as f32;
             };
-            let d = &light.disk;
-            for (j, a) in d.law[k].iter().enumerate() {
-                set(LIGHT_DISK + j, d.centre_radiance[k] * a);
+            // Lunar disks are refused by `GpuRenderer::render` before this.
+            if let DiskProfile::Emitting {
+                centre_radiance,
+                law,
+            } = &light.disk
+            {
+                for (j, a) in law[k].iter().enumerate() {
+                    set(LIGHT_DISK + j, centre_radiance[k] * a);
+                }
             }
             set(LIGHT_SCALE, scale[k]);
             set(LIGHT_IRRADIANCE, light.irradiance[k]);

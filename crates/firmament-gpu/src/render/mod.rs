@@ -391,6 +391,17 @@ impl GpuRenderer {
             )
             .into());
         }
+        if let Some(i) = (lights.iter()).position(|l| {
+            l.visible_disk && matches!(l.disk, firmament::scene::DiskProfile::Lunar(_))
+        }) {
+            return Err(firmament::Error::invalid(
+                format!("lights[{i}].disk"),
+                "the moon's disk",
+                "disks of self-luminous lights only on the GPU so far (render the moon's disk \
+                 on the CPU with --backend cpu, or hide it; its light is supported)",
+            )
+            .into());
+        }
         let (w, h) = (settings.width, settings.height);
         let limits = ctx.limits();
         let adapter = ctx.adapter_name().to_string();

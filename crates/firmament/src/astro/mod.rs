@@ -8,6 +8,7 @@
 
 pub mod coordinates;
 pub mod moon;
+pub mod photometry;
 pub mod sun;
 pub mod time;
 
@@ -34,21 +35,21 @@ impl Place {
     pub fn new(lat_deg: f64, lon_deg: f64, elevation_m: f64) -> Result<Place> {
         if !(-90.0..=90.0).contains(&lat_deg) {
             return Err(Error::invalid(
-                "lat-deg",
+                "--lat-deg",
                 lat_deg,
                 "between −90 and 90 degrees",
             ));
         }
         if !(-180.0..360.0).contains(&lon_deg) {
             return Err(Error::invalid(
-                "lon-deg",
+                "--lon-deg",
                 lon_deg,
                 "between −180 (inclusive) and 360 (exclusive) degrees, east positive",
             ));
         }
         if !(-500.0..=100_000.0).contains(&elevation_m) {
             return Err(Error::invalid(
-                "elevation-m",
+                "--elevation-m",
                 elevation_m,
                 "between −500 and 100000 m",
             ));
@@ -94,14 +95,14 @@ impl Weather {
     pub fn new(pressure_hpa: f64, temperature_c: f64) -> Result<Weather> {
         if !(pressure_hpa > 0.0 && pressure_hpa <= 2000.0) {
             return Err(Error::invalid(
-                "pressure-hpa",
+                "--pressure-hpa",
                 pressure_hpa,
                 "above 0 and at most 2000 hPa",
             ));
         }
         if !(temperature_c > -273.15 && temperature_c <= 100.0) {
             return Err(Error::invalid(
-                "temperature-c",
+                "--temperature-c",
                 temperature_c,
                 "above −273.15 and at most 100 °C",
             ));
@@ -179,11 +180,11 @@ mod tests {
         assert!(Place::new(91.0, 0.0, 0.0)
             .unwrap_err()
             .to_string()
-            .contains("lat-deg"));
+            .contains("--lat-deg"));
         assert!(Place::new(0.0, 360.0, 0.0)
             .unwrap_err()
             .to_string()
-            .contains("lon-deg"));
+            .contains("--lon-deg"));
         let p = Place::new(0.0, 350.0, 0.0).unwrap();
         assert_eq!(p.lon_east_deg(), -10.0);
         assert!(Weather::new(0.0, 15.0).is_err());

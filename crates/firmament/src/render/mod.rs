@@ -130,11 +130,12 @@ impl<'s> Shader<'s> {
             None => with_channel_buffers(n, |[l, t]| {
                 let disks = (self.disks.iter())
                     .any(|&(i, cos)| ray.dir.dot(scene.lights[i].direction) > cos);
+                let background = scene.background.as_ref();
                 for (j, view) in self.views.iter().enumerate() {
                     let (shadow, _) = self.shadow(ray, view.light(), end, scratch);
                     // The transmittance along the ray (the same for every light) only for a
-                    // disk in view.
-                    let t = if disks && j == 0 {
+                    // disk in view or a background.
+                    let t = if (disks || background.is_some()) && j == 0 {
                         &mut t[..]
                     } else {
                         &mut [][..]
@@ -147,6 +148,12 @@ impl<'s> Shader<'s> {
                 if disks {
                     for &(i, _) in &self.disks {
                         scene.lights[i].add_disk_radiance(ray.dir, t, &mut out[..n]);
+                    }
+                }
+                if let Some(b) = background {
+                    let f = b.factor(ray.origin, ray.dir);
+                    for k in 0..n {
+                        out[k] += b.zenith_radiance[k] * f * t[k];
                     }
                 }
             }),

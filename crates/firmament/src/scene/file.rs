@@ -59,6 +59,43 @@ fn yes() -> bool {
     true
 }
 
+/// Where the observer stands on the Earth (with `[time]`, the sun and the moon follow).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneLocation {
+    /// Latitude (degrees north, [−90, 90]).
+    pub lat_deg: f64,
+    /// Longitude (degrees east, [−180, 360)).
+    pub lon_deg: f64,
+    /// Height above the ellipsoid (m) for the parallax; the camera's altitude is separate.
+    #[serde(default)]
+    pub elevation_m: f64,
+    /// Surface pressure for refraction (hPa).
+    #[serde(default = "standard_pressure")]
+    pub pressure_hpa: f64,
+    /// Surface temperature for refraction (°C).
+    #[serde(default = "standard_temperature")]
+    pub temperature_c: f64,
+}
+
+fn standard_pressure() -> f64 {
+    1013.25
+}
+fn standard_temperature() -> f64 {
+    15.0
+}
+
+/// When: an instant, ISO 8601 with `Z` or an offset.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneTime {
+    /// The instant, e.g. `2026-06-21T16:30:00+02:00`.
+    pub at: String,
+    /// Draw the moon's disk (its light is always there).
+    #[serde(default = "yes")]
+    pub moon_disk: bool,
+}
+
 /// Exposure, tone mapping and files.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -94,10 +131,29 @@ pub struct SceneFile {
     pub camera: Camera,
     /// Image size.
     pub image: SceneImage,
-    /// Sun.
+    /// Sun (from `[time]` and `[location]` when those are given; then `[sun]` may only
+    /// say whether its disk is drawn).
+    #[serde(default)]
     pub sun: SceneSun,
+    /// Where, for `[time]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub location: Option<SceneLocation>,
+    /// When: the sun, the moon and the night sky from the date.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time: Option<SceneTime>,
     /// Output.
     pub output: SceneOutput,
+}
+
+impl Default for SceneSun {
+    /// Low in the west-south-west: late afternoon.
+    fn default() -> Self {
+        SceneSun {
+            zenith_deg: 84.0,
+            azimuth_deg: 250.0,
+            disk: true,
+        }
+    }
 }
 
 impl Default for SceneFile {
@@ -122,11 +178,9 @@ impl Default for SceneFile {
                 width: 1280,
                 height: 720,
             },
-            sun: SceneSun {
-                zenith_deg: 84.0,
-                azimuth_deg: 250.0,
-                disk: true,
-            },
+            sun: SceneSun::default(),
+            location: None,
+            time: None,
             output: SceneOutput {
                 ev100: None,
                 tonemap: ToneCurve::Aces,
@@ -146,6 +200,20 @@ impl SceneFile {
         })?;
         let mut scene: SceneFile = toml::from_str(&text)
             .map_err(|e| Error::Toml(format!("scene {}: {e}", path.display())))?;
+        // The sun's place comes from the date or from the angles, never both.
+        let raw: toml::Table = toml::from_str(&text)
+            .map_err(|e| Error::Toml(format!("scene {}: {e}", path.display())))?;
+        let sun_angles = raw
+            .get("sun")
+            .and_then(|s| s.as_table())
+            .is_some_and(|s| s.contains_key("zenith_deg") || s.contains_key("azimuth_deg"));
+        if scene.time.is_some() && sun_angles {
+            return Err(Error::invalid(
+                "sun.zenith_deg/sun.azimuth_deg",
+                "given with [time]",
+                "either [time] (with [location]) or the sun's angles, not both",
+            ));
+        }
         if let (Some(f), Some(dir)) = (&scene.atmosphere.file, path.parent()) {
             if f.is_relative() {
                 scene.atmosphere.file = Some(dir.join(f));
@@ -153,6 +221,17 @@ impl SceneFile {
         }
         scene.validate()?;
         Ok(scene)
+    }
+
+    /// The sun and the moon of `[time]` at `[location]`, when given.
+    pub fn astro(&self) -> Result<Option<crate::astro::Sky>> {
+        let (Some(t), Some(l)) = (&self.time, &self.location) else {
+            return Ok(None);
+        };
+        let instant = crate::astro::Instant::parse(&t.at, "time.at")?;
+        let place = crate::astro::Place::new(l.lat_deg, l.lon_deg, l.elevation_m)?;
+        let weather = crate::astro::Weather::new(l.pressure_hpa, l.temperature_c)?;
+        crate::astro::Sky::at(instant, place, &weather).map(Some)
     }
 
     /// Check every value; messages name the field.
@@ -189,6 +268,20 @@ impl SceneFile {
                 self.sun.azimuth_deg,
                 "a number in [-360, 360] degrees",
             ));
+        }
+        if let Some(t) = &self.time {
+            crate::astro::Instant::parse(&t.at, "time.at")?;
+            let Some(l) = &self.location else {
+                return Err(Error::invalid(
+                    "location",
+                    "missing",
+                    "a [location] with lat_deg and lon_deg when [time] is given",
+                ));
+            };
+            crate::astro::Place::new(l.lat_deg, l.lon_deg, l.elevation_m)
+                .map_err(|e| e.prefixed("location."))?;
+            crate::astro::Weather::new(l.pressure_hpa, l.temperature_c)
+                .map_err(|e| e.prefixed("location."))?;
         }
         if let Some(ev) = self.output.ev100 {
             if !(ev.is_finite() && (-20.0..=30.0).contains(&ev)) {

@@ -1,12 +1,13 @@
 //! Lights: a direction, an angular radius, a spectral irradiance at the top of the atmosphere
-//! and a radiance profile across the disk. The sun is the first; the moon will be the
-//! second, lighting the same sky tables scaled by its own irradiance.
+//! and a radiance profile across the disk. The sun is the first; the moon ([`super::lunar`])
+//! the second, lighting the same sky tables scaled by its own irradiance.
 
 use std::f64::consts::PI;
 
 use crate::atmosphere::{LimbDarkening, Model};
 use crate::math::sphere::safe_sqrt;
 use crate::math::Vec3;
+use crate::scene::lunar::{lunar_light, LunarDisk, MoonGeometry};
 
 /// A light outside the atmosphere.
 #[derive(Clone, Debug)]
@@ -23,15 +24,19 @@ pub struct Light {
     pub visible_disk: bool,
 }
 
-/// The radiance across a light's disk outside the atmosphere, per channel: the centre's
-/// radiance times a polynomial law in μ, the cosine of the emergence angle on the emitting
-/// sphere (I(μ)/I(1) = max(Σ a_j μ^j, 0)).
+/// The radiance across a light's disk outside the atmosphere, per channel.
 #[derive(Clone, Debug)]
-pub struct DiskProfile {
-    /// Radiance at the disk's centre (W·m⁻²·sr⁻¹·nm⁻¹), per channel.
-    pub centre_radiance: Vec<f64>,
-    /// The law's coefficients a_0 … a_5, per channel.
-    pub law: Vec<[f64; 6]>,
+pub enum DiskProfile {
+    /// A self-luminous sphere (the sun): the centre's radiance times a polynomial law in μ,
+    /// the cosine of the emergence angle (I(μ)/I(1) = max(Σ a_j μ^j, 0)).
+    Emitting {
+        /// Radiance at the disk's centre (W·m⁻²·sr⁻¹·nm⁻¹), per channel.
+        centre_radiance: Vec<f64>,
+        /// The law's coefficients a_0 … a_5, per channel.
+        law: Vec<[f64; 6]>,
+    },
+    /// A sphere lit by the sun (the moon): its phase, terminator and earthshine.
+    Lunar(LunarDisk),
 }
 
 impl Light {
@@ -46,7 +51,7 @@ impl Light {
             direction,
             angular_radius_rad: alpha,
             irradiance: model.solar_irradiance.clone(),
-            disk: DiskProfile {
+            disk: DiskProfile::Emitting {
                 centre_radiance: model
                     .solar_irradiance
                     .iter()
@@ -58,6 +63,19 @@ impl Light {
                     .map(|&l| limb_darkening_coefficients(law, l))
                     .collect(),
             },
+            visible_disk,
+        }
+    }
+
+    /// The moon of `model`'s sun (its spectrum) in the geometry `moon`: irradiance and disk
+    /// from [`lunar_light`].
+    pub fn moon(model: &Model, moon: &MoonGeometry, visible_disk: bool) -> Light {
+        let (irradiance, disk) = lunar_light(model, moon);
+        Light {
+            direction: moon.direction,
+            angular_radius_rad: moon.angular_radius_rad,
+            irradiance,
+            disk: DiskProfile::Lunar(disk),
             visible_disk,
         }
     }
@@ -81,11 +99,20 @@ impl Light {
         if cos_angle <= alpha.cos() {
             return;
         }
-        let x = cos_angle.acos().sin() / alpha.sin();
-        let mu = safe_sqrt(1.0 - x * x);
-        let d = &self.disk;
-        for (k, o) in out.iter_mut().enumerate() {
-            *o += d.centre_radiance[k] * polynomial_law(&d.law[k], mu) * transmittance[k];
+        match &self.disk {
+            DiskProfile::Emitting {
+                centre_radiance,
+                law,
+            } => {
+                let x = cos_angle.acos().sin() / alpha.sin();
+                let mu = safe_sqrt(1.0 - x * x);
+                for (k, o) in out.iter_mut().enumerate() {
+                    *o += centre_radiance[k] * polynomial_law(&law[k], mu) * transmittance[k];
+                }
+            }
+            DiskProfile::Lunar(moon) => {
+                moon.add_radiance(dir, self.direction, alpha, transmittance, out)
+            }
         }
     }
 }

@@ -8,6 +8,8 @@
 pub mod camera;
 pub mod file;
 pub mod light;
+pub mod lunar;
+pub mod sky_lights;
 pub mod surface;
 pub mod volume;
 
@@ -32,6 +34,9 @@ pub struct Scene<'a> {
     pub volumes: Vec<Box<dyn Volume + 'a>>,
     /// Lights.
     pub lights: Vec<Light>,
+    /// A glow from beyond the atmosphere in every direction (the night sky's,
+    /// [`sky_lights::night_sky_background`]), seen through the air.
+    pub background: Option<sky_lights::Background>,
 }
 
 impl<'a> Scene<'a> {
@@ -44,6 +49,7 @@ impl<'a> Scene<'a> {
             surfaces: vec![Box::new(Sphere::ground(model))],
             volumes: Vec::new(),
             lights: vec![Light::sun(model, sun_direction, sun_disk)],
+            background: None,
         }
     }
 
