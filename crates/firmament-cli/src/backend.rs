@@ -12,6 +12,7 @@ use clap::ValueEnum;
 use firmament::atmosphere::Model;
 use firmament::math::Vec3;
 use firmament::render::{Frame, RenderSettings};
+use firmament::scene::sky_lights::Background;
 use firmament::scene::{Light, Scene};
 use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, Tables};
 use firmament_gpu::Precomputer;
@@ -301,16 +302,19 @@ impl<'a> RenderSky<'a> {
     pub fn render(
         &self,
         settings: &RenderSettings,
-        sun: Vec3,
-        sun_disk: bool,
+        lights: &[Light],
+        background: Option<&Background>,
         quiet: bool,
     ) -> Result<Frame> {
         match self {
             RenderSky::Cpu(sky) => {
                 let bar = progress_bar(1000, quiet);
                 bar.set_message("rendering");
+                let mut scene = Scene::clear_sky(sky.as_ref(), Vec3::Z, false);
+                scene.lights = lights.to_vec();
+                scene.background = background.cloned();
                 let frame = firmament::render::render(
-                    &Scene::clear_sky(sky.as_ref(), sun, sun_disk),
+                    &scene,
                     settings,
                     &|f| bar.set_position((f * 1000.0) as u64),
                     Some(cancel_flag()),
@@ -319,16 +323,27 @@ impl<'a> RenderSky<'a> {
                 Ok(frame?)
             }
             RenderSky::Gpu {
-                gpu,
-                sky,
-                sky_model,
-                renderer,
-            } => on_gpu("rendering on the GPU", quiet, || {
-                let lights = [Light::sun(sky_model, sun, sun_disk)];
-                renderer
-                    .render(&gpu.ctx, sky, &lights, settings)
-                    .map_err(|e| gpu_failure("rendering", e))
-            }),
+                gpu, sky, renderer, ..
+            } => {
+                if background.is_some() {
+                    anyhow::bail!(
+                        "the night sky's glow (a --time with the sun below the horizon) is rendered on the CPU only so far: use --backend cpu"
+                    );
+                }
+                on_gpu("rendering on the GPU", quiet, || {
+                    renderer
+                        .render(&gpu.ctx, sky, lights, settings)
+                        .map_err(|e| gpu_failure("rendering", e))
+                })
+            }
+        }
+    }
+
+    /// The model the sky's tables hold (lights are built from it).
+    pub fn model(&self) -> &Model {
+        match self {
+            RenderSky::Cpu(sky) => &sky.model,
+            RenderSky::Gpu { sky_model, .. } => sky_model,
         }
     }
 }

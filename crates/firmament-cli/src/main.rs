@@ -13,7 +13,7 @@ use std::process::ExitCode;
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 
-use commands::{atmosphere, bake, bench, gallery, query, render, validate};
+use commands::{astro, atmosphere, bake, bench, gallery, query, render, validate};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -30,6 +30,8 @@ struct Cli {
 enum Command {
     /// Radiometric answers as JSON: radiance, luminance, transmittance, optical depths, irradiance.
     Query(query::QueryArgs),
+    /// Where the sun and the moon are for a date and a place, and the day's sunrise, sunset and twilights, as JSON.
+    Astro(astro::AstroCommandArgs),
     /// Print or check atmosphere definitions.
     Atmosphere {
         #[command(subcommand)]
@@ -38,7 +40,7 @@ enum Command {
     /// Precompute the tables and write them to a file for `--tables`.
     Bake(bake::BakeArgs),
     /// Render a picture of the sky (with no arguments: a default scene to firmament.png and firmament.exr).
-    Render(render::RenderArgs),
+    Render(Box<render::RenderArgs>),
     /// The canonical views as PNGs with an index.html contact sheet.
     Gallery(gallery::GalleryArgs),
     /// Benchmarks: medians of the precomputation and frame costs.
@@ -51,6 +53,10 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Query(args) => {
             let value = query::run(&args)?;
+            println!("{}", serde_json::to_string_pretty(&value)?);
+        }
+        Command::Astro(args) => {
+            let value = astro::run(&args)?;
             println!("{}", serde_json::to_string_pretty(&value)?);
         }
         Command::Atmosphere { action } => atmosphere::run(&action)?,

@@ -1,6 +1,7 @@
 //! One module per subcommand: its arguments (clap) and its `run`. What several share lives
 //! in [`crate::common`] (atmosphere and tables) and [`crate::backend`] (CPU or GPU).
 
+pub mod astro;
 pub mod atmosphere;
 pub mod bake;
 pub mod bench;

@@ -7,12 +7,14 @@ use anyhow::{Context, Result};
 use clap::Args;
 use firmament::atmosphere::Model;
 use firmament::io::{self, ExrPrecision, OutputFormat};
-use firmament::math::Vec3;
 use firmament::reference::{self, ReferenceSettings};
 use firmament::render::{self, tonemap, RenderSettings, ToneCurve};
+use firmament::scene::file::{SceneLocation, SceneTime};
+use firmament::scene::sky_lights::{lights_of, night_sky_background, Background};
 use firmament::scene::{sun_direction, Light, Projection, SceneFile as Scene};
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
+use crate::commands::astro::AstroArgs;
 use crate::common::{
     cancel_flag, check_output_dir, check_reference_samples, progress_bar, AtmosphereArgs,
 };
@@ -57,6 +59,12 @@ pub struct RenderArgs {
     /// Do not draw the solar disk.
     #[arg(long)]
     pub no_sun_disk: bool,
+    /// A date and a place instead of the sun's angles.
+    #[command(flatten)]
+    pub astro: AstroArgs,
+    /// Do not draw the moon's disk (its light stays).
+    #[arg(long)]
+    pub no_moon_disk: bool,
     /// Embedded preset.
     #[arg(long, conflicts_with = "atmosphere")]
     pub preset: Option<String>,
@@ -170,10 +178,33 @@ fn scene_from_args(args: &RenderArgs) -> Result<Scene> {
             6_360_000.0 + scene.camera.altitude_m,
         );
     }
+    if scene.time.is_some() && (args.sun_zenith_deg.is_some() || args.sun_azimuth_deg.is_some()) {
+        anyhow::bail!(
+            "--sun-zenith-deg/--sun-azimuth-deg cannot be used with the scene file's [time]: the sun follows from the date (use --time to change it)"
+        );
+    }
     set!(args.sun_zenith_deg, scene.sun.zenith_deg);
     set!(args.sun_azimuth_deg, scene.sun.azimuth_deg);
     if args.no_sun_disk {
         scene.sun.disk = false;
+    }
+    if let Some((instant, place, weather)) = args.astro.resolve()? {
+        scene.time = Some(SceneTime {
+            at: instant.utc.to_rfc3339(),
+            moon_disk: true,
+        });
+        scene.location = Some(SceneLocation {
+            lat_deg: place.lat_deg,
+            lon_deg: place.lon_deg,
+            elevation_m: place.elevation_m,
+            pressure_hpa: weather.pressure_hpa,
+            temperature_c: weather.temperature_c,
+        });
+    }
+    if args.no_moon_disk {
+        if let Some(t) = &mut scene.time {
+            t.moon_disk = false;
+        }
     }
     if let Some(p) = &args.preset {
         scene.atmosphere.preset = p.clone();
@@ -232,9 +263,26 @@ fn render_settings(scene: &Scene) -> RenderSettings<'_> {
     }
 }
 
-/// The direction of the scene's sun.
-fn sun_direction_of(scene: &Scene) -> Vec3 {
-    sun_direction(scene.sun.zenith_deg, scene.sun.azimuth_deg)
+/// The scene's lights and background: from `[time]` at `[location]` when given (the sun,
+/// the moon above the horizon, the night sky's glow while the sun is down), else its sun.
+pub fn lights_of_scene(model: &Model, scene: &Scene) -> Result<(Vec<Light>, Option<Background>)> {
+    Ok(match scene.astro()? {
+        Some(sky) => {
+            let moon_disk = scene.time.as_ref().is_none_or(|t| t.moon_disk);
+            let lights = lights_of(model, &sky, scene.sun.disk, moon_disk);
+            // Above the horizon the glow is under 10⁻⁶ of the sky's radiance.
+            let night = 90.0 - sky.sun.apparent_zenith_deg < -0.833;
+            (lights, night.then(|| night_sky_background(model)))
+        }
+        None => (
+            vec![Light::sun(
+                model,
+                sun_direction(scene.sun.zenith_deg, scene.sun.azimuth_deg),
+                scene.sun.disk,
+            )],
+            None,
+        ),
+    })
 }
 
 /// The scene's EV100, or the automatic exposure of the frame.
@@ -247,13 +295,9 @@ fn ev100(scene: &Scene, frame: &render::Frame) -> f64 {
 
 /// Render the scene with a sky on its backend; returns the frame and the EV100 used.
 pub fn render_scene(sky: &RenderSky, scene: &Scene, quiet: bool) -> Result<(render::Frame, f64)> {
+    let (lights, background) = lights_of_scene(sky.model(), scene)?;
     let frame = sky
-        .render(
-            &render_settings(scene),
-            sun_direction_of(scene),
-            scene.sun.disk,
-            quiet,
-        )
+        .render(&render_settings(scene), &lights, background.as_ref(), quiet)
         .context("rendering")?;
     let ev100 = ev100(scene, &frame);
     Ok((frame, ev100))
@@ -306,14 +350,20 @@ fn render_scene_reference(
     quiet: bool,
 ) -> Result<(render::Frame, f64)> {
     check_reference_samples(samples)?;
-    let sun = Light::sun(model, sun_direction_of(scene), scene.sun.disk);
+    let (lights, background) = lights_of_scene(model, scene)?;
+    if lights.len() > 1 || background.is_some() {
+        anyhow::bail!(
+            "`--method reference` traces the sun's light only so far: a --time with the moon up or the sun down is not supported with it"
+        );
+    }
+    let sun = &lights[0];
     let bar = progress_bar(1000, quiet);
     bar.set_message(format!("reference, {samples} paths/λ"));
     let result = reference::render_frame(
         model,
         &[],
         &render_settings(scene),
-        &sun,
+        sun,
         &ReferenceSettings::with_samples(samples),
         &|f| bar.set_position((f * 1000.0) as u64),
         Some(cancel_flag()),
