@@ -457,6 +457,60 @@ def gen_sun_events(eph, ts):
     return rows
 
 
+# --------------------------------------------------------------------------------------
+# 4. Bright stars
+# --------------------------------------------------------------------------------------
+
+# (time, lat, lon): a January midnight at 60° N (Sirius, Polaris and Vega all up), winter
+# evenings in the Alps, a summer night in Arizona, a southern autumn evening.
+STAR_CASES = [
+    ("2026-01-15T23:30:00Z", 60.0, 10.0),
+    ("2026-01-15T21:00:00Z", 46.5, 8.0),
+    ("2026-01-15T03:00:00Z", 46.5, 8.0),
+    ("1990-07-01T22:00:00Z", 35.0, -110.0),
+    ("2040-03-20T18:00:00Z", -33.9, 18.4),
+]
+STAR_NAMES = ["Sirius", "Vega", "Polaris", "Betelgeuse", "Canopus", "Arcturus"]
+
+
+def gen_stars(eph, ts):
+    """Apparent topocentric places of named stars from firmament's own catalogue values
+    (crates/firmament/data/stars.csv: ICRS J2000 position and proper motion) computed by
+    skyfield (precession-nutation, aberration, light deflection; no refraction)."""
+    from skyfield.api import Star
+
+    catalogue = {}
+    with open(os.path.join(ROOT, "crates", "firmament", "data", "stars.csv")) as f:
+        lines = [l for l in f if not l.startswith("#")]
+    header = lines[0].strip().split(",")
+    for line in lines[1:]:
+        row = dict(zip(header, line.rstrip("\n").split(",")))
+        if row["name"] in STAR_NAMES and row["name"] not in catalogue:
+            catalogue[row["name"]] = row
+    earth = eph["earth"]
+    rows = []
+    for when, lat, lon in STAR_CASES:
+        t = ts.from_datetime(parse_utc(when))
+        observer = earth + wgs84.latlon(lat, lon)
+        for name in STAR_NAMES:
+            c = catalogue[name]
+            star = Star(ra_hours=float(c["ra_deg"]) / 15.0, dec_degrees=float(c["dec_deg"]),
+                        ra_mas_per_year=float(c["pm_ra_mas_yr"]),
+                        dec_mas_per_year=float(c["pm_dec_mas_yr"]), epoch=ts.tt(2000, 1, 1, 12))
+            alt, az, _ = observer.at(t).observe(star).apparent().altaz()
+            rows.append([when, f"{lat:.6f}", f"{lon:.6f}", name, c["vmag"], c["b_v"],
+                         f"{float(t.delta_t):.4f}", f"{float(t.dut1):.4f}",
+                         f"{alt.degrees:.6f}", f"{az.degrees:.6f}"])
+    source = skyfield_source(ts) + [
+        "stars: skyfield Star(ra, dec, proper motion, epoch J2000.0 TT) from the rows of "
+        "crates/firmament/data/stars.csv; (earth + wgs84.latlon(lat, lon)).at(t).observe(star)"
+        ".apparent().altaz(): geometric altitude (no refraction), azimuth clockwise from north",
+    ]
+    write_csv("stars.csv", source,
+              ["time_utc", "lat_deg", "lon_deg", "name", "vmag", "b_v", "delta_t_s",
+               "ut1_minus_utc_s", "altitude_deg", "azimuth_deg"], rows)
+
+
 def summarize_moon(header, rows):
     col = {name: i for i, name in enumerate(header)}
     alt = np.array([float(r[col["altitude_deg"]]) for r in rows])
@@ -474,6 +528,7 @@ def main():
     header, rows = gen_moon(eph, ts)
     summarize_moon(header, rows)
     gen_sun_events(eph, ts)
+    gen_stars(eph, ts)
 
 
 if __name__ == "__main__":

@@ -12,8 +12,8 @@ use clap::ValueEnum;
 use firmament::atmosphere::Model;
 use firmament::math::Vec3;
 use firmament::render::{Frame, RenderSettings};
-use firmament::scene::sky_lights::Background;
-use firmament::scene::{Light, Scene};
+use firmament::scene::sky_lights::SkySources;
+use firmament::scene::Scene;
 use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, Tables};
 use firmament_gpu::Precomputer;
 use firmament_gpu::{GpuContext, GpuError, GpuRenderer, GpuSky};
@@ -302,8 +302,7 @@ impl<'a> RenderSky<'a> {
     pub fn render(
         &self,
         settings: &RenderSettings,
-        lights: &[Light],
-        background: Option<&Background>,
+        sources: &SkySources,
         quiet: bool,
     ) -> Result<Frame> {
         match self {
@@ -311,8 +310,9 @@ impl<'a> RenderSky<'a> {
                 let bar = progress_bar(1000, quiet);
                 bar.set_message("rendering");
                 let mut scene = Scene::clear_sky(sky.as_ref(), Vec3::Z, false);
-                scene.lights = lights.to_vec();
-                scene.background = background.cloned();
+                scene.lights = sources.lights.clone();
+                scene.background = sources.background.clone();
+                scene.stars = sources.stars.clone();
                 let frame = firmament::render::render(
                     &scene,
                     settings,
@@ -325,14 +325,14 @@ impl<'a> RenderSky<'a> {
             RenderSky::Gpu {
                 gpu, sky, renderer, ..
             } => {
-                if background.is_some() {
+                if sources.background.is_some() || !sources.stars.is_empty() {
                     anyhow::bail!(
-                        "the night sky's glow (a --time with the sun below the horizon) is rendered on the CPU only so far: use --backend cpu"
+                        "the night sky's glow and the stars (a --time with the sun below the horizon) are rendered on the CPU only so far: use --backend cpu"
                     );
                 }
                 on_gpu("rendering on the GPU", quiet, || {
                     renderer
-                        .render(&gpu.ctx, sky, lights, settings)
+                        .render(&gpu.ctx, sky, &sources.lights, settings)
                         .map_err(|e| gpu_failure("rendering", e))
                 })
             }

@@ -163,3 +163,30 @@ fn sunrise_sunset_and_twilights_match_the_ephemeris() {
     }
     eprintln!("sun events, worst |Δt| {worst:.1} s");
 }
+
+#[test]
+fn stars_match_the_ephemeris() {
+    use firmament::astro::stars::{catalogue, star_place};
+    let cases = rows(include_str!("data/astro/stars.csv"));
+    let mut worst = 0.0f64;
+    for c in &cases {
+        let ut1 = time(c, "time_utc")
+            + Duration::microseconds((num(c, "ut1_minus_utc_s") * 1e6).round() as i64);
+        let instant = Instant::with_delta_t(ut1, num(c, "delta_t_s"));
+        let place = Place::new(num(c, "lat_deg"), num(c, "lon_deg"), 0.0).unwrap();
+        let star = catalogue().iter().find(|s| s.name == c["name"]).unwrap();
+        let p = star_place(star, &instant, &place, &Weather::default());
+        let d_alt = (p.altitude_deg - num(c, "altitude_deg")).abs();
+        let d_az = angle_diff(p.azimuth_deg, num(c, "azimuth_deg")).abs()
+            * num(c, "altitude_deg").to_radians().cos();
+        worst = worst.max(d_alt).max(d_az);
+        // Nutation (≤ 17″) and aberration (≤ 20.5″) are left out: at most ~0.011°.
+        assert!(
+            d_alt < 0.012 && d_az < 0.012,
+            "{} {}: {d_alt:.4}° {d_az:.4}°",
+            c["time_utc"],
+            c["name"]
+        );
+    }
+    eprintln!("stars, worst |Δ| {worst:.4}° on the sky");
+}

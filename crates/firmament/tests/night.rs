@@ -5,11 +5,14 @@ use std::sync::OnceLock;
 
 use chrono::{DateTime, Utc};
 use firmament::astro::photometry::luminance_from_surface_brightness;
+use firmament::astro::refraction_deg;
 use firmament::astro::{Instant, Place, Sky, Weather};
 use firmament::atmosphere::Atmosphere;
 use firmament::math::Vec3;
+use firmament::render::{self, RenderSettings};
 use firmament::render::{ShadeScratch, Shader};
-use firmament::scene::sky_lights::{lights_of, night_sky_background};
+use firmament::scene::sky_lights::{lights_of, night_sky_background, sources_of};
+use firmament::scene::{Camera, Projection};
 use firmament::scene::{Ray, Scene, Sphere};
 use firmament::sky::bruneton4d::{Bruneton4d, MieStorage, TableConfig, TableSizes, Tables};
 use firmament::sky::SkyMethod;
@@ -55,6 +58,7 @@ fn night_scene<'a>(method: &'a Bruneton4d, sky: &Sky) -> Scene<'a> {
         volumes: Vec::new(),
         lights: lights_of(model, sky, true, true),
         background: Some(night_sky_background(model)),
+        stars: Vec::new(),
     }
 }
 
@@ -166,4 +170,131 @@ fn the_moons_disk_shows_its_phase() {
         dark < 1e-2 * lit && dark > sky_beside,
         "{dark} vs {sky_beside}"
     );
+}
+
+#[test]
+fn sirius_vega_and_polaris_land_on_their_pixels_with_their_brightness_and_colours() {
+    // 2026-01-15 23:30 UTC from 60° N, 10° E: all three up (positions from skyfield in
+    // tests/data/astro/stars.csv, independent of our astronomy).
+    let utc: DateTime<Utc> = "2026-01-15T23:30:00Z".parse().unwrap();
+    let weather = Weather::default();
+    let astro = Sky::at(
+        Instant::from_utc(utc).unwrap(),
+        Place::new(60.0, 10.0, 0.0).unwrap(),
+        &weather,
+    )
+    .unwrap();
+    let method = sky();
+    let model = method.model();
+    let sources = sources_of(model, &astro, true, true);
+    assert!(
+        sources.stars.len() > 3000,
+        "{} stars up",
+        sources.stars.len()
+    );
+    let mut scene = night_scene(method, &astro);
+    scene.stars = sources.stars;
+    let size = 512;
+    let camera = Camera {
+        projection: Projection::Fisheye,
+        altitude_m: 2.0,
+        heading_deg: 0.0,
+        pitch_deg: 0.0,
+        roll_deg: 0.0,
+        fov_deg: 60.0,
+    };
+    let settings = RenderSettings {
+        camera: &camera,
+        width: size,
+        height: size,
+        white_balance: false,
+    };
+    let frame = render::render(&scene, &settings, &|_| {}, None).unwrap();
+    let prepared = camera.prepare(model.bottom_radius_m, size, size);
+    let cases = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/astro/stars.csv"
+    ))
+    .unwrap();
+    let mut found = std::collections::HashMap::new();
+    for line in cases
+        .lines()
+        .filter(|l| l.starts_with("2026-01-15T23:30:00Z"))
+    {
+        let f: Vec<&str> = line.split(',').collect();
+        let (name, alt, az): (&str, f64, f64) =
+            (f[3], f[8].parse().unwrap(), f[9].parse().unwrap());
+        if alt < 5.0 {
+            continue;
+        }
+        // The equidistant fisheye (zenith at the centre, north up, east left), written
+        // out here rather than taken from the camera code.
+        let zenith = (90.0 - alt - refraction_deg(alt, &weather)).to_radians();
+        let rho = zenith / (std::f64::consts::PI / 2.0);
+        let (x, y) = (-rho * az.to_radians().sin(), rho * az.to_radians().cos());
+        let (ex, ey) = ((x + 1.0) / 2.0 * size as f64, (1.0 - y) / 2.0 * size as f64);
+        // The star's light: the sum over a 5×5 window of (pixel − the window's median
+        // border) × its solid angle, and its centroid.
+        let (cx, cy) = (ex.floor() as i64, ey.floor() as i64);
+        let px = |x: i64, y: i64| frame.image.data[y as usize * size + x as usize];
+        let lum = |p: [f32; 3]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
+        let mut border: Vec<[f32; 3]> = Vec::new();
+        for d in -3..=3 {
+            border.extend([
+                px(cx + d, cy - 3),
+                px(cx + d, cy + 3),
+                px(cx - 3, cy + d),
+                px(cx + 3, cy + d),
+            ]);
+        }
+        border.sort_by(|a, b| lum(*a).total_cmp(&lum(*b)));
+        let bg = border[border.len() / 2];
+        let (mut flux, mut mx, mut my) = ([0.0f64; 3], 0.0, 0.0);
+        for dy in -2..=2 {
+            for dx in -2..=2 {
+                let (x, y) = (cx + dx, cy + dy);
+                let omega = prepared.pixel_solid_angle(x as usize, y as usize);
+                let p = px(x, y);
+                let e: Vec<f64> = (0..3)
+                    .map(|i| ((p[i] - bg[i]) as f64).max(0.0) * omega)
+                    .collect();
+                let l = 0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2];
+                mx += l * (x as f64 + 0.5);
+                my += l * (y as f64 + 0.5);
+                for i in 0..3 {
+                    flux[i] += e[i];
+                }
+            }
+        }
+        let total = 0.2126 * flux[0] + 0.7152 * flux[1] + 0.0722 * flux[2];
+        let (mx, my) = (mx / total, my / total);
+        assert!(
+            (mx - ex).hypot(my - ey) < 0.75,
+            "{name}: centroid ({mx:.2}, {my:.2}), expected ({ex:.2}, {ey:.2})"
+        );
+        // Blue/red outside the air: the rendered colour over the transmittance at the
+        // red and blue samples of the RGB grid (680 and 440 nm).
+        let dir = firmament::astro::local_direction(zenith.to_degrees(), az);
+        let (mut l, mut t) = (vec![0.0; 3], vec![0.0; 3]);
+        let origin = Vec3::new(0.0, 0.0, model.bottom_radius_m + 2.0);
+        let view = method.view(origin, &scene.lights[0]);
+        view.sky_radiance(dir, firmament::sky::Shadow::None, &mut l, &mut t);
+        let outside = (flux[2] / t[2]) / (flux[0] / t[0]);
+        found.insert(name.to_string(), (total, flux[2] / flux[0], outside));
+    }
+    let (sirius, vega, polaris) = (found["Sirius"], found["Vega"], found["Polaris"]);
+    let betelgeuse = found["Betelgeuse"];
+    eprintln!("illuminance (lx), blue/red in the image and outside the air: Sirius {sirius:?}, Vega {vega:?}, Polaris {polaris:?}, Betelgeuse {betelgeuse:?}");
+    // Brightness: Sirius (−1.44, 12° up) > Vega (0.03, 10°) > Polaris (1.97, 60°); Sirius
+    // outside the air gives 10^(−0.4(−1.44 + 13.98)) = 9.7·10⁻⁶ lx, dimmed by 12° of air.
+    assert!(sirius.0 > vega.0 && vega.0 > polaris.0);
+    assert!(sirius.0 > 2e-6 && sirius.0 < 9.7e-6, "{}", sirius.0);
+    // Polaris at 60°: 10^(−0.4(1.97 + 13.98)) = 4.2·10⁻⁷ lx × about 0.8.
+    assert!((polaris.0 / 4.2e-7 - 0.8).abs() < 0.15, "{}", polaris.0);
+    // Colours outside the air: blue-white Sirius and Vega (B−V ≈ 0), yellow-white Polaris
+    // (0.64), orange Betelgeuse (1.5).
+    assert!(sirius.2 > polaris.2 && vega.2 > polaris.2 && polaris.2 > betelgeuse.2);
+    assert!((sirius.2 / vega.2 - 1.0).abs() < 0.1);
+    // In the image, low Sirius is reddened by 12° of air, and red Betelgeuse stays reddest.
+    assert!(sirius.1 < sirius.2 && betelgeuse.1 < vega.1.min(polaris.1));
 }

@@ -10,7 +10,7 @@ use firmament::io::{self, ExrPrecision, OutputFormat};
 use firmament::reference::{self, ReferenceSettings};
 use firmament::render::{self, tonemap, RenderSettings, ToneCurve};
 use firmament::scene::file::{SceneLocation, SceneTime};
-use firmament::scene::sky_lights::{lights_of, night_sky_background, Background};
+use firmament::scene::sky_lights::{sources_of, SkySources};
 use firmament::scene::{sun_direction, Light, Projection, SceneFile as Scene};
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
@@ -263,25 +263,22 @@ fn render_settings(scene: &Scene) -> RenderSettings<'_> {
     }
 }
 
-/// The scene's lights and background: from `[time]` at `[location]` when given (the sun,
-/// the moon above the horizon, the night sky's glow while the sun is down), else its sun.
-pub fn lights_of_scene(model: &Model, scene: &Scene) -> Result<(Vec<Light>, Option<Background>)> {
+/// The scene's lights, glow and stars: from `[time]` at `[location]` when given, else its
+/// sun.
+pub fn sources_of_scene(model: &Model, scene: &Scene) -> Result<SkySources> {
     Ok(match scene.astro()? {
         Some(sky) => {
             let moon_disk = scene.time.as_ref().is_none_or(|t| t.moon_disk);
-            let lights = lights_of(model, &sky, scene.sun.disk, moon_disk);
-            // Above the horizon the glow is under 10⁻⁶ of the sky's radiance.
-            let night = 90.0 - sky.sun.apparent_zenith_deg < -0.833;
-            (lights, night.then(|| night_sky_background(model)))
+            sources_of(model, &sky, scene.sun.disk, moon_disk)
         }
-        None => (
-            vec![Light::sun(
+        None => SkySources {
+            lights: vec![Light::sun(
                 model,
                 sun_direction(scene.sun.zenith_deg, scene.sun.azimuth_deg),
                 scene.sun.disk,
             )],
-            None,
-        ),
+            ..SkySources::default()
+        },
     })
 }
 
@@ -295,9 +292,9 @@ fn ev100(scene: &Scene, frame: &render::Frame) -> f64 {
 
 /// Render the scene with a sky on its backend; returns the frame and the EV100 used.
 pub fn render_scene(sky: &RenderSky, scene: &Scene, quiet: bool) -> Result<(render::Frame, f64)> {
-    let (lights, background) = lights_of_scene(sky.model(), scene)?;
+    let sources = sources_of_scene(sky.model(), scene)?;
     let frame = sky
-        .render(&render_settings(scene), &lights, background.as_ref(), quiet)
+        .render(&render_settings(scene), &sources, quiet)
         .context("rendering")?;
     let ev100 = ev100(scene, &frame);
     Ok((frame, ev100))
@@ -350,8 +347,9 @@ fn render_scene_reference(
     quiet: bool,
 ) -> Result<(render::Frame, f64)> {
     check_reference_samples(samples)?;
-    let (lights, background) = lights_of_scene(model, scene)?;
-    if lights.len() > 1 || background.is_some() {
+    let sources = sources_of_scene(model, scene)?;
+    let lights = &sources.lights;
+    if lights.len() > 1 || sources.background.is_some() {
         anyhow::bail!(
             "`--method reference` traces the sun's light only so far: a --time with the moon up or the sun down is not supported with it"
         );

@@ -9,6 +9,7 @@
 pub mod coordinates;
 pub mod moon;
 pub mod photometry;
+pub mod stars;
 pub mod sun;
 pub mod time;
 
@@ -134,6 +135,8 @@ pub struct Sky {
     pub instant: Instant,
     /// The place.
     pub place: Place,
+    /// The air, for refraction.
+    pub weather: Weather,
     /// The sun.
     pub sun: SunPosition,
     /// The moon.
@@ -148,6 +151,7 @@ impl Sky {
         Ok(Sky {
             instant,
             place,
+            weather: *weather,
             sun,
             moon,
         })

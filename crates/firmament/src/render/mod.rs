@@ -8,6 +8,7 @@
 //! the lights for their disks. A second surface or light needs no change here.
 
 pub mod frame;
+mod stars;
 pub mod tonemap;
 mod volumes;
 
@@ -239,6 +240,18 @@ pub fn render(
         });
     if interrupted.load(Ordering::Relaxed) {
         return Err(Error::Interrupted);
+    }
+    if let (false, Some(view)) = (scene.stars.is_empty(), shader.views.first()) {
+        stars::draw_stars(
+            scene,
+            view.as_ref(),
+            &prepared,
+            observer,
+            &colour,
+            balance,
+            &mut image,
+            &mask,
+        );
     }
     Ok(Frame { image, mask })
 }

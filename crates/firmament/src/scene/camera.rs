@@ -247,6 +247,93 @@ impl PreparedCamera {
     }
 }
 
+impl PreparedCamera {
+    /// The continuous pixel position (pixel centres at +0.5) that sees direction `dir`
+    /// (unit, local frame): the inverse of [`PreparedCamera::ray`]. None outside the image.
+    pub fn pixel_of(&self, dir: Vec3) -> Option<(f64, f64)> {
+        let (w, h) = (self.width as f64, self.height as f64);
+        let (u, v) = match self.camera.projection {
+            Projection::Perspective | Projection::Orbit => {
+                let f = dir.dot(self.forward);
+                if f <= 0.0 {
+                    return None;
+                }
+                let t = self.tan_half_fov;
+                (
+                    dir.dot(self.right) / (f * t * w / h),
+                    dir.dot(self.up) / (f * t),
+                )
+            }
+            Projection::Fisheye => {
+                let zenith = dir.z.clamp(-1.0, 1.0).acos();
+                let rho = zenith / (PI / 2.0);
+                if rho > 1.0 {
+                    return None;
+                }
+                let s = zenith.sin();
+                let (x, y) = if s > 0.0 {
+                    (-rho * dir.x / s, rho * dir.y / s)
+                } else {
+                    (0.0, 0.0)
+                };
+                let aspect = w / h;
+                if aspect >= 1.0 {
+                    (x / aspect, y)
+                } else {
+                    (x, y * aspect)
+                }
+            }
+            Projection::Equirect => (
+                dir.x.atan2(dir.y) / PI,
+                dir.z.clamp(-1.0, 1.0).asin() / (PI / 2.0),
+            ),
+            Projection::Cubemap => {
+                // The face of the major axis; cube_direction solved for (u, v).
+                let a = dir.abs();
+                let (face, fu, fv) = if a.x >= a.y && a.x >= a.z {
+                    if dir.x > 0.0 {
+                        (0, -dir.y / a.x, dir.z / a.x)
+                    } else {
+                        (1, dir.y / a.x, dir.z / a.x)
+                    }
+                } else if a.y >= a.z {
+                    if dir.y > 0.0 {
+                        (2, dir.x / a.y, dir.z / a.y)
+                    } else {
+                        (3, -dir.x / a.y, dir.z / a.y)
+                    }
+                } else if dir.z > 0.0 {
+                    (4, -dir.x / a.z, dir.y / a.z)
+                } else {
+                    (5, dir.x / a.z, dir.y / a.z)
+                };
+                let face_w = w / 6.0;
+                let px = face as f64 * face_w + (fu + 1.0) / 2.0 * face_w;
+                return Some((px, (1.0 - fv) / 2.0 * h));
+            }
+        };
+        if u.abs() > 1.0 || v.abs() > 1.0 {
+            return None;
+        }
+        Some(((u + 1.0) / 2.0 * w, (1.0 - v) / 2.0 * h))
+    }
+
+    /// Solid angle (sr) seen by pixel (x, y), from the rays through its edges' midpoints.
+    pub fn pixel_solid_angle(&self, x: usize, y: usize) -> f64 {
+        let (cx, cy) = (x as f64 + 0.5, y as f64 + 0.5);
+        let d = |px: f64, py: f64| self.ray(px, py).map(|r| r.dir);
+        match (
+            d(cx - 0.5, cy),
+            d(cx + 0.5, cy),
+            d(cx, cy - 0.5),
+            d(cx, cy + 0.5),
+        ) {
+            (Some(l), Some(r), Some(t), Some(b)) => (r - l).cross(b - t).length(),
+            _ => 0.0,
+        }
+    }
+}
+
 /// Vertical field of view (degrees) that frames a sphere of `radius_m` seen from
 /// `distance_m` from its centre with a 15 % margin (120° when the camera is too close).
 pub fn orbit_fit_fov_deg(radius_m: f64, distance_m: f64) -> f64 {
@@ -267,5 +354,53 @@ pub fn cube_direction(face: usize, u: f64, v: f64) -> Vec3 {
         3 => Vec3::new(-u, -1.0, v), // −Y south: right is west
         4 => Vec3::new(-u, v, 1.0),  // +Z up, north at the top: right is west
         _ => Vec3::new(u, v, -1.0),  // −Z down, north at the top: right is east
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pixel_of_inverts_ray_for_every_projection() {
+        for (projection, w, h) in [
+            (Projection::Perspective, 320, 200),
+            (Projection::Fisheye, 256, 256),
+            (Projection::Equirect, 400, 200),
+            (Projection::Cubemap, 600, 100),
+        ] {
+            let camera = Camera {
+                projection,
+                altitude_m: 10.0,
+                heading_deg: 30.0,
+                pitch_deg: 10.0,
+                roll_deg: 5.0,
+                fov_deg: 60.0,
+            };
+            let p = camera.prepare(6_360_000.0, w, h);
+            for (px, py) in [(10.3, 20.7), (w as f64 * 0.6, h as f64 * 0.45), (5.5, 90.2)] {
+                let Some(ray) = p.ray(px, py) else { continue };
+                let (qx, qy) = p.pixel_of(ray.dir).unwrap();
+                assert!(
+                    (qx - px).abs() < 1e-6 && (qy - py).abs() < 1e-6,
+                    "{projection:?}: ({px}, {py}) → ({qx}, {qy})"
+                );
+            }
+        }
+        // A fisheye's pixels tile the upper hemisphere: their solid angles sum to 2π.
+        let camera = Camera {
+            projection: Projection::Fisheye,
+            altitude_m: 0.0,
+            heading_deg: 0.0,
+            pitch_deg: 0.0,
+            roll_deg: 0.0,
+            fov_deg: 60.0,
+        };
+        let p = camera.prepare(6_360_000.0, 200, 200);
+        let sum: f64 = (0..200)
+            .flat_map(|y| (0..200).map(move |x| (x, y)))
+            .map(|(x, y)| p.pixel_solid_angle(x, y))
+            .sum();
+        assert!((sum / (2.0 * PI) - 1.0).abs() < 0.02, "{sum}");
     }
 }

@@ -37,6 +37,8 @@ pub struct Scene<'a> {
     /// A glow from beyond the atmosphere in every direction (the night sky's,
     /// [`sky_lights::night_sky_background`]), seen through the air.
     pub background: Option<sky_lights::Background>,
+    /// Point lights outside the atmosphere drawn into images (the stars), seen through it.
+    pub stars: Vec<sky_lights::PointSource>,
 }
 
 impl<'a> Scene<'a> {
@@ -50,6 +52,7 @@ impl<'a> Scene<'a> {
             volumes: Vec::new(),
             lights: vec![Light::sun(model, sun_direction, sun_disk)],
             background: None,
+            stars: Vec::new(),
         }
     }
 

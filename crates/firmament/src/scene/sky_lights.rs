@@ -1,5 +1,9 @@
 //! The lights of a date and a place: the sun and the moon where [`crate::astro`] puts them,
-//! and the natural night sky's background glow.
+//! the stars of the catalogue, and the natural night sky's background glow.
+//!
+//! Stars: each a point of spectral irradiance outside the atmosphere, a Planck spectrum at
+//! the temperature of its B−V (Ballesteros 2012) scaled to the illuminance of its V
+//! magnitude (zero point in [`crate::astro::photometry`]).
 //!
 //! The background (integrated starlight, zodiacal light, airglow) is a uniform radiance
 //! outside the atmosphere seen through the atmosphere's transmittance, with the solar
@@ -13,7 +17,11 @@
 //! colour is the solar shape here) and the glow scattered by the air itself, which is why
 //! the last degrees above the horizon come out darker than a real night sky.
 
-use crate::astro::photometry::{luminance_from_surface_brightness, scale_to_illuminance};
+use crate::astro::photometry::{
+    illuminance_from_magnitude_lx, luminance_from_surface_brightness, planck_shape,
+    scale_to_illuminance, temperature_from_b_v,
+};
+use crate::astro::stars::{catalogue, star_place};
 use crate::astro::sun::ASTRONOMICAL_UNIT_M;
 use crate::astro::Sky;
 use crate::atmosphere::Model;
@@ -104,4 +112,66 @@ pub fn lights_of(model: &Model, sky: &Sky, sun_disk: bool, moon_disk: bool) -> V
         lights.push(Light::moon(model, &moon_geometry(sky), moon_disk));
     }
     lights
+}
+
+/// A point light outside the atmosphere: a star.
+#[derive(Clone, Debug)]
+pub struct PointSource {
+    /// Unit vector towards it (local frame, refracted).
+    pub direction: Vec3,
+    /// Spectral irradiance per channel outside the atmosphere (W·m⁻²·nm⁻¹).
+    pub irradiance: Vec<f64>,
+}
+
+/// The catalogue's stars above the horizon (apparent altitude > −1°) of `sky`, for
+/// `model`'s wavelengths.
+pub fn stars_of(model: &Model, sky: &Sky) -> Vec<PointSource> {
+    let nm = model.wavelengths.nm();
+    let colour = ColourMatrix::new(nm);
+    catalogue()
+        .iter()
+        .filter_map(|star| {
+            let p = star_place(star, &sky.instant, &sky.place, &sky.weather);
+            if p.apparent_zenith_deg > 91.0 {
+                return None;
+            }
+            let t = temperature_from_b_v(star.b_v);
+            let shape: Vec<f64> = nm.iter().map(|&l| planck_shape(l, t)).collect();
+            Some(PointSource {
+                direction: crate::astro::local_direction(p.apparent_zenith_deg, p.azimuth_deg),
+                irradiance: scale_to_illuminance(
+                    &shape,
+                    &colour,
+                    illuminance_from_magnitude_lx(star.vmag),
+                ),
+            })
+        })
+        .collect()
+}
+
+/// Everything a date and a place light a scene with.
+#[derive(Clone, Debug, Default)]
+pub struct SkySources {
+    /// The sun, and the moon when up.
+    pub lights: Vec<Light>,
+    /// The night sky's glow, while the sun is down.
+    pub background: Option<Background>,
+    /// The stars, while the sun is down.
+    pub stars: Vec<PointSource>,
+}
+
+/// The sources of `sky` for `model`: [`lights_of`], and at night (the sun's upper limb
+/// below the horizon, −0.833°) the glow and the stars; by day both are under 10⁻⁶ of the
+/// sky's radiance.
+pub fn sources_of(model: &Model, sky: &Sky, sun_disk: bool, moon_disk: bool) -> SkySources {
+    let night = 90.0 - sky.sun.apparent_zenith_deg < -0.833;
+    SkySources {
+        lights: lights_of(model, sky, sun_disk, moon_disk),
+        background: night.then(|| night_sky_background(model)),
+        stars: if night {
+            stars_of(model, sky)
+        } else {
+            Vec::new()
+        },
+    }
 }
