@@ -9,6 +9,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use clap::Args;
 use firmament::scene::camera::orbit_fit_fov_deg;
+use firmament::scene::file::{SceneLocation, SceneTime};
 use firmament::scene::{Camera, Projection, SceneFile as Scene};
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
@@ -46,6 +47,10 @@ struct View {
     size: (usize, usize),
     /// Added to the automatic exposure (stops darker), for views whose bright part is small.
     ev_offset: f64,
+    /// A date and a place (ISO 8601, latitude, longitude) instead of `sun`.
+    when: Option<(&'static str, f64, f64)>,
+    /// A time-lapse strip: this many frames side by side, this many minutes apart.
+    strip: Option<(usize, i64)>,
 }
 
 fn views(width: usize) -> Vec<View> {
@@ -60,16 +65,54 @@ fn views(width: usize) -> Vec<View> {
     };
     use Projection::*;
     vec![
-        View { name: "noon", title: "Noon from the ground, looking north (sun 60° high in the south)", camera: cam(Perspective, 2.0, 0.0, 12.0, 80.0), sun: (30.0, 180.0), size: (width, h), ev_offset: 0.0 },
-        View { name: "afternoon", title: "Afternoon, facing the sun (30° high)", camera: cam(Perspective, 2.0, 240.0, 12.0, 80.0), sun: (60.0, 240.0), size: (width, h), ev_offset: 0.0 },
-        View { name: "sunset", title: "Sunset (sun 1° high in the west)", camera: cam(Perspective, 2.0, 270.0, 6.0, 80.0), sun: (89.0, 270.0), size: (width, h), ev_offset: 0.0 },
-        View { name: "twilight", title: "Twilight, facing east away from the sun 4° below the horizon: Earth's shadow and the Belt of Venus", camera: cam(Perspective, 2.0, 90.0, 8.0, 80.0), sun: (94.0, 270.0), size: (width, h), ev_offset: 0.0 },
-        View { name: "altitude-10km", title: "From 10 km, looking down the aerial perspective", camera: cam(Perspective, 10_000.0, 200.0, -8.0, 80.0), sun: (50.0, 160.0), size: (width, h), ev_offset: 0.0 },
-        View { name: "low-orbit", title: "From low orbit (400 km), the limb with the sun low", camera: cam(Perspective, 400_000.0, 90.0, -17.0, 60.0), sun: (75.0, 90.0), size: (width, h), ev_offset: 0.0 },
-        View { ev_offset: 1.5, name: "planet", title: "The whole planet from 30 000 km: limb, terminator, night side", camera: cam(Orbit, 30_000_000.0, 0.0, 0.0, orbit_fit_fov_deg(6_424_000.0, 36_360_000.0)), sun: (75.0, 90.0), size: (width * 2 / 3, width * 2 / 3) },
-        View { name: "fisheye", title: "All-sky fisheye (equidistant, north up, east left), sun 45° high in the south-east", camera: cam(Fisheye, 2.0, 0.0, 0.0, 60.0), sun: (45.0, 135.0), size: (width * 2 / 3, width * 2 / 3), ev_offset: 0.0 },
-        View { name: "equirect", title: "Equirectangular environment map (north at the centre column), sun 20° high in the east-south-east", camera: cam(Equirect, 2.0, 0.0, 0.0, 60.0), sun: (70.0, 120.0), size: (width, width / 2), ev_offset: 0.0 },
+        View { name: "noon", title: "Noon from the ground, looking north (sun 60° high in the south)", camera: cam(Perspective, 2.0, 0.0, 12.0, 80.0), sun: (30.0, 180.0), size: (width, h), ev_offset: 0.0, when: None, strip: None },
+        View { name: "afternoon", title: "Afternoon, facing the sun (30° high)", camera: cam(Perspective, 2.0, 240.0, 12.0, 80.0), sun: (60.0, 240.0), size: (width, h), ev_offset: 0.0, when: None, strip: None },
+        View { name: "sunset", title: "Sunset (sun 1° high in the west)", camera: cam(Perspective, 2.0, 270.0, 6.0, 80.0), sun: (89.0, 270.0), size: (width, h), ev_offset: 0.0, when: None, strip: None },
+        View { name: "twilight", title: "Twilight, facing east away from the sun 4° below the horizon: Earth's shadow and the Belt of Venus", camera: cam(Perspective, 2.0, 90.0, 8.0, 80.0), sun: (94.0, 270.0), size: (width, h), ev_offset: 0.0, when: None, strip: None },
+        View { name: "altitude-10km", title: "From 10 km, looking down the aerial perspective", camera: cam(Perspective, 10_000.0, 200.0, -8.0, 80.0), sun: (50.0, 160.0), size: (width, h), ev_offset: 0.0, when: None, strip: None },
+        View { name: "low-orbit", title: "From low orbit (400 km), the limb with the sun low", camera: cam(Perspective, 400_000.0, 90.0, -17.0, 60.0), sun: (75.0, 90.0), size: (width, h), ev_offset: 0.0, when: None, strip: None },
+        View { ev_offset: 1.5, name: "planet", title: "The whole planet from 30 000 km: limb, terminator, night side", camera: cam(Orbit, 30_000_000.0, 0.0, 0.0, orbit_fit_fov_deg(6_424_000.0, 36_360_000.0)), sun: (75.0, 90.0), size: (width * 2 / 3, width * 2 / 3), when: None, strip: None },
+        View { name: "fisheye", title: "All-sky fisheye (equidistant, north up, east left), sun 45° high in the south-east", camera: cam(Fisheye, 2.0, 0.0, 0.0, 60.0), sun: (45.0, 135.0), size: (width * 2 / 3, width * 2 / 3), ev_offset: 0.0, when: None, strip: None },
+        View { name: "moonlit", title: "Full-moon night over the Alps (46.5° N, 8° E), 2026-01-03 21:00 CET, facing the moon 38° high in the east", camera: cam(Perspective, 2.0, 92.0, 14.0, 70.0), sun: (0.0, 0.0), size: (width, h), ev_offset: 0.0, when: Some(("2026-01-03T20:00:00Z", 46.5, 8.0)), strip: None },
+        View { name: "starry-twilight", title: "Nautical twilight with a 4 % crescent moon in the west-south-west and the first stars, 2026-01-20 18:20 CET (46.5° N, 8° E), fisheye", camera: cam(Fisheye, 2.0, 0.0, 0.0, 60.0), sun: (0.0, 0.0), size: (width * 2 / 3, width * 2 / 3), ev_offset: 1.0, when: Some(("2026-01-20T17:20:00Z", 46.5, 8.0)), strip: None },
+        View { name: "sunrise-strip", title: "Sunrise time-lapse, 21 June 2026 at 46.5° N, 8° E, facing north-east: 02:40 to 04:20 UTC every 20 min (sunrise 03:35)", camera: cam(Perspective, 2.0, 50.0, 8.0, 60.0), sun: (0.0, 0.0), size: (width / 3, width / 3), ev_offset: 0.0, when: Some(("2026-06-21T02:40:00Z", 46.5, 8.0)), strip: Some((6, 20)) },
+        View { name: "equirect", title: "Equirectangular environment map (north at the centre column), sun 20° high in the east-south-east", camera: cam(Equirect, 2.0, 0.0, 0.0, 60.0), sun: (70.0, 120.0), size: (width, width / 2), ev_offset: 0.0, when: None, strip: None },
     ]
+}
+
+/// `frames` frames of `scene` from its `[time]`, `minutes` apart, each with its own
+/// automatic exposure (as a camera would), side by side in one PNG at `path`.
+fn write_strip(
+    sky: &RenderSky,
+    scene: &Scene,
+    frames: usize,
+    minutes: i64,
+    path: &std::path::Path,
+) -> Result<()> {
+    let start = firmament::astro::Instant::parse(
+        &scene.time.as_ref().context("a strip needs a time")?.at,
+        "time",
+    )?;
+    let (w, h) = (scene.image.width, scene.image.height);
+    let mut strip = vec![[0u8; 3]; w * frames * h];
+    for i in 0..frames {
+        let mut s = scene.clone();
+        let at = start.utc + chrono::Duration::minutes(minutes * i as i64);
+        if let Some(t) = &mut s.time {
+            t.at = at.to_rfc3339();
+        }
+        let (frame, ev100) = render_scene(sky, &s, true)?;
+        let rgb = frame.to_srgb8(
+            firmament::render::tonemap::exposure_from_ev100(ev100),
+            s.output.tonemap,
+        );
+        for y in 0..h {
+            let at = y * w * frames + i * w;
+            strip[at..at + w].copy_from_slice(&rgb[y * w..(y + 1) * w]);
+        }
+    }
+    firmament::io::write_png_srgb8(path, w * frames, h, &strip)?;
+    Ok(())
 }
 
 /// Run the gallery.
@@ -101,30 +144,70 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
         scene.camera = v.camera.clone();
         scene.sun.zenith_deg = v.sun.0;
         scene.sun.azimuth_deg = v.sun.1;
+        if let Some((at, lat, lon)) = v.when {
+            if !sky.on().is_empty() {
+                if !args.quiet {
+                    eprintln!(
+                        "{:14} skipped: dates and night skies render on the CPU only so far",
+                        v.name
+                    );
+                }
+                continue;
+            }
+            scene.time = Some(SceneTime {
+                at: at.into(),
+                moon_disk: true,
+            });
+            scene.location = Some(SceneLocation {
+                lat_deg: lat,
+                lon_deg: lon,
+                elevation_m: 0.0,
+                pressure_hpa: 1013.25,
+                temperature_c: 15.0,
+            });
+        }
         (scene.image.width, scene.image.height) = v.size;
         let file = format!("{}.png", v.name);
         scene.output.files = vec![args.out.join(&file)];
         scene.validate()?;
         let t = Instant::now();
-        let (frame, ev100) = render_scene(&sky, &scene, true)?;
-        let ev100 = ev100 + v.ev_offset;
-        write_outputs(&frame, &scene, ev100, false, true)?;
+        let ev100 = match v.strip {
+            None => {
+                let (frame, ev100) = render_scene(&sky, &scene, true)?;
+                let ev100 = ev100 + v.ev_offset;
+                write_outputs(&frame, &scene, ev100, false, true)?;
+                ev100
+            }
+            Some((frames, minutes)) => {
+                write_strip(&sky, &scene, frames, minutes, &args.out.join(&file))?;
+                f64::NAN
+            }
+        };
         if !args.quiet {
             eprintln!(
                 "{:14} {}×{}{} in {:.2} s",
                 v.name,
-                v.size.0,
+                v.size.0 * v.strip.map_or(1, |s| s.0),
                 v.size.1,
                 sky.on(),
                 t.elapsed().as_secs_f64()
             );
         }
         let c = &v.camera;
+        let sun = match v.when {
+            Some((at, lat, lon)) => format!("--time {at} --lat-deg {lat} --lon-deg {lon}"),
+            None => format!("--sun-zenith-deg {} --sun-azimuth-deg {}", v.sun.0, v.sun.1),
+        };
+        let exposure = if ev100.is_nan() {
+            "automatic exposure per frame".to_string()
+        } else {
+            format!("EV100 {ev100:.1}")
+        };
         let _ = writeln!(
             html,
-            "<figure><img src=\"{file}\"><figcaption><b>{}</b><br>{:?}, altitude {} m, heading {}°, pitch {}°, fov {:.1}°; sun zenith {}°, azimuth {}°; EV100 {:.1}<br><code>firmament render --camera {} --altitude-m {} --heading-deg {} --pitch-deg {} --fov-deg {:.1} --sun-zenith-deg {} --sun-azimuth-deg {} --width {} --height {}</code></figcaption></figure>",
-            v.title, c.projection, c.altitude_m, c.heading_deg, c.pitch_deg, c.fov_deg, v.sun.0, v.sun.1, ev100,
-            format!("{:?}", c.projection).to_lowercase(), c.altitude_m, c.heading_deg, c.pitch_deg, c.fov_deg, v.sun.0, v.sun.1, v.size.0, v.size.1
+            "<figure><img src=\"{file}\"><figcaption><b>{}</b><br>{:?}, altitude {} m, heading {}°, pitch {}°, fov {:.1}°; {exposure}<br><code>firmament render --camera {} --altitude-m {} --heading-deg {} --pitch-deg {} --fov-deg {:.1} {sun} --width {} --height {}</code></figcaption></figure>",
+            v.title, c.projection, c.altitude_m, c.heading_deg, c.pitch_deg, c.fov_deg,
+            format!("{:?}", c.projection).to_lowercase(), c.altitude_m, c.heading_deg, c.pitch_deg, c.fov_deg, v.size.0, v.size.1
         );
     }
     let index = args.out.join("index.html");

@@ -8,4 +8,5 @@ pub mod bench;
 pub mod gallery;
 pub mod query;
 pub mod render;
+pub mod timelapse;
 pub mod validate;

@@ -2,15 +2,18 @@
 
 use anyhow::Result;
 use clap::Args;
+use firmament::astro::Sky;
 use firmament::math::{direction_from_zenith_azimuth, Vec3};
 use firmament::reference::{self, ReferenceSettings};
+use firmament::scene::sky_lights::{sources_of, SkySources};
 use firmament::scene::{sun_direction, Light};
-use firmament::sky::{Shadow, SkyMethod};
+use firmament::sky::{Shadow, SkyMethod, SkyView};
 use firmament::spectrum::{luminance_from_spectrum, spectrum_to_xyz, xyz_to_linear_srgb};
 use serde::Serialize;
 use serde_json::json;
 
 use crate::backend::{Backend, BackendChoice};
+use crate::commands::astro::AstroArgs;
 use crate::common::{check_range, check_reference_samples, AtmosphereArgs};
 
 /// Arguments of `firmament query`.
@@ -21,12 +24,17 @@ pub struct QueryArgs {
     /// Observer altitude above the ground (m); above the atmosphere top is space.
     #[arg(long, allow_hyphen_values = true)]
     pub altitude_m: f64,
-    /// Sun zenith angle (degrees, 0–180; above 90 the sun is below the horizon).
+    /// Sun zenith angle (degrees, 0–180; above 90 the sun is below the horizon); required
+    /// unless --time is given.
     #[arg(long, allow_hyphen_values = true)]
-    pub sun_zenith_deg: f64,
-    /// Sun azimuth (degrees clockwise from north).
-    #[arg(long, default_value_t = 180.0, allow_hyphen_values = true)]
-    pub sun_azimuth_deg: f64,
+    pub sun_zenith_deg: Option<f64>,
+    /// Sun azimuth (degrees clockwise from north; default 180).
+    #[arg(long, allow_hyphen_values = true)]
+    pub sun_azimuth_deg: Option<f64>,
+    /// A date and a place instead of the sun's angles (the moon and, at night, the night
+    /// sky's glow then add to the views).
+    #[command(flatten)]
+    pub astro: AstroArgs,
     /// A view direction `ZENITH_DEG,AZIMUTH_DEG` (azimuth clockwise from north); repeatable.
     #[arg(
         long = "view",
@@ -85,23 +93,61 @@ fn parse_view(s: &str) -> Result<(f64, f64)> {
     Ok((parsed[0], parsed[1]))
 }
 
+/// The moon's place and light when --time is given (null without; `irradiance` null when
+/// it is below the horizon and so not a light).
+fn moon_json(
+    sky_now: &Option<Sky>,
+    views: &[Box<dyn SkyView + '_>],
+    sources: &SkySources,
+    camera: Vec3,
+    nm: &[f64],
+) -> serde_json::Value {
+    let Some(s) = sky_now else {
+        return serde_json::Value::Null;
+    };
+    let light = match (sources.lights.get(1), views.get(1)) {
+        (Some(moon), Some(view)) => {
+            let n = nm.len();
+            let (mut direct, mut diffuse) = (vec![0.0; n], vec![0.0; n]);
+            view.sun_and_sky_irradiance(camera, Vec3::Z, &mut direct, &mut diffuse);
+            json!({
+                "irradiance_toa": moon.irradiance,
+                "illuminance_toa_lux": luminance_from_spectrum(nm, &moon.irradiance),
+                "direct_lux": luminance_from_spectrum(nm, &direct),
+                "sky_lux": luminance_from_spectrum(nm, &diffuse),
+            })
+        }
+        _ => serde_json::Value::Null,
+    };
+    json!({
+        "zenith_deg": s.moon.zenith_deg,
+        "apparent_zenith_deg": s.moon.apparent_zenith_deg,
+        "azimuth_deg": s.moon.azimuth_deg,
+        "illuminated_fraction": s.moon.illuminated_fraction,
+        "phase_angle_deg": s.moon.phase_angle_deg,
+        "light": light,
+    })
+}
+
 /// Run the query and return the JSON.
 pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
     check_range("--altitude-m", args.altitude_m, 0.0, 1e12, "m")?;
-    check_range(
-        "--sun-zenith-deg",
-        args.sun_zenith_deg,
-        0.0,
-        180.0,
-        "degrees",
-    )?;
-    check_range(
-        "--sun-azimuth-deg",
-        args.sun_azimuth_deg,
-        -360.0,
-        360.0,
-        "degrees",
-    )?;
+    let astro = args.astro.resolve()?;
+    let (sun_zenith_deg, sun_azimuth_deg) = match (&astro, args.sun_zenith_deg) {
+        (Some(_), _) => (f64::NAN, f64::NAN),
+        (None, Some(z)) => (z, args.sun_azimuth_deg.unwrap_or(180.0)),
+        (None, None) => anyhow::bail!("the sun's place is needed: --sun-zenith-deg (and --sun-azimuth-deg), or --time with --lat-deg/--lon-deg"),
+    };
+    if astro.is_none() {
+        check_range("--sun-zenith-deg", sun_zenith_deg, 0.0, 180.0, "degrees")?;
+        check_range(
+            "--sun-azimuth-deg",
+            sun_azimuth_deg,
+            -360.0,
+            360.0,
+            "degrees",
+        )?;
+    }
     let reference = match args.method.as_str() {
         "lut" => None,
         "reference" => {
@@ -142,12 +188,36 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
 
     let camera = Vec3::new(0.0, 0.0, model.bottom_radius_m + args.altitude_m);
     let up = Vec3::Z;
-    let sun = sun_direction(args.sun_zenith_deg, args.sun_azimuth_deg);
+    let sky_now = match astro {
+        Some((instant, place, weather)) => Some(Sky::at(instant, place, &weather)?),
+        None => None,
+    };
+    let sources = match &sky_now {
+        Some(s) => sources_of(model, s, false, false),
+        None => SkySources {
+            lights: vec![Light::sun(
+                model,
+                sun_direction(sun_zenith_deg, sun_azimuth_deg),
+                false,
+            )],
+            ..SkySources::default()
+        },
+    };
+    if reference.is_some() && (sources.lights.len() > 1 || sources.background.is_some()) {
+        anyhow::bail!("`--method reference` traces the sun's light only so far: a --time with the moon up or the sun down is not supported with it");
+    }
+    let sun = sources.lights[0].direction;
+    let (sun_zenith_deg, sun_azimuth_deg) = match &sky_now {
+        Some(s) => (s.sun.apparent_zenith_deg, s.sun.azimuth_deg),
+        None => (sun_zenith_deg, sun_azimuth_deg),
+    };
 
     let optical_depths = model.optical_depths_vertical(args.altitude_m);
     let mut sun_transmittance = vec![0.0; n];
-    let light = Light::sun(model, sun, false);
-    let sky_view = sky.view(camera, &light);
+    let views_of_lights: Vec<_> = (sources.lights.iter())
+        .map(|l| sky.view(camera, l))
+        .collect();
+    let sky_view = &views_of_lights[0];
     sky_view.transmittance_to_light(camera, &mut sun_transmittance);
     let (mut sun_irradiance, mut sky_irradiance) = (vec![0.0; n], vec![0.0; n]);
     sky_view.sun_and_sky_irradiance(camera, up, &mut sun_irradiance, &mut sky_irradiance);
@@ -158,6 +228,18 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
         let dir = direction_from_zenith_azimuth(zenith_deg.to_radians(), azimuth_deg.to_radians());
         let (mut radiance, mut transmittance) = (vec![0.0; n], vec![0.0; n]);
         sky_view.sky_radiance(dir, Shadow::None, &mut radiance, &mut transmittance);
+        // The other lights (the moon) and the night glow add to the sky.
+        let mut other = vec![0.0; n];
+        for view in &views_of_lights[1..] {
+            view.sky_radiance(dir, Shadow::None, &mut other, &mut []);
+            radiance.iter_mut().zip(&other).for_each(|(r, o)| *r += o);
+        }
+        if let Some(b) = &sources.background {
+            let f = b.factor(camera, dir);
+            for k in 0..n {
+                radiance[k] += b.zenith_radiance[k] * f * transmittance[k];
+            }
+        }
         let estimate = reference.as_ref().map(|settings| {
             let e = reference::sky_radiance_keyed(model, camera, dir, sun, settings, i as u64);
             radiance.copy_from_slice(&e.radiance);
@@ -196,7 +278,8 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
             "luminance": "cd m-2 (CIE 1931 2 deg, 683 lm/W; spectrum linearly interpolated between samples)",
         },
         "altitude_m": args.altitude_m,
-        "sun": { "zenith_deg": args.sun_zenith_deg, "azimuth_deg": args.sun_azimuth_deg },
+        "sun": { "zenith_deg": sun_zenith_deg, "azimuth_deg": sun_azimuth_deg },
+        "moon": moon_json(&sky_now, &views_of_lights, &sources, camera, &nm),
         "optical_depth_zenith": optical_depths,
         "solar_irradiance_toa": model.solar_irradiance,
         "solar_illuminance_toa_lux": lux(&model.solar_irradiance),

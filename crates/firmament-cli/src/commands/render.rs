@@ -15,6 +15,7 @@ use firmament::scene::{sun_direction, Light, Projection, SceneFile as Scene};
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
 use crate::commands::astro::AstroArgs;
+use crate::commands::timelapse;
 use crate::common::{
     cancel_flag, check_output_dir, check_reference_samples, progress_bar, AtmosphereArgs,
 };
@@ -65,6 +66,16 @@ pub struct RenderArgs {
     /// Do not draw the moon's disk (its light stays).
     #[arg(long)]
     pub no_moon_disk: bool,
+    /// A time-lapse: frames from --time to this instant (ISO 8601), every --every; each
+    /// --out needs a frame number (`frames/sky_%04d.exr`).
+    #[arg(long, value_name = "ISO8601", requires_all = ["time", "every"])]
+    pub until: Option<String>,
+    /// The time-lapse's step: `30s`, `10m`, `1h`, `1d`.
+    #[arg(long, value_name = "STEP", requires = "until")]
+    pub every: Option<String>,
+    /// Skip the time-lapse's frames whose every output file exists (resume a stopped run).
+    #[arg(long, requires = "until")]
+    pub resume: bool,
     /// Embedded preset.
     #[arg(long, conflicts_with = "atmosphere")]
     pub preset: Option<String>,
@@ -381,9 +392,26 @@ fn render_scene_reference(
 /// Run `firmament render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
     let scene = scene_from_args(args)?;
-    for f in &scene.output.files {
-        check_output_dir(f, "--out")?;
-        OutputFormat::from_path(f)?;
+    let times = match (&args.until, &args.every, &scene.time) {
+        (Some(until), Some(every), Some(t)) => {
+            for f in &scene.output.files {
+                OutputFormat::from_path(f)?;
+                timelapse::numbered(f, 0)?;
+            }
+            Some(timelapse::instants(&t.at, until, every)?)
+        }
+        _ => {
+            for f in &scene.output.files {
+                check_output_dir(f, "--out")?;
+                OutputFormat::from_path(f)?;
+            }
+            None
+        }
+    };
+    if times.is_some() && args.method == "reference" {
+        anyhow::bail!(
+            "a time-lapse (--until) uses the tables: `--method reference` is not supported with it"
+        );
     }
     match args.method.as_str() {
         // An empty `--method` is taken as the default.
@@ -434,6 +462,18 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             },
             t.elapsed().as_secs_f64()
         );
+    }
+    if let Some(times) = times {
+        let t = Instant::now();
+        let (rendered, _) =
+            timelapse::run(&sky, &scene, &times, args.resume, args.exr_half, args.quiet)?;
+        if !args.quiet && rendered > 0 {
+            eprintln!(
+                "time-lapse: {:.2} s per frame",
+                t.elapsed().as_secs_f64() / rendered as f64
+            );
+        }
+        return Ok(());
     }
     let t = Instant::now();
     let (frame, ev100) = render_scene(&sky, &scene, args.quiet)?;

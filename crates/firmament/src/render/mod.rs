@@ -201,7 +201,11 @@ pub fn render(
     let prepared = settings.camera.prepare(model.bottom_radius_m, w, h);
     let observer =
         crate::math::Vec3::new(0.0, 0.0, model.bottom_radius_m + settings.camera.altitude_m);
-    let shader = Shader::new(scene, observer)?;
+    let mut shader = Shader::new(scene, observer)?;
+    let points = stars::small_disks(scene, &prepared, w, h);
+    shader
+        .disks
+        .retain(|(i, _)| points.iter().all(|(j, _)| j != i));
     let n = shader.channels;
     let mut image = ImageRgbF32::new(w, h);
     let mut mask = vec![false; w * h];
@@ -241,8 +245,9 @@ pub fn render(
     if interrupted.load(Ordering::Relaxed) {
         return Err(Error::Interrupted);
     }
-    if let (false, Some(view)) = (scene.stars.is_empty(), shader.views.first()) {
-        stars::draw_stars(
+    if let Some(view) = shader.views.first() {
+        stars::draw_points(
+            scene.stars.iter().chain(points.iter().map(|(_, p)| p)),
             scene,
             view.as_ref(),
             &prepared,

@@ -1,16 +1,19 @@
-//! Point lights outside the atmosphere (the stars) drawn into a frame: each star's
-//! irradiance, extinguished along its line of sight, spread over the four pixels around its
-//! position with bilinear weights that sum to one, each share divided by its pixel's solid
-//! angle, so a star's energy in the image is its irradiance whatever the resolution.
+//! Point lights outside the atmosphere (the stars, and lights' disks smaller than a few
+//! pixels) drawn into a frame: each point's irradiance, extinguished along its line of
+//! sight, spread over the four pixels around its position with bilinear weights that sum to
+//! one, each share divided by its pixel's solid angle, so a point's energy in the image is
+//! its irradiance whatever the resolution.
 
 use crate::io::ImageRgbF32;
+use crate::scene::sky_lights::PointSource;
 use crate::scene::{PreparedCamera, Ray, Scene};
 use crate::sky::{Shadow, SkyView};
 use crate::spectrum::ColourMatrix;
 
-/// Adds `scene`'s stars to `image` (linear sRGB, Y in cd/m², times `balance`), seen from
-/// `observer` through `view`'s transmittance and hidden by the scene's surfaces.
-pub(super) fn draw_stars(
+/// Adds `points` to `image` (linear sRGB, Y in cd/m², times `balance`), seen from
+/// `observer` through `view`'s transmittance and hidden by `scene`'s surfaces.
+pub(super) fn draw_points<'p>(
+    points: impl IntoIterator<Item = &'p PointSource>,
     scene: &Scene,
     view: &dyn SkyView,
     camera: &PreparedCamera,
@@ -23,7 +26,7 @@ pub(super) fn draw_stars(
     let n = scene.sky.model().channels();
     let (w, h) = (image.width, image.height);
     let (mut radiance, mut t, mut e) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    for star in &scene.stars {
+    for star in points {
         let Some((px, py)) = camera.pixel_of(star.direction) else {
             continue;
         };
@@ -63,4 +66,36 @@ pub(super) fn draw_stars(
             }
         }
     }
+}
+
+/// The lights whose drawn disks would cover fewer than four pixels where they stand: their
+/// index and their light as a point (a disk that small, sampled at pixel centres, would
+/// flicker in and out of the image; as a point its energy is kept).
+pub(super) fn small_disks(
+    scene: &Scene,
+    camera: &PreparedCamera,
+    width: usize,
+    height: usize,
+) -> Vec<(usize, PointSource)> {
+    let mut out = Vec::new();
+    for (i, light) in scene.lights.iter().enumerate() {
+        if !light.visible_disk {
+            continue;
+        }
+        let Some((px, py)) = camera.pixel_of(light.direction) else {
+            continue;
+        };
+        let (x, y) = ((px as usize).min(width - 1), (py as usize).min(height - 1));
+        let disk = std::f64::consts::PI * light.angular_radius_rad.sin().powi(2);
+        if disk < 4.0 * camera.pixel_solid_angle(x, y) {
+            out.push((
+                i,
+                PointSource {
+                    direction: light.direction,
+                    irradiance: light.irradiance.clone(),
+                },
+            ));
+        }
+    }
+    out
 }
