@@ -148,6 +148,12 @@ fn start_u_mu(s: ViewStart, ground: bool) -> f32 {
 
 // The scattering-table coordinates at d_km along the ray from the start (the law of
 // cosines for r, μ and μ_s there: geometry::advance, Bruneton4dView::combined_scattering).
+// μ_s at distance d along the ray.
+fn mu_s_along(s: ViewStart, nu: f32, d_km: f32) -> f32 {
+    let r_d_km = radius_from_rho(rho_at(s.r_km, s.rho_km, s.mu, d_km));
+    return clamp_cosine((s.r_km * s.mu_s + d_km * nu) / r_d_km);
+}
+
 fn uvwz_along(s: ViewStart, nu: f32, d_km: f32, ground: bool) -> vec4<f32> {
     let rho_d_km = rho_at(s.r_km, s.rho_km, s.mu, d_km);
     let r_d_km = radius_from_rho(rho_d_km);
@@ -281,12 +287,16 @@ struct At {
     // red-only ratio rule; computed once per ray by `at_red`.
     red: f32,
     scat0: f32,
+    // Below the tables' lowest sun (μ_s < μ_s,min): nothing scattered here
+    // (Bruneton4dView::combined_scattering).
+    dark: bool,
 }
 
-fn at_table(uvwz: vec4<f32>) -> At {
+fn at_table(uvwz: vec4<f32>, mu_s: f32) -> At {
     var a: At;
     a.sliced = false;
     a.table = scattering_filter(uvwz);
+    a.dark = mu_s < atm.mu_s_min;
     return a;
 }
 
@@ -296,6 +306,7 @@ fn at_start(s: ViewStart, light: ViewLight, nu: f32, ground: bool) -> At {
     var a: At;
     a.sliced = s.at_observer;
     a.slice = light.slice;
+    a.dark = s.mu_s < atm.mu_s_min;
     let u_nu = u_nu_from_nu(s.mu, s.mu_s, nu);
     if (a.sliced) {
         a.slice_filter = slice_filter(u_nu, start_u_mu(s, ground));
@@ -330,6 +341,11 @@ fn at_red(v: View, a_in: At, p_r: f32) -> At {
 
 fn combined_scattering(v: View, a: At, k: u32, p_r: f32) -> Combined {
     var c: Combined;
+    if (a.dark) {
+        c.scattering = vec4<f32>(0.0);
+        c.mie = vec4<f32>(0.0);
+        return c;
+    }
     c.scattering = rayleigh_and_multiple(a, k, p_r);
     if (v.mie_layout == 0u) {
         if (a.sliced) {
@@ -380,7 +396,7 @@ fn sky_ray(v: View, o: Observer, light: ViewLight, dir: vec3<f32>, shadow_length
     ray.shadowed = shadow_length_km > 0.0;
     if (ray.shadowed) {
         // The scattering beyond the shadow, attenuated by T(0, l).
-        ray.at = at_table(uvwz_along(s, nu, shadow_length_km, ray.ground));
+        ray.at = at_table(uvwz_along(s, nu, shadow_length_km, ray.ground), mu_s_along(s, nu, shadow_length_km));
         ray.t_shadow = transmittance_filters(s.r_km, s.rho_km, s.mu, shadow_length_km, ray.ground);
     } else {
         ray.at = at_start(s, light, nu, ray.ground);
@@ -460,10 +476,10 @@ fn ground_ray(v: View, o: Observer, light: ViewLight, dir: vec3<f32>, shadow_len
     if (shadow_length_km > 0.0) {
         // The lit part ends `shadow_length_km` before the point.
         let e_km = max(d_km - shadow_length_km, 0.0);
-        ray.at_end = at_red(v, at_table(uvwz_along(s, nu, e_km, true)), p_r);
+        ray.at_end = at_red(v, at_table(uvwz_along(s, nu, e_km, true), mu_s_along(s, nu, e_km)), p_r);
         ray.t_end = transmittance_filters(s.r_km, s.rho_km, s.mu, e_km, true);
     } else {
-        ray.at_end = at_red(v, at_table(scattering_uvwz(atm.bottom_radius_km, 0.0, mu_p, ray.mu_s_ground, nu, true)), p_r);
+        ray.at_end = at_red(v, at_table(scattering_uvwz(atm.bottom_radius_km, 0.0, mu_p, ray.mu_s_ground, nu, true), ray.mu_s_ground), p_r);
         ray.t_end = ray.t_point;
     }
     return ray;

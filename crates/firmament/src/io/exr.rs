@@ -80,9 +80,12 @@ pub fn write_exr_with_attributes(
                 .to_buffered(out)
             }
             ExrPrecision::F16 => {
+                // Half floats end at 65504: brighter samples (the sun's disk, a star's
+                // pixel) are clamped there rather than written as infinity.
+                let half = |v: f32| f16::from_f32(v.min(f16::MAX.to_f32()));
                 let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
                     let [r, g, b] = px(p);
-                    (f16::from_f32(r), f16::from_f32(g), f16::from_f32(b))
+                    (half(r), half(g), half(b))
                 });
                 Image::from_layer(Layer::new(
                     size,

@@ -143,7 +143,8 @@ pub enum ExrPrecision {
     /// 32-bit float samples (lossless for `f32` data).
     #[default]
     F32,
-    /// 16-bit half float samples (11 significant bits, range about 6e-5 .. 65504).
+    /// 16-bit half float samples (11 significant bits, range about 6e-5 .. 65504; brighter
+    /// samples, such as the sun's disk, are clamped to 65504).
     F16,
 }
 
