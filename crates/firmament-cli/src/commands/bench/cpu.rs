@@ -11,6 +11,7 @@ use firmament::atmosphere::Model;
 use firmament::math::Vec3;
 use firmament::reference::{self, ReferenceSettings};
 use firmament::render::{self, ToneCurve};
+use firmament::scene::sky_lights::sources_of;
 use firmament::scene::{sun_direction, Scene};
 use firmament::sky::bruneton4d::precompute::precompute;
 use firmament::sky::bruneton4d::{Bruneton4d, TableConfig};
@@ -89,7 +90,27 @@ pub fn frame_timings(sky: &Bruneton4d, runs: usize) -> Result<CpuFrames> {
             &scenes::equirect_4096x2048(),
             runs,
         )?),
+        cpu_frame_1080p_night_s: Some(night_seconds(sky, runs)?),
     })
+}
+
+/// Median seconds of the night frame: the date's sun, moon and stars computed, then the
+/// frame with two lights, the stars and the glow.
+fn night_seconds(sky: &Bruneton4d, runs: usize) -> Result<f64> {
+    let frame = scenes::perspective_1080p();
+    let settings = frame.settings();
+    let seconds = time_runs(frame.runs(runs), || {
+        let night = scenes::night()?;
+        let sources = sources_of(&sky.model, &night, true, true);
+        let mut scene = Scene::clear_sky(sky, Vec3::Z, false);
+        scene.lights = sources.lights;
+        scene.background = sources.background;
+        scene.stars = sources.stars;
+        let image = render::render(&scene, &settings, &|_| {}, None)?;
+        let _ = image.to_srgb8(1.0, ToneCurve::Aces);
+        Ok(())
+    })?;
+    Ok(median(seconds))
 }
 
 /// Median seconds of one frame, tone mapped to 8 bits.

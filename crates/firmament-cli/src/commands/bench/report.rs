@@ -52,6 +52,9 @@ pub struct CpuFrames {
     pub cpu_frame_1080p_perspective_s: Option<f64>,
     pub cpu_frame_1024_fisheye_s: Option<f64>,
     pub cpu_frame_4096x2048_equirect_s: Option<f64>,
+    /// The 1080p view at night (full moon as a second light, the stars and the glow), the
+    /// astronomy of the date included.
+    pub cpu_frame_1080p_night_s: Option<f64>,
 }
 
 /// The reference path tracer's throughput: one earth RGB pixel (the zenith from 1 m, the

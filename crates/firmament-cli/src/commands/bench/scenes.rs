@@ -70,3 +70,11 @@ pub fn equirect_4096x2048() -> BenchFrame {
 pub fn sun() -> Vec3 {
     sun_direction(60.0, 200.0)
 }
+
+/// The night of the night benchmark frame: a full moon 38° high in the east over the Alps,
+/// 2026-01-03 20:00 UTC, 46.5° N, 8° E.
+pub fn night() -> firmament::Result<firmament::astro::Sky> {
+    use firmament::astro::{Instant, Place, Sky, Weather};
+    let instant = Instant::parse("2026-01-03T20:00:00Z", "time")?;
+    Sky::at(instant, Place::new(46.5, 8.0, 0.0)?, &Weather::default())
+}
