@@ -296,3 +296,74 @@ fn a_time_lapse_renders_resumes_and_follows_the_sun() {
     let b: Vec<f64> = [0, 6, 12, 18, 23].iter().map(|&i| brightness(i)).collect();
     assert!(b.windows(2).all(|w| w[1] > w[0]), "{b:?}");
 }
+
+#[test]
+fn ctrl_c_stops_a_time_lapse_cleanly_and_resume_finishes_it() {
+    let dir = tmp_subdir("timelapse-interrupted");
+    let t = tables().to_str().unwrap();
+    let pattern = dir.join("sky_%03d.png");
+    let args = [
+        "render",
+        "--tables",
+        t,
+        "--time",
+        "2026-06-21T00:00:00Z",
+        "--until",
+        "2026-06-21T23:00:00Z",
+        "--every",
+        "1h",
+        "--lat-deg",
+        "46.5",
+        "--lon-deg",
+        "8",
+        "--width",
+        "240",
+        "--height",
+        "135",
+        "--ev100",
+        "10",
+        "--backend",
+        "cpu",
+        "--out",
+        pattern.to_str().unwrap(),
+    ];
+    let frame = |i: usize| dir.join(format!("sky_{i:03}.png"));
+    let child = common::bin()
+        .args(args)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Interrupt once a few frames are written (SIGINT, as Ctrl-C sends).
+    let start = std::time::Instant::now();
+    while !frame(2).exists() && start.elapsed().as_secs() < 120 {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let killed = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let o = child.wait_with_output().unwrap();
+    let done = (0..24).filter(|&i| frame(i).exists()).count();
+    if done < 24 {
+        // Stopped: a non-zero exit that says how to go on, and no partial file.
+        assert!(!o.status.success());
+        assert!(stderr(&o).contains("interrupted"), "{}", stderr(&o));
+    }
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    let mut resumed = args.to_vec();
+    resumed.push("--resume");
+    let o = run(&resumed);
+    succeeds(&o);
+    assert!(
+        stderr(&o).contains(&format!("{} frames rendered, {done} skipped", 24 - done)),
+        "{}",
+        stderr(&o)
+    );
+    assert!((0..24).all(|i| frame(i).exists()));
+}
