@@ -293,6 +293,21 @@ pub fn sources_of_scene(model: &Model, scene: &Scene) -> Result<SkySources> {
     })
 }
 
+/// A note when the date's sun is in the twilight the tables do not hold (below their lowest
+/// sun, above −18°): that sky is missing from the picture.
+fn twilight_note(model: &Model, scene: &Scene) -> Result<()> {
+    if let Some(sky) = scene.astro()? {
+        let elevation = 90.0 - sky.sun.apparent_zenith_deg;
+        let lowest = 90.0 - model.mu_s_min.acos().to_degrees();
+        if elevation < lowest && elevation > -18.0 {
+            eprintln!(
+                "note: the sun is {elevation:.1}° high, below the lowest sun of these tables ({lowest:.0}°): the last twilight is left out; an atmosphere with min_sun_elevation_deg = -18 keeps it (docs/accuracy.md)"
+            );
+        }
+    }
+    Ok(())
+}
+
 /// The scene's EV100, or the automatic exposure of the frame.
 fn ev100(scene: &Scene, frame: &render::Frame) -> f64 {
     scene
@@ -472,6 +487,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             },
             t.elapsed().as_secs_f64()
         );
+    }
+    if !args.quiet && times.is_none() {
+        twilight_note(sky.model(), &scene)?;
     }
     if let Some(times) = times {
         let t = Instant::now();
