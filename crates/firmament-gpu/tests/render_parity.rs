@@ -433,3 +433,109 @@ fn tables_kept_on_the_device_render_like_tables_read_back() {
     assert_eq!(a.image.data, b.image.data);
     assert!(a.image.data.iter().any(|p| luminance(p) > 0.0));
 }
+
+#[test]
+fn telephoto_on_the_half_moon_shows_its_phase_and_earthshine() {
+    // 2026-01-26 18:00 UTC from 46.5° N, 8° E: a 56 % moon 63° high, the sun 17° below the
+    // horizon; a 1.2° field on the moon: the lit half, the terminator, earthshine, the
+    // moonlit sky (the lights only: the stars and the night glow are CPU-side).
+    let name = "half moon";
+    let Some(gpu) = gpu(name) else { return };
+    let _guard = serial();
+    let sky = earth_rgb();
+    let instant = firmament::astro::Instant::parse("2026-01-26T18:00:00Z", "time").unwrap();
+    let place = firmament::astro::Place::new(46.5, 8.0, 0.0).unwrap();
+    let astro = firmament::astro::Sky::at(instant, place, &Default::default()).unwrap();
+    let m = &astro.moon;
+    let cam = camera(
+        Projection::Perspective,
+        2.0,
+        m.azimuth_deg,
+        90.0 - m.apparent_zenith_deg,
+        1.2,
+    );
+    let settings = RenderSettings {
+        camera: &cam,
+        width: 96,
+        height: 96,
+        white_balance: false,
+    };
+    let mut scene = Scene::clear_sky(sky, Vec3::Z, false);
+    scene.lights = firmament::scene::sky_lights::lights_of(&sky.model, &astro, true, true);
+    assert_eq!(scene.lights.len(), 2);
+    let cpu_frame = render(&scene, &settings, &|_| {}, None).unwrap();
+    let gpu_sky = GpuSky::from_sky(&gpu.ctx, sky).unwrap();
+    let gpu_frame = gpu
+        .renderer
+        .render(&gpu.ctx, &gpu_sky, &scene.lights, &settings)
+        .unwrap();
+    let p = measure(
+        name,
+        sky,
+        &settings,
+        &scene.lights,
+        &cpu_frame,
+        &gpu_frame,
+        0.0,
+    );
+    assert_parity(name, &p);
+    // The lit limb is far brighter than the dark half's earthshine, on both sides.
+    let lum = |f: &firmament::render::Frame, x: usize, y: usize| {
+        let q = f.image.data[y * 96 + x];
+        0.2126 * q[0] + 0.7152 * q[1] + 0.0722 * q[2]
+    };
+    let (bright, dark) = (
+        (0..96)
+            .map(|x| lum(&gpu_frame, x, 48))
+            .fold(0.0f32, f32::max),
+        (0..96)
+            .map(|x| lum(&gpu_frame, x, 48))
+            .fold(f32::MAX, f32::min),
+    );
+    assert!(bright > 100.0 * dark, "{bright} vs {dark}");
+}
+
+#[test]
+fn moonlit_night_fisheye_with_the_glow() {
+    // 2026-01-03 20:00 UTC from 46.5° N, 8° E: the full moon 38° high, the sun 41° below
+    // the horizon, the night sky's glow (van Rhijn airglow) through the air.
+    let name = "moonlit night";
+    let Some(gpu) = gpu(name) else { return };
+    let _guard = serial();
+    let sky = earth_rgb();
+    let instant = firmament::astro::Instant::parse("2026-01-03T20:00:00Z", "time").unwrap();
+    let place = firmament::astro::Place::new(46.5, 8.0, 0.0).unwrap();
+    let astro = firmament::astro::Sky::at(instant, place, &Default::default()).unwrap();
+    let cam = camera(Projection::Fisheye, 2.0, 0.0, 0.0, 60.0);
+    let settings = RenderSettings {
+        camera: &cam,
+        width: 96,
+        height: 96,
+        white_balance: false,
+    };
+    let sources = firmament::scene::sky_lights::sources_of(&sky.model, &astro, true, true);
+    let mut scene = Scene::clear_sky(sky, Vec3::Z, false);
+    scene.lights = sources.lights;
+    scene.background = sources.background;
+    assert!(scene.background.is_some());
+    let cpu_frame = render(&scene, &settings, &|_| {}, None).unwrap();
+    let gpu_sky = GpuSky::from_sky(&gpu.ctx, sky).unwrap();
+    let inputs = firmament_gpu::RenderInputs {
+        background: scene.background.as_ref(),
+        ..Default::default()
+    };
+    let gpu_frame = gpu
+        .renderer
+        .render_with(&gpu.ctx, &gpu_sky, &scene.lights, &settings, inputs)
+        .unwrap();
+    let p = measure(
+        name,
+        sky,
+        &settings,
+        &scene.lights,
+        &cpu_frame,
+        &gpu_frame,
+        0.0,
+    );
+    assert_parity(name, &p);
+}

@@ -145,15 +145,6 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
         scene.sun.zenith_deg = v.sun.0;
         scene.sun.azimuth_deg = v.sun.1;
         if let Some((at, lat, lon)) = v.when {
-            if !sky.on().is_empty() {
-                if !args.quiet {
-                    eprintln!(
-                        "{:14} skipped: dates and night skies render on the CPU only so far",
-                        v.name
-                    );
-                }
-                continue;
-            }
             scene.time = Some(SceneTime {
                 at: at.into(),
                 moon_disk: true,

@@ -460,17 +460,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
         other => anyhow::bail!("invalid value for `--method`: {other} (accepted: lut, reference)"),
     }
-    // Dates bring the moon's disk, the stars and the night glow, which only the CPU draws
-    // so far: `auto` picks it for them.
-    let choice = if scene.time.is_some() && args.backend == BackendChoice::Auto {
-        if !args.quiet {
-            eprintln!("backend: cpu (a scene with a date: the moon, the stars and the night glow are drawn on the CPU only so far)");
-        }
-        BackendChoice::Cpu
-    } else {
-        args.backend
-    };
-    let backend = Backend::open(choice, args.quiet)?;
+    let backend = Backend::open(args.backend, args.quiet)?;
     let t = Instant::now();
     let sky = RenderSky::new(
         &backend,

@@ -6,6 +6,7 @@
 use firmament::math::sphere::safe_sqrt;
 use firmament::math::Vec3;
 use firmament::render::RenderSettings;
+use firmament::scene::sky_lights::Background;
 use firmament::scene::{DiskProfile, Light, Projection};
 use firmament::sky::bruneton4d::params::scattering_uvwz;
 use firmament::spectrum::MAX_CHANNELS;
@@ -23,8 +24,9 @@ pub const CHANNEL_MIE_RATIO: usize = 3;
 pub const CHANNEL_DATA_VEC4: usize = MAX_CHANNELS / GROUP * CHANNEL_STRIDE;
 /// The most lights a GPU frame takes (each has its slice of the tables).
 pub const MAX_LIGHTS: usize = 4;
-/// vec4 per light and channel group: the disk law × centre radiance (6), the scale and the
-/// irradiance.
+/// vec4 per light and channel group: the disk's six rows (an emitting disk: its law ×
+/// centre radiance; a lunar disk: the lit factor, the earthshine and the direction from the
+/// moon to the sun in xyz), the scale and the irradiance.
 pub const LIGHT_STRIDE: usize = 8;
 /// Offsets in a light's group data.
 pub const LIGHT_DISK: usize = 0;
@@ -134,8 +136,12 @@ impl FrameConstants {
 }
 
 /// The `Lights` uniform: directions, disks and per-group data of up to [`MAX_LIGHTS`]
-/// lights, scaled against the tables' solar irradiance.
-pub(crate) fn light_words(sky: &GpuSky, lights: &[Light]) -> Vec<u32> {
+/// lights, scaled against the tables' solar irradiance, and the background glow.
+pub(crate) fn light_words(
+    sky: &GpuSky,
+    lights: &[Light],
+    background: Option<&Background>,
+) -> Vec<u32> {
     let groups = MAX_CHANNELS / GROUP;
     let mut direction = vec![0u32; MAX_LIGHTS * 4];
     let mut disk = vec![0u32; MAX_LIGHTS * 4];
@@ -144,30 +150,53 @@ pub(crate) fn light_words(sky: &GpuSky, lights: &[Light]) -> Vec<u32> {
         direction[l * 4..l * 4 + 4].copy_from_slice(&v4(light.direction, light.angular_radius_rad));
         disk[l * 4] = u32::from(light.visible_disk);
         disk[l * 4 + 1] = bits(light.angular_radius_rad.sin());
+        disk[l * 4 + 2] = u32::from(matches!(light.disk, DiskProfile::Lunar(_)));
         let scale = light.scale_against(&sky.solar_irradiance);
         for k in 0..sky.channels {
             let (group, lane) = (k / GROUP, k % GROUP);
             let mut set = |row: usize, v: f64| {
                 data[((l * groups + group) * LIGHT_STRIDE + row) * 4 + lane] = v as f32;
             };
-            // Lunar disks are refused by `GpuRenderer::render` before this.
-            if let DiskProfile::Emitting {
-                centre_radiance,
-                law,
-            } = &light.disk
-            {
-                for (j, a) in law[k].iter().enumerate() {
-                    set(LIGHT_DISK + j, centre_radiance[k] * a);
+            match &light.disk {
+                DiskProfile::Emitting {
+                    centre_radiance,
+                    law,
+                } => {
+                    for (j, a) in law[k].iter().enumerate() {
+                        set(LIGHT_DISK + j, centre_radiance[k] * a);
+                    }
+                }
+                DiskProfile::Lunar(moon) => {
+                    set(LIGHT_DISK, moon.lit[k]);
+                    set(LIGHT_DISK + 1, moon.earthshine[k]);
                 }
             }
             set(LIGHT_SCALE, scale[k]);
             set(LIGHT_IRRADIANCE, light.irradiance[k]);
+        }
+        if let DiskProfile::Lunar(moon) = &light.disk {
+            // The direction to the sun, in channel group 0's third disk row.
+            let s = moon.sun_from_moon;
+            let at = (l * groups * LIGHT_STRIDE + LIGHT_DISK + 2) * 4;
+            data[at..at + 3].copy_from_slice(&[s.x as f32, s.y as f32, s.z as f32]);
+        }
+    }
+    // The glow: (on, the layer's share, the layer's radius in km, 0), then its zenith
+    // radiance per channel group.
+    let mut glow = vec![0.0f32; 4 + groups * 4];
+    if let Some(b) = background {
+        glow[0] = 1.0;
+        glow[1] = b.layer_fraction as f32;
+        glow[2] = (b.layer_radius_m * 1e-3) as f32;
+        for (k, v) in b.zenith_radiance.iter().enumerate().take(sky.channels) {
+            glow[4 + k] = *v as f32;
         }
     }
     direction
         .into_iter()
         .chain(disk)
         .chain(data.into_iter().map(f32::to_bits))
+        .chain(glow.into_iter().map(f32::to_bits))
         .collect()
 }
 

@@ -89,6 +89,8 @@ pub struct RenderInputs<'a> {
     /// TEXTURE_BINDING). Sky rays are in shadow over their first metres, rays to the ground
     /// over their last.
     pub shadow_lengths: Option<&'a wgpu::TextureView>,
+    /// A glow from beyond the atmosphere (the night sky's), seen through the air.
+    pub background: Option<&'a firmament::scene::sky_lights::Background>,
 }
 
 /// A render pipeline (for one output) and its `camera_slice` entry point.
@@ -391,17 +393,6 @@ impl GpuRenderer {
             )
             .into());
         }
-        if let Some(i) = (lights.iter()).position(|l| {
-            l.visible_disk && matches!(l.disk, firmament::scene::DiskProfile::Lunar(_))
-        }) {
-            return Err(firmament::Error::invalid(
-                format!("lights[{i}].disk"),
-                "the moon's disk",
-                "disks of self-luminous lights only on the GPU so far (render the moon's disk \
-                 on the CPU with --backend cpu, or hide it; its light is supported)",
-            )
-            .into());
-        }
         let (w, h) = (settings.width, settings.height);
         let limits = ctx.limits();
         let adapter = ctx.adapter_name().to_string();
@@ -466,7 +457,7 @@ impl GpuRenderer {
                     wgpu::BufferUsages::UNIFORM,
                 )
             };
-            let light_uniform = uniform("lights", &light_words(sky, lights));
+            let light_uniform = uniform("lights", &light_words(sky, lights, inputs.background));
             let slice_uniform = uniform("slice coordinates", &slice_words(sky, lights, settings));
             let shadow = inputs.shadow_lengths.unwrap_or(&self.no_shadow_lengths);
             let tables = sky.tables();

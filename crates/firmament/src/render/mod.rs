@@ -8,7 +8,7 @@
 //! the lights for their disks. A second surface or light needs no change here.
 
 pub mod frame;
-mod stars;
+pub mod stars;
 pub mod tonemap;
 mod volumes;
 
@@ -246,14 +246,19 @@ pub fn render(
         return Err(Error::Interrupted);
     }
     if let Some(view) = shader.views.first() {
+        let transmittance = |dir: crate::math::Vec3, out: &mut [f64]| {
+            stars::scene_transmittance(scene, view.as_ref(), observer, dir, out)
+        };
+        let points_view = stars::PointView {
+            transmittance: &transmittance,
+            camera: &prepared,
+            colour: &colour,
+            balance,
+        };
         stars::draw_points(
             scene.stars.iter().chain(points.iter().map(|(_, p)| p)),
-            scene,
-            view.as_ref(),
-            &prepared,
-            observer,
-            &colour,
-            balance,
+            n,
+            &points_view,
             &mut image,
             &mask,
         );

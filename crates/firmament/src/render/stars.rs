@@ -4,40 +4,46 @@
 //! one, each share divided by its pixel's solid angle, so a point's energy in the image is
 //! its irradiance whatever the resolution.
 
+use crate::atmosphere::Model;
 use crate::io::ImageRgbF32;
+use crate::math::sphere::ray_intersects_ground;
+use crate::math::Vec3;
 use crate::scene::sky_lights::PointSource;
 use crate::scene::{PreparedCamera, Ray, Scene};
 use crate::sky::{Shadow, SkyView};
 use crate::spectrum::ColourMatrix;
 
-/// Adds `points` to `image` (linear sRGB, Y in cd/m², times `balance`), seen from
-/// `observer` through `view`'s transmittance and hidden by `scene`'s surfaces.
-pub(super) fn draw_points<'p>(
+/// How the points are seen: the transmittance from the observer to space along a
+/// direction (per channel, 0 where the direction is blocked), and the image's frame.
+pub struct PointView<'a> {
+    /// Transmittance to space along a unit direction (local frame), into the slice.
+    pub transmittance: &'a dyn Fn(Vec3, &mut [f64]),
+    /// The camera of the image.
+    pub camera: &'a PreparedCamera,
+    /// The image's colour conversion and white balance.
+    pub colour: &'a ColourMatrix,
+    /// Factors per linear sRGB channel.
+    pub balance: [f64; 3],
+}
+
+/// Adds `points` to `image` (linear sRGB, Y in cd/m², times `balance`) as `view` sees them;
+/// `channels` is the points' number of channels.
+pub fn draw_points<'p>(
     points: impl IntoIterator<Item = &'p PointSource>,
-    scene: &Scene,
-    view: &dyn SkyView,
-    camera: &PreparedCamera,
-    observer: crate::math::Vec3,
-    colour: &ColourMatrix,
-    balance: [f64; 3],
+    channels: usize,
+    view: &PointView,
     image: &mut ImageRgbF32,
     mask: &[bool],
 ) {
-    let n = scene.sky.model().channels();
+    let (camera, colour, balance) = (view.camera, view.colour, view.balance);
+    let n = channels;
     let (w, h) = (image.width, image.height);
-    let (mut radiance, mut t, mut e) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let (mut t, mut e) = (vec![0.0; n], vec![0.0; n]);
     for star in points {
         let Some((px, py)) = camera.pixel_of(star.direction) else {
             continue;
         };
-        let ray = Ray {
-            origin: observer,
-            dir: star.direction,
-        };
-        if scene.nearest_hit(&ray, f64::INFINITY).is_some() {
-            continue;
-        }
-        view.sky_radiance(star.direction, Shadow::None, &mut radiance, &mut t);
+        (view.transmittance)(star.direction, &mut t);
         for k in 0..n {
             e[k] = star.irradiance[k] * t[k];
         }
@@ -98,4 +104,56 @@ pub(super) fn small_disks(
         }
     }
     out
+}
+
+/// In `scene` through `sky_view`: the sky method's transmittance to space, zero where a
+/// surface blocks the direction.
+pub(super) fn scene_transmittance(
+    scene: &Scene,
+    sky_view: &dyn SkyView,
+    observer: Vec3,
+    dir: Vec3,
+    out: &mut [f64],
+) {
+    let ray = Ray {
+        origin: observer,
+        dir,
+    };
+    if scene.nearest_hit(&ray, f64::INFINITY).is_some() {
+        out.iter_mut().for_each(|v| *v = 0.0);
+        return;
+    }
+    let mut radiance = vec![0.0; out.len()];
+    sky_view.sky_radiance(dir, Shadow::None, &mut radiance, out);
+}
+
+/// Transmittance from `observer` (planet-centred, m) to space along `dir`, from `model`'s
+/// columns (no tables; 0 when the planet's ground is in the way): for frames drawn where
+/// no CPU tables are at hand (the GPU's).
+pub fn transmittance_to_space(model: &Model, observer: Vec3, dir: Vec3, out: &mut [f64]) {
+    let (bottom, top) = (model.bottom_radius_m, model.top_radius_m);
+    let mut r = observer.length();
+    let mut rmu = observer.dot(dir);
+    if r > top {
+        match crate::math::sphere::distance_to_enter_sphere(r, rmu, top) {
+            Some(d) => {
+                rmu += d;
+                r = top;
+            }
+            None => {
+                out.iter_mut().for_each(|v| *v = 1.0);
+                return;
+            }
+        }
+    }
+    let mu = (rmu / r).clamp(-1.0, 1.0);
+    if ray_intersects_ground(r, mu, bottom) {
+        out.iter_mut().for_each(|v| *v = 0.0);
+        return;
+    }
+    let length = crate::math::sphere::distance_to_top_atmosphere_boundary(r, mu, top);
+    let tau = model.optical_depth_along_ray(r, mu, length);
+    for (o, t) in out.iter_mut().zip(tau) {
+        *o = (-t).exp();
+    }
 }
