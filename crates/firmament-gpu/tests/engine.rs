@@ -367,6 +367,7 @@ fn shadowed_lengths_per_pixel_match_the_cpu() {
     let gpu_sky = GpuSky::from_sky(&gpu.ctx, sky).unwrap();
     let inputs = RenderInputs {
         shadow_lengths: Some(&view),
+        ..RenderInputs::default()
     };
     let gpu_frame = gpu
         .renderer
