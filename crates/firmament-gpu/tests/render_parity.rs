@@ -434,6 +434,13 @@ fn tables_kept_on_the_device_render_like_tables_read_back() {
     assert!(a.image.data.iter().any(|p| luminance(p) > 0.0));
 }
 
+/// The sun and the moon at `time` from 46.5° N, 8° E.
+fn alps_at(time: &str) -> firmament::astro::Sky {
+    let instant = firmament::astro::Instant::parse(time, "time").unwrap();
+    let place = firmament::astro::Place::new(46.5, 8.0, 0.0).unwrap();
+    firmament::astro::Sky::at(instant, place, &Default::default()).unwrap()
+}
+
 #[test]
 fn telephoto_on_the_half_moon_shows_its_phase_and_earthshine() {
     // 2026-01-26 18:00 UTC from 46.5° N, 8° E: a 56 % moon 63° high, the sun 17° below the
@@ -443,9 +450,7 @@ fn telephoto_on_the_half_moon_shows_its_phase_and_earthshine() {
     let Some(gpu) = gpu(name) else { return };
     let _guard = serial();
     let sky = earth_rgb();
-    let instant = firmament::astro::Instant::parse("2026-01-26T18:00:00Z", "time").unwrap();
-    let place = firmament::astro::Place::new(46.5, 8.0, 0.0).unwrap();
-    let astro = firmament::astro::Sky::at(instant, place, &Default::default()).unwrap();
+    let astro = alps_at("2026-01-26T18:00:00Z");
     let m = &astro.moon;
     let cam = camera(
         Projection::Perspective,
@@ -503,9 +508,7 @@ fn moonlit_night_fisheye_with_the_glow() {
     let Some(gpu) = gpu(name) else { return };
     let _guard = serial();
     let sky = earth_rgb();
-    let instant = firmament::astro::Instant::parse("2026-01-03T20:00:00Z", "time").unwrap();
-    let place = firmament::astro::Place::new(46.5, 8.0, 0.0).unwrap();
-    let astro = firmament::astro::Sky::at(instant, place, &Default::default()).unwrap();
+    let astro = alps_at("2026-01-03T20:00:00Z");
     let cam = camera(Projection::Fisheye, 2.0, 0.0, 0.0, 60.0);
     let settings = RenderSettings {
         camera: &cam,
