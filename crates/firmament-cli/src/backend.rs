@@ -15,7 +15,6 @@ use firmament::render::{stars, Frame, RenderSettings};
 use firmament::scene::sky_lights::SkySources;
 use firmament::scene::Scene;
 use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, Tables};
-use firmament::spectrum::ColourMatrix;
 use firmament_gpu::Precomputer;
 use firmament_gpu::{GpuContext, GpuError, GpuRenderer, GpuSky, RenderInputs};
 
@@ -338,28 +337,8 @@ impl<'a> RenderSky<'a> {
                         .render_with(&gpu.ctx, sky, &sources.lights, settings, inputs)
                         .map_err(|e| gpu_failure("rendering", e))
                 })?;
-                // The stars are points: splatted on the CPU into the frame read back, through
-                // the model's own transmittance (no CPU tables on this side).
-                if !sources.stars.is_empty() {
-                    let model: &Model = sky_model;
-                    let (w, h) = (settings.width, settings.height);
-                    let camera = settings.camera.prepare(model.bottom_radius_m, w, h);
-                    let observer =
-                        Vec3::new(0.0, 0.0, model.bottom_radius_m + settings.camera.altitude_m);
-                    let colour = ColourMatrix::new(model.wavelengths.nm());
-                    let transmittance = |dir: Vec3, out: &mut [f64]| {
-                        stars::transmittance_to_space(model, observer, dir, out)
-                    };
-                    let view = stars::PointView {
-                        transmittance: &transmittance,
-                        camera: &camera,
-                        colour: &colour,
-                        balance: colour
-                            .white_balance(&model.solar_irradiance, settings.white_balance),
-                    };
-                    let Frame { image, mask } = &mut frame;
-                    stars::draw_points(&sources.stars, model.channels(), &view, image, mask);
-                }
+                // The stars are points: splatted on the CPU into the frame read back.
+                stars::draw_points_into(&mut frame, &sources.stars, sky_model, settings);
                 Ok(frame)
             }
         }

@@ -6,7 +6,7 @@ use firmament::astro::Sky;
 use firmament::math::{direction_from_zenith_azimuth, Vec3};
 use firmament::reference::{self, ReferenceSettings};
 use firmament::scene::sky_lights::{sources_of, SkySources};
-use firmament::scene::{sun_direction, Light};
+use firmament::scene::sun_direction;
 use firmament::sky::{Shadow, SkyMethod, SkyView};
 use firmament::spectrum::{luminance_from_spectrum, spectrum_to_xyz, xyz_to_linear_srgb};
 use serde::Serialize;
@@ -194,14 +194,7 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
     };
     let sources = match &sky_now {
         Some(s) => sources_of(model, s, false, false),
-        None => SkySources {
-            lights: vec![Light::sun(
-                model,
-                sun_direction(sun_zenith_deg, sun_azimuth_deg),
-                false,
-            )],
-            ..SkySources::default()
-        },
+        None => SkySources::sun(model, sun_direction(sun_zenith_deg, sun_azimuth_deg), false),
     };
     if reference.is_some() && (sources.lights.len() > 1 || sources.background.is_some()) {
         anyhow::bail!("`--method reference` traces the sun's light only so far: a --time with the moon up or the sun down is not supported with it");

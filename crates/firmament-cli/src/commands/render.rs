@@ -11,7 +11,7 @@ use firmament::reference::{self, ReferenceSettings};
 use firmament::render::{self, tonemap, RenderSettings, ToneCurve};
 use firmament::scene::file::{SceneLocation, SceneTime};
 use firmament::scene::sky_lights::{sources_of, SkySources};
-use firmament::scene::{sun_direction, Light, Projection, SceneFile as Scene};
+use firmament::scene::{sun_direction, Projection, SceneFile as Scene};
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
 use crate::commands::astro::AstroArgs;
@@ -282,14 +282,11 @@ pub fn sources_of_scene(model: &Model, scene: &Scene) -> Result<SkySources> {
             let moon_disk = scene.time.as_ref().is_none_or(|t| t.moon_disk);
             sources_of(model, &sky, scene.sun.disk, moon_disk)
         }
-        None => SkySources {
-            lights: vec![Light::sun(
-                model,
-                sun_direction(scene.sun.zenith_deg, scene.sun.azimuth_deg),
-                scene.sun.disk,
-            )],
-            ..SkySources::default()
-        },
+        None => SkySources::sun(
+            model,
+            sun_direction(scene.sun.zenith_deg, scene.sun.azimuth_deg),
+            scene.sun.disk,
+        ),
     })
 }
 

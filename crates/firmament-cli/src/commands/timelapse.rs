@@ -75,7 +75,6 @@ pub fn run(
 ) -> Result<(usize, usize)> {
     let patterns = scene.output.files.clone();
     for p in &patterns {
-        numbered(p, 0)?;
         if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         }

@@ -148,18 +148,14 @@ fn start_u_mu(s: ViewStart, ground: bool) -> f32 {
 
 // The scattering-table coordinates at d_km along the ray from the start (the law of
 // cosines for r, μ and μ_s there: geometry::advance, Bruneton4dView::combined_scattering).
-// μ_s at distance d along the ray.
-fn mu_s_along(s: ViewStart, nu: f32, d_km: f32) -> f32 {
-    let r_d_km = radius_from_rho(rho_at(s.r_km, s.rho_km, s.mu, d_km));
-    return clamp_cosine((s.r_km * s.mu_s + d_km * nu) / r_d_km);
-}
-
-fn uvwz_along(s: ViewStart, nu: f32, d_km: f32, ground: bool) -> vec4<f32> {
+// The 4D lookup at distance d along the ray (Bruneton4dView::combined_scattering away from
+// the start), dark when μ_s there is below the tables' lowest sun.
+fn at_along(s: ViewStart, nu: f32, d_km: f32, ground: bool) -> At {
     let rho_d_km = rho_at(s.r_km, s.rho_km, s.mu, d_km);
     let r_d_km = radius_from_rho(rho_d_km);
     let mu_d = clamp_cosine((s.r_km * s.mu + d_km) / r_d_km);
     let mu_s_d = clamp_cosine((s.r_km * s.mu_s + d_km * nu) / r_d_km);
-    return scattering_uvwz(r_d_km, rho_d_km, mu_d, mu_s_d, nu, ground);
+    return at_table(scattering_uvwz(r_d_km, rho_d_km, mu_d, mu_s_d, nu, ground), mu_s_d);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -396,7 +392,7 @@ fn sky_ray(v: View, o: Observer, light: ViewLight, dir: vec3<f32>, shadow_length
     ray.shadowed = shadow_length_km > 0.0;
     if (ray.shadowed) {
         // The scattering beyond the shadow, attenuated by T(0, l).
-        ray.at = at_table(uvwz_along(s, nu, shadow_length_km, ray.ground), mu_s_along(s, nu, shadow_length_km));
+        ray.at = at_along(s, nu, shadow_length_km, ray.ground);
         ray.t_shadow = transmittance_filters(s.r_km, s.rho_km, s.mu, shadow_length_km, ray.ground);
     } else {
         ray.at = at_start(s, light, nu, ray.ground);
@@ -476,7 +472,7 @@ fn ground_ray(v: View, o: Observer, light: ViewLight, dir: vec3<f32>, shadow_len
     if (shadow_length_km > 0.0) {
         // The lit part ends `shadow_length_km` before the point.
         let e_km = max(d_km - shadow_length_km, 0.0);
-        ray.at_end = at_red(v, at_table(uvwz_along(s, nu, e_km, true), mu_s_along(s, nu, e_km)), p_r);
+        ray.at_end = at_red(v, at_along(s, nu, e_km, true), p_r);
         ray.t_end = transmittance_filters(s.r_km, s.rho_km, s.mu, e_km, true);
     } else {
         ray.at_end = at_red(v, at_table(scattering_uvwz(atm.bottom_radius_km, 0.0, mu_p, ray.mu_s_ground, nu, true), ray.mu_s_ground), p_r);

@@ -17,8 +17,8 @@ struct Lights {
     data: array<vec4<f32>, LIGHTS_DATA_VEC4>,
     // The glow from beyond the air (scene::sky_lights::Background): (on, the emitting
     // layer's share, its radius in km, 0), then the zenith radiance per channel group.
-    glow: vec4<f32>,
-    glow_radiance: array<vec4<f32>, MAX_CHANNEL_GROUPS>,
+    background: vec4<f32>,
+    background_radiance: array<vec4<f32>, MAX_CHANNEL_GROUPS>,
 }
 
 @group(0) @binding(14) var<uniform> lights: Lights;
@@ -67,10 +67,10 @@ fn disk_radiance(light: u32, mu: f32, k: u32) -> vec4<f32> {
     return max(s, vec4<f32>(0.0));
 }
 
-// LunarDisk::add_radiance before the transmittance: the surface normal where `dir` meets a
+// LunarDisk::add_radiance (scene/lunar.rs) before the transmittance: the surface normal where `dir` meets a
 // unit-distance sphere of radius sin α, then lit × μ₀/(μ₀ + μ) + earthshine on the lit
 // part, earthshine on the dark part.
-fn lunar_radiance(light: u32, dir: vec3<f32>, k: u32) -> vec4<f32> {
+fn lunar_disk_radiance(light: u32, dir: vec3<f32>, k: u32) -> vec4<f32> {
     let c = lights.direction[light].xyz;
     let r = bitcast<f32>(lights.disk[light].y);
     let off = cross(dir, c);
@@ -93,7 +93,7 @@ fn lunar_radiance(light: u32, dir: vec3<f32>, k: u32) -> vec4<f32> {
 // The disk's radiance along `dir` for channel group k (inside the disk).
 fn light_disk_radiance(light: u32, disk: Disk, dir: vec3<f32>, k: u32) -> vec4<f32> {
     if (lights.disk[light].z != 0u) {
-        return lunar_radiance(light, dir, k);
+        return lunar_disk_radiance(light, dir, k);
     }
     return disk_radiance(light, disk.mu, k);
 }
@@ -106,10 +106,10 @@ fn light_irradiance(light: u32, k: u32) -> vec4<f32> {
     return light_data(light, k, LIGHT_IRRADIANCE);
 }
 
-// Background::factor: the van Rhijn factor for the layer's share, 1 for the rest, seen
-// from radius r_km with the cosine of the zenith angle cos_z.
-fn glow_factor(r_km: f32, cos_z: f32) -> f32 {
-    let x = min(r_km / lights.glow.z, 1.0);
+// Background::factor (scene/sky_lights.rs): the van Rhijn factor for the layer's share, 1
+// for the rest, seen from radius r_km with the cosine of the zenith angle cos_z.
+fn background_factor(r_km: f32, cos_z: f32) -> f32 {
+    let x = min(r_km / lights.background.z, 1.0);
     let van_rhijn = 1.0 / sqrt(max(1.0 - x * x * (1.0 - cos_z * cos_z), 1e-6));
-    return lights.glow.y * van_rhijn + (1.0 - lights.glow.y);
+    return lights.background.y * van_rhijn + (1.0 - lights.background.y);
 }

@@ -84,20 +84,20 @@ fn shade(dir: vec3<f32>, shadow_length_km: f32) -> vec3<f32> {
         // The sky, and the light's disk through the air (never towards the ground).
         let s = sky_ray(v, o, vl, dir, shadow_length_km);
         let disk = light_disk(light, dir);
-        // The night glow once (with the first light's ray: the transmittance is the same).
-        let glow = light == 0u && lights.glow.x > 0.0;
-        var glow_f = 0.0;
-        if (glow) {
+        // The background once (with the first light's ray: the transmittance is the same).
+        let background = light == 0u && lights.background.x > 0.0;
+        var background_f = 0.0;
+        if (background) {
             // The observer is on the +z axis: the ray's cosine of the zenith angle is dir.z.
-            glow_f = glow_factor(o.r_km, dir.z);
+            background_f = background_factor(o.r_km, dir.z);
         }
         for (var k = 0u; k < atm.groups; k++) {
             var l = sky_radiance(v, s, k) * light_scale(light, k);
             if (disk.inside) {
                 l += light_disk_radiance(light, disk, dir, k) * sky_transmittance(s, k);
             }
-            if (glow) {
-                l += lights.glow_radiance[k] * glow_f * sky_transmittance(s, k);
+            if (background) {
+                l += lights.background_radiance[k] * background_f * sky_transmittance(s, k);
             }
             rgb += to_srgb(l, k);
         }

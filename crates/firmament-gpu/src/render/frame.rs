@@ -181,8 +181,8 @@ pub(crate) fn light_words(
             data[at..at + 3].copy_from_slice(&[s.x as f32, s.y as f32, s.z as f32]);
         }
     }
-    // The glow: (on, the layer's share, the layer's radius in km, 0), then its zenith
-    // radiance per channel group.
+    // The background: (on, the layer's share, the layer's radius in km, 0), then its
+    // zenith radiance per channel group.
     let mut glow = vec![0.0f32; 4 + groups * 4];
     if let Some(b) = background {
         glow[0] = 1.0;

@@ -123,8 +123,9 @@ pub(super) fn scene_transmittance(
         out.iter_mut().for_each(|v| *v = 0.0);
         return;
     }
-    let mut radiance = vec![0.0; out.len()];
-    sky_view.sky_radiance(dir, Shadow::None, &mut radiance, out);
+    crate::spectrum::with_channel_buffers(out.len(), |[radiance]| {
+        sky_view.sky_radiance(dir, Shadow::None, radiance, out)
+    });
 }
 
 /// Transmittance from `observer` (planet-centred, m) to space along `dir`, from `model`'s
@@ -156,4 +157,28 @@ pub fn transmittance_to_space(model: &Model, observer: Vec3, dir: Vec3, out: &mu
     for (o, t) in out.iter_mut().zip(tau) {
         *o = (-t).exp();
     }
+}
+
+/// Adds `points` to `frame`, rendered elsewhere (the GPU) with `settings` for `model`, seen
+/// through the model's own transmittance ([`transmittance_to_space`]).
+pub fn draw_points_into(
+    frame: &mut super::Frame,
+    points: &[PointSource],
+    model: &Model,
+    settings: &super::RenderSettings,
+) {
+    let (w, h) = (settings.width, settings.height);
+    let camera = settings.camera.prepare(model.bottom_radius_m, w, h);
+    let observer = Vec3::new(0.0, 0.0, model.bottom_radius_m + settings.camera.altitude_m);
+    let colour = ColourMatrix::new(model.wavelengths.nm());
+    let transmittance =
+        |dir: Vec3, out: &mut [f64]| transmittance_to_space(model, observer, dir, out);
+    let view = PointView {
+        transmittance: &transmittance,
+        camera: &camera,
+        colour: &colour,
+        balance: colour.white_balance(&model.solar_irradiance, settings.white_balance),
+    };
+    let super::Frame { image, mask } = frame;
+    draw_points(points, model.channels(), &view, image, mask);
 }

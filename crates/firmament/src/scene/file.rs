@@ -229,8 +229,10 @@ impl SceneFile {
             return Ok(None);
         };
         let instant = crate::astro::Instant::parse(&t.at, "time.at")?;
-        let place = crate::astro::Place::new(l.lat_deg, l.lon_deg, l.elevation_m)?;
-        let weather = crate::astro::Weather::new(l.pressure_hpa, l.temperature_c)?;
+        let place = crate::astro::Place::new(l.lat_deg, l.lon_deg, l.elevation_m)
+            .map_err(|e| e.prefixed("location."))?;
+        let weather = crate::astro::Weather::new(l.pressure_hpa, l.temperature_c)
+            .map_err(|e| e.prefixed("location."))?;
         crate::astro::Sky::at(instant, place, &weather).map(Some)
     }
 
@@ -269,20 +271,14 @@ impl SceneFile {
                 "a number in [-360, 360] degrees",
             ));
         }
-        if let Some(t) = &self.time {
-            crate::astro::Instant::parse(&t.at, "time.at")?;
-            let Some(l) = &self.location else {
-                return Err(Error::invalid(
-                    "location",
-                    "missing",
-                    "a [location] with lat_deg and lon_deg when [time] is given",
-                ));
-            };
-            crate::astro::Place::new(l.lat_deg, l.lon_deg, l.elevation_m)
-                .map_err(|e| e.prefixed("location."))?;
-            crate::astro::Weather::new(l.pressure_hpa, l.temperature_c)
-                .map_err(|e| e.prefixed("location."))?;
+        if self.time.is_some() && self.location.is_none() {
+            return Err(Error::invalid(
+                "location",
+                "missing",
+                "a [location] with lat_deg and lon_deg when [time] is given",
+            ));
         }
+        self.astro()?;
         if let Some(ev) = self.output.ev100 {
             if !(ev.is_finite() && (-20.0..=30.0).contains(&ev)) {
                 return Err(Error::invalid("output.ev100", ev, "a number in [-20, 30]"));

@@ -160,6 +160,16 @@ pub struct SkySources {
     pub stars: Vec<PointSource>,
 }
 
+impl SkySources {
+    /// `model`'s sun alone in direction `direction` (a scene without a date).
+    pub fn sun(model: &Model, direction: Vec3, disk: bool) -> SkySources {
+        SkySources {
+            lights: vec![Light::sun(model, direction, disk)],
+            ..SkySources::default()
+        }
+    }
+}
+
 /// The sources of `sky` for `model`: [`lights_of`], and at night (the sun's upper limb
 /// below the horizon, −0.833°) the glow and the stars; by day both are under 10⁻⁶ of the
 /// sky's radiance.
