@@ -397,6 +397,7 @@ fn reference_is_deterministic_given_a_seed() {
     let pixels = reference::render_pixels(
         &model,
         &[],
+        &[],
         &[(camera, view), (camera, Vec3::new(0.0, 0.0, 1.0))],
         0,
         sun,

@@ -107,7 +107,7 @@ fn a_scattering_ball_matches_the_reference() {
         let target = ball.centre + Vec3::new(offset.0, 0.0, offset.1);
         let dir = (target - o).normalize();
         let fast = colour.to_xyz(&common::shade(&scene, o, dir))[1];
-        let e = reference::scene_radiance(model, &volumes, o, dir, sun, &settings, i as u64);
+        let e = reference::scene_radiance(model, &volumes, &[], o, dir, sun, &settings, i as u64);
         let (truth, se) = colour.luminance_and_stderr(&e.radiance, &e.stderr);
         let clear = reference::sky_radiance_keyed(model, o, dir, sun, &settings, 100 + i as u64);
         let (sky_only, _) = colour.luminance_and_stderr(&clear.radiance, &clear.stderr);

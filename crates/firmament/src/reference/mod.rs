@@ -4,7 +4,9 @@
 //!
 //! Physics: spherical planet (any radius up to the plane-parallel limit, R_g = 1e12 m),
 //! layered density profiles, every constituent with its own scattering, absorption and
-//! phase function, a Lambertian ground with per-wavelength albedo, all scattering orders.
+//! phase function, a Lambertian ground with per-wavelength albedo, all scattering orders;
+//! the scene's volumes and its surfaces (terrain, balls: Lambertian, each with its own
+//! albedo, casting shadows) besides the ground sphere where given.
 //! Each wavelength is traced independently with its own coefficients (independent random
 //! streams, so channel errors are independent). Free paths by delta tracking with a
 //! piecewise majorant; the scattering constituent is chosen in proportion to its
@@ -44,7 +46,7 @@ use rayon::prelude::*;
 use crate::atmosphere::Model;
 use crate::math::sphere::ray_sphere;
 use crate::math::Vec3;
-use crate::scene::Volume;
+use crate::scene::{Surface, Volume};
 pub use render::render_frame;
 pub use results::{FluxBudget, IrradianceEstimate, RadianceEstimate, Tally};
 use sampler::{estimate, Stats};
@@ -78,9 +80,11 @@ fn ray_start(model: &Model, camera: Vec3, view: Vec3) -> Option<Vec3> {
     Some(camera + near.max(0.0) * view)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn radiance_pixel(
     model: &Model,
     volumes: &[Box<dyn Volume + '_>],
+    surfaces: &[Box<dyn Surface + '_>],
     camera: Vec3,
     view: Vec3,
     sun: Vec3,
@@ -102,7 +106,7 @@ fn radiance_pixel(
     let o = frame.offset(start);
     let primaries: Vec<tracer::Primary> = (0..n)
         .map(|k| {
-            Channel::new(model, volumes, k, settings).primary(
+            Channel::new(model, volumes, surfaces, k, settings).primary(
                 &frame,
                 o,
                 view,
@@ -113,6 +117,7 @@ fn radiance_pixel(
     let stats = estimate::<1, _>(
         model,
         volumes,
+        surfaces,
         settings,
         DOMAIN_RADIANCE ^ key,
         parallel,
@@ -144,7 +149,7 @@ pub fn sky_radiance(
     sun: Vec3,
     settings: &ReferenceSettings,
 ) -> RadianceEstimate {
-    radiance_pixel(model, &[], camera, view, sun, settings, 0, true)
+    radiance_pixel(model, &[], &[], camera, view, sun, settings, 0, true)
 }
 
 /// [`sky_radiance`] with the random streams keyed by `key` (estimates with different keys
@@ -157,31 +162,43 @@ pub fn sky_radiance_keyed(
     settings: &ReferenceSettings,
     key: u64,
 ) -> RadianceEstimate {
-    radiance_pixel(model, &[], camera, view, sun, settings, key, true)
+    radiance_pixel(model, &[], &[], camera, view, sun, settings, key, true)
 }
 
 /// [`sky_radiance_keyed`] through the scene's `volumes` too (clouds and other media besides
 /// the atmosphere's constituents): their extinction in delta tracking and towards the sun,
-/// their scattering and phase functions at collisions.
+/// their scattering and phase functions at collisions; and with its `surfaces` besides the
+/// planet's ground sphere (terrain, balls; the ground sphere itself is the model's and must
+/// not be among them, though an equal sphere changes nothing): a path that meets one inside
+/// the atmosphere is reflected there (Lambertian, the surface's albedo, NEE with the hit's
+/// normal), a shadow ray that meets one carries no sunlight, and the surface seen directly
+/// counts like the ground (`include_ground`).
+#[allow(clippy::too_many_arguments)]
 pub fn scene_radiance(
     model: &Model,
     volumes: &[Box<dyn Volume + '_>],
+    surfaces: &[Box<dyn Surface + '_>],
     camera: Vec3,
     view: Vec3,
     sun: Vec3,
     settings: &ReferenceSettings,
     key: u64,
 ) -> RadianceEstimate {
-    radiance_pixel(model, volumes, camera, view, sun, settings, key, true)
+    radiance_pixel(
+        model, volumes, surfaces, camera, view, sun, settings, key, true,
+    )
 }
 
 /// [`scene_radiance`] for many (camera, view) rays, in parallel over pixels; pixel
 /// `first + i` uses the random streams of that index (so pixel 0 equals [`sky_radiance`]
-/// without volumes, and an image rendered in batches equals one rendered at once).
+/// without volumes or surfaces, and an image rendered in batches equals one rendered at
+/// once).
 /// `progress` is called once per finished pixel (from any thread).
+#[allow(clippy::too_many_arguments)]
 pub fn render_pixels(
     model: &Model,
     volumes: &[Box<dyn Volume + '_>],
+    surfaces: &[Box<dyn Surface + '_>],
     rays: &[(Vec3, Vec3)],
     first: u64,
     sun: Vec3,
@@ -192,7 +209,9 @@ pub fn render_pixels(
         .enumerate()
         .map(|(i, &(camera, view))| {
             let key = first + i as u64;
-            let e = radiance_pixel(model, volumes, camera, view, sun, settings, key, false);
+            let e = radiance_pixel(
+                model, volumes, surfaces, camera, view, sun, settings, key, false,
+            );
             progress();
             e
         })
@@ -216,6 +235,7 @@ pub fn irradiance(
     let stats =
         estimate::<1, _>(
             model,
+            &[],
             &[],
             settings,
             DOMAIN_IRRADIANCE,
@@ -270,6 +290,7 @@ pub fn flux_budget(
             let o = frame.offset(start);
             estimate::<BUDGET_TALLIES, _>(
                 model,
+                &[],
                 &[],
                 settings,
                 DOMAIN_BUDGET,

@@ -1,6 +1,6 @@
 //! Whole frames by the reference path tracer: the ground-truth image of the clear-sky scene
-//! that `render::render` draws from the tables (ground included, the sun's disk added
-//! through the air along the view).
+//! that `render::render` draws from the tables (ground and surfaces included, the sun's
+//! disk added through the air along the view where no surface hides it).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -10,21 +10,24 @@ use crate::io::ImageRgbF32;
 use crate::math::sphere::ray_sphere;
 use crate::math::Vec3;
 use crate::render::{Frame, RenderSettings};
-use crate::scene::{Light, Volume};
+use crate::scene::{Light, Ray, Surface, Volume};
 use crate::spectrum::ColourMatrix;
 use crate::{Error, Result};
 
 /// The frame of `settings` lit by `sun` (the model's sun in a direction) through the
-/// atmosphere and `volumes`, every pixel traced
-/// with `reference.samples` paths per wavelength (`include_ground` is forced on: a picture
-/// shows the ground). Colour and white balance as [`crate::render::render`]; the sun's disk
-/// is added where a view ray does not meet the ground, attenuated by the transmittance of
-/// the model's column integrals. `progress` receives the fraction done; `cancel` stops it
+/// atmosphere and `volumes`, with `surfaces` besides the ground sphere (see
+/// [`super::scene_radiance`]), every pixel traced with `reference.samples` paths per
+/// wavelength (`include_ground` is forced on: a picture shows the ground). Colour and white
+/// balance as [`crate::render::render`]; the sun's disk is added where a view ray meets
+/// neither the ground nor a surface, attenuated by the transmittance of the model's column
+/// integrals. `progress` receives the fraction done; `cancel` stops it
 /// between batches of pixels. Returns the frame and the mean relative standard error of the
 /// pixels' luminance.
+#[allow(clippy::too_many_arguments)]
 pub fn render_frame(
     model: &Model,
     volumes: &[Box<dyn Volume + '_>],
+    surfaces: &[Box<dyn Surface + '_>],
     settings: &RenderSettings,
     sun: &Light,
     reference: &ReferenceSettings,
@@ -59,6 +62,7 @@ pub fn render_frame(
         estimates.extend(render_pixels(
             model,
             volumes,
+            surfaces,
             chunk,
             (b * batch) as u64,
             sun.direction,
@@ -85,7 +89,7 @@ pub fn render_frame(
     for ((&p, &(origin, dir)), e) in pixels.iter().zip(&rays).zip(&estimates) {
         let mut l: Vec<f64> = e.radiance.iter().zip(&scale).map(|(v, s)| v * s).collect();
         if sun.visible_disk {
-            let t = view_transmittance(model, origin, dir);
+            let t = view_transmittance(model, surfaces, origin, dir);
             sun.add_disk_radiance(dir, &t, &mut l);
         }
         let (y, se) = colour.luminance_and_stderr(&e.radiance, &e.stderr);
@@ -110,10 +114,19 @@ pub fn render_frame(
 }
 
 /// Transmittance of the air along a view ray from `origin` to the top of the atmosphere, 0
-/// where it meets the ground (the model's column integrals).
-fn view_transmittance(model: &Model, origin: Vec3, dir: Vec3) -> Vec<f64> {
+/// where it meets the ground or any of `surfaces` (the model's column integrals).
+fn view_transmittance(
+    model: &Model,
+    surfaces: &[Box<dyn Surface + '_>],
+    origin: Vec3,
+    dir: Vec3,
+) -> Vec<f64> {
     let n = model.channels();
     if ray_sphere(origin, dir, model.bottom_radius_m).is_some_and(|(near, _)| near > 0.0) {
+        return vec![0.0; n];
+    }
+    let ray = Ray { origin, dir };
+    if (surfaces.iter()).any(|s| s.intersect(&ray, f64::INFINITY).is_some()) {
         return vec![0.0; n];
     }
     let mut transmittance = vec![1.0; n];

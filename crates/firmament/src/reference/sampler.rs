@@ -7,7 +7,7 @@ use super::rng::Rng;
 use super::tracer::{self, Channel};
 use super::ReferenceSettings;
 use crate::atmosphere::Model;
-use crate::scene::Volume;
+use crate::scene::{Surface, Volume};
 
 /// Samples per block: the unit of parallel work and of the fixed-order reduction.
 const BLOCK: usize = 256;
@@ -60,6 +60,7 @@ impl Stats {
 pub(super) fn estimate<const M: usize, F>(
     model: &Model,
     volumes: &[Box<dyn Volume + '_>],
+    surfaces: &[Box<dyn Surface + '_>],
     settings: &ReferenceSettings,
     key: u64,
     parallel: bool,
@@ -72,7 +73,7 @@ where
     let samples = settings.samples;
     let blocks = samples.div_ceil(BLOCK).max(1);
     let channels: Vec<Channel> = (0..n_ch)
-        .map(|k| Channel::new(model, volumes, k, settings))
+        .map(|k| Channel::new(model, volumes, surfaces, k, settings))
         .collect();
     let run = |job: usize| -> [Stats; M] {
         let (k, blk) = (job / blocks, job % blocks);

@@ -1,7 +1,8 @@
 //! The path tracer proper: one wavelength at a time through a [`Model`]: the channel's
 //! coefficients ([`Channel`]), positions relative to an anchor ([`geometry`]), free paths by
-//! delta tracking ([`free_path`]), deterministic optical depths ([`optical_depth`]) and the
-//! paths themselves ([`paths`]).
+//! delta tracking ([`free_path`]), deterministic optical depths ([`optical_depth`]), the
+//! scene's volumes ([`volumes`]) and surfaces ([`surfaces`]), and the paths themselves
+//! ([`paths`]).
 //!
 //! Geometry. Positions are kept as an offset `o` from an *anchor* `A` on the ground sphere
 //! (|A| = R_g, below the ray's start), so that the quantity that matters, the altitude, is
@@ -24,11 +25,17 @@
 //! approach), and is 0 if the ray meets the ground (so the partial disk at sunset and the
 //! planet's shadow at twilight come out right). Light that reaches the sun by phase
 //! sampling is not counted (no double counting; the sun disk itself is never seen).
+//!
+//! Surfaces. Besides the analytic ground sphere (the model's albedo), a flight ends at the
+//! nearest of the scene's surfaces inside the atmosphere, where the path is reflected as
+//! at the ground: Lambertian with the surface's albedo about the hit's normal, NEE with
+//! cos = n·l, a shadow ray that any surface blocks. See [`surfaces`].
 
 mod free_path;
 pub(crate) mod geometry;
 mod optical_depth;
 mod paths;
+mod surfaces;
 #[cfg(test)]
 mod tests;
 mod volumes;
@@ -41,7 +48,7 @@ use crate::atmosphere::{LimbDarkening, Model};
 use crate::math::Vec3;
 use crate::medium::{DensityProfile, PhaseFunction};
 use crate::scene::light::{disk_solid_angle_weighted, limb_darkening};
-use crate::scene::Volume;
+use crate::scene::{Surface, SurfaceHit, Volume};
 use geometry::rotate;
 pub(crate) use geometry::{cosine_direction, Frame};
 
@@ -85,6 +92,9 @@ pub(crate) struct Channel<'a> {
     roulette_after: usize,
     /// The scene's volumes (non-atmospheric media), sampled in world coordinates.
     volumes: &'a [Box<dyn Volume + 'a>],
+    /// The scene's surfaces besides the planet's ground sphere (terrain, balls), met by
+    /// world-space rays.
+    surfaces: &'a [Box<dyn Surface + 'a>],
     /// Wavelengths of the model (the volumes' coefficients come for all at once).
     channels: usize,
 }
@@ -92,14 +102,26 @@ pub(crate) struct Channel<'a> {
 /// Graded intervals per monotone piece of a camera ray in [`Primary`].
 pub(crate) const PRIMARY_INTERVALS: usize = 128;
 
-/// A camera ray with its cumulative optical depth at graded nodes (for one wavelength).
+/// A camera ray with its cumulative optical depth at graded nodes (for one wavelength), up
+/// to where it ends (`t_end` m, at `end`).
 pub(crate) struct Primary {
     o: Vec3,
     d: Vec3,
     t: Vec<f64>,
     tau: Vec<f64>,
     t_end: f64,
-    ground: bool,
+    end: End,
+}
+
+/// Where a flight leaves the air.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum End {
+    /// Through the top of the atmosphere.
+    Space,
+    /// On the planet's ground sphere.
+    Ground,
+    /// On the scene's surface of this index.
+    Surface(usize, SurfaceHit),
 }
 
 /// Scratch space for one path: what a collision leaves for the phase function and the
@@ -114,12 +136,15 @@ pub(crate) struct Scratch {
     /// Per-channel buffers for `Volume::coefficients`.
     pub(crate) extinction: Vec<f64>,
     pub(crate) scattering: Vec<f64>,
+    /// Per-channel buffer for `Surface::albedo`.
+    pub(crate) albedo: Vec<f64>,
 }
 
 impl<'a> Channel<'a> {
     pub(crate) fn new(
         model: &'a Model,
         volumes: &'a [Box<dyn Volume + 'a>],
+        surfaces: &'a [Box<dyn Surface + 'a>],
         k: usize,
         settings: &ReferenceSettings,
     ) -> Channel<'a> {
@@ -187,6 +212,7 @@ impl<'a> Channel<'a> {
             max_bounces: settings.max_bounces,
             roulette_after: settings.roulette_after,
             volumes,
+            surfaces,
             channels: model.channels(),
         }
     }
@@ -203,6 +229,7 @@ impl<'a> Channel<'a> {
             point: Vec3::ZERO,
             extinction: vec![0.0; self.channels],
             scattering: vec![0.0; self.channels],
+            albedo: vec![0.0; self.channels],
         }
     }
 

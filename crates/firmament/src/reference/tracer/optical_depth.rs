@@ -9,12 +9,12 @@ use crate::math::Vec3;
 
 impl Channel<'_> {
     /// Deterministic transmittance from offset `o` along unit `d` to the top of the
-    /// atmosphere, through the volumes too; 0 if the ray meets the ground.
+    /// atmosphere, through the volumes too; 0 if the ray meets the ground or a surface.
     pub(crate) fn transmittance(&self, frame: &Frame, o: Vec3, d: Vec3) -> f64 {
         let x0 = frame.x(o);
         let b = frame.b(o, d);
         let (t_end, ground) = self.boundary(x0, b);
-        if ground {
+        if ground || self.surfaces_block(frame, o, d, t_end) {
             return 0.0;
         }
         let mut tau = self.optical_depth(x0, b, t_end);
@@ -122,11 +122,12 @@ impl Channel<'_> {
         tau
     }
 
-    /// The cumulative optical depth along a camera ray, for forced first collisions.
+    /// The cumulative optical depth along a camera ray up to where it ends (the ground, a
+    /// surface or the top), for forced first collisions.
     pub(crate) fn primary(&self, frame: &Frame, o: Vec3, d: Vec3, intervals: usize) -> Primary {
         let x0 = frame.x(o);
         let b = frame.b(o, d);
-        let (t_end, ground) = self.boundary(x0, b);
+        let (t_end, end) = self.flight(frame, o, d, x0, b);
         let mut t = vec![0.0];
         let mut tau = vec![0.0];
         let ts = -b;
@@ -166,7 +167,7 @@ impl Channel<'_> {
             t,
             tau,
             t_end,
-            ground,
+            end,
         }
     }
 }

@@ -1,6 +1,6 @@
 //! The paths: camera rays with a forced first collision, then delta tracking with
-//! next-event estimation towards the sun at every collision and ground bounce; photons from
-//! the sun for the flux budget.
+//! next-event estimation towards the sun at every collision and reflection (on the ground
+//! sphere or a surface); photons from the sun for the flux budget.
 
 use std::f64::consts::PI;
 
@@ -14,15 +14,16 @@ use crate::reference::rng::Rng;
 
 impl Channel<'_> {
     /// One radiance sample (W·m⁻²·sr⁻¹·nm⁻¹) along a camera ray (the path runs from the
-    /// eye towards the light). `primary_ground`: whether the ground seen directly by this
-    /// ray contributes its reflected light.
+    /// eye towards the light). `primary_ground`: whether the ground or surface seen directly
+    /// by this ray contributes its reflected light.
     ///
     /// The first collision is forced: its optical depth is drawn from the exponential
-    /// distribution truncated to the ray's total τ_L (tabulated exactly at
-    /// `intervals` graded nodes per monotone piece, linear in between), with weight
-    /// σ_s(t)·(1 − e^{−τ_L})/σ̄(interval); the uncollided part (probability e^{−τ_L}) is
-    /// followed too when it reaches a ground that counts. This removes the variance of
-    /// "did the path collide at all", which dominates in thin air (zenith views, space).
+    /// distribution truncated to the ray's total τ_L (tabulated exactly at `intervals`
+    /// graded nodes per monotone piece, linear in between; τ_L up to the ground, a surface
+    /// or the top), with weight σ_s(t)·(1 − e^{−τ_L})/σ̄(interval); the uncollided part
+    /// (probability e^{−τ_L}) is followed too when it reaches a ground or surface that
+    /// counts. This removes the variance of "did the path collide at all", which dominates
+    /// in thin air (zenith views, space).
     /// Through volumes the first flight is plain delta tracking.
     pub(crate) fn radiance_sample(
         &self,
@@ -69,11 +70,30 @@ impl Channel<'_> {
                 }
             }
         }
-        if primary.ground && primary_ground && self.ground_albedo > 0.0 {
-            let o = advance(primary.o, primary.t_end, primary.d);
-            radiance += self.after_ground(frame, o, (-tau_l).exp(), 0, sun, rng, scratch);
+        if primary_ground {
+            radiance += self.primary_reflection(frame, primary, (-tau_l).exp(), sun, rng, scratch);
         }
         radiance
+    }
+
+    /// The reflection where a camera ray ends (none at the top of the atmosphere), reached
+    /// uncollided with weight `w`.
+    fn primary_reflection(
+        &self,
+        frame: &Frame,
+        primary: &Primary,
+        w: f64,
+        sun: Vec3,
+        rng: &mut Rng,
+        scratch: &mut Scratch,
+    ) -> f64 {
+        let (o, d) = (primary.o, primary.d);
+        match self.reflection(frame, o, d, primary.t_end, &primary.end, scratch) {
+            Some((o, n, albedo)) if albedo > 0.0 => {
+                self.after_reflection(frame, o, n, albedo, w, 0, sun, rng, scratch)
+            }
+            _ => 0.0,
+        }
     }
 
     /// [`Channel::radiance_sample`] through the scene's volumes: the first flight by plain
@@ -98,9 +118,8 @@ impl Channel<'_> {
                 }
                 self.after_collision(frame, x, d, ss / st, ss, sun, rng, scratch)
             }
-            None if primary.ground && primary_ground && self.ground_albedo > 0.0 => {
-                let x = advance(o, primary.t_end, d);
-                self.after_ground(frame, x, 1.0, 0, sun, rng, scratch)
+            None if primary_ground => {
+                self.primary_reflection(frame, primary, 1.0, sun, rng, scratch)
             }
             None => 0.0,
         }
@@ -135,28 +154,31 @@ impl Channel<'_> {
         radiance
     }
 
-    /// A ground reflection at `o` with incoming weight `w` after `events` events: NEE, then
-    /// the rest of the path.
-    pub(super) fn after_ground(
+    /// A Lambertian reflection at `o` (on the ground or lifted off a surface) about unit
+    /// normal `n` with `albedo`, incoming weight `w` after `events` events: NEE, then the
+    /// rest of the path.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn after_reflection(
         &self,
         frame: &Frame,
         o: Vec3,
+        n: Vec3,
+        albedo: f64,
         mut w: f64,
         mut events: usize,
         sun: Vec3,
         rng: &mut Rng,
         scratch: &mut Scratch,
     ) -> f64 {
-        let n = frame.up(o);
         events += 1;
         let (ls, e) = self.sample_sun(sun, rng);
         let cos = n.dot(ls);
         let mut radiance = 0.0;
         if cos > 0.0 {
             let tr = self.transmittance(frame, o, ls);
-            radiance += w * self.ground_albedo / PI * cos * tr * e;
+            radiance += w * albedo / PI * cos * tr * e;
         }
-        w *= self.ground_albedo;
+        w *= albedo;
         if events >= self.max_bounces || !self.roulette(events, &mut w, rng) {
             return radiance;
         }
@@ -180,7 +202,7 @@ impl Channel<'_> {
         loop {
             let x0 = frame.x(o);
             let b = frame.b(o, d);
-            let (t_end, ground) = self.boundary(x0, b);
+            let (t_end, end) = self.flight(frame, o, d, x0, b);
             if let Some(t) = self.collide(frame, o, d, t_end, rng, scratch) {
                 o = advance(o, t, d);
                 let h = self.alt(x0, b, t);
@@ -200,19 +222,22 @@ impl Channel<'_> {
                 }
                 d = self.scatter(d, scratch, ss, rng);
             } else {
-                if !ground || self.ground_albedo <= 0.0 {
+                let Some((p, n, albedo)) = self.reflection(frame, o, d, t_end, &end, scratch)
+                else {
+                    break;
+                };
+                if albedo <= 0.0 {
                     break;
                 }
-                o = advance(o, t_end, d);
-                let n = frame.up(o);
+                o = p;
                 events += 1;
                 let (ls, e) = self.sample_sun(sun, rng);
                 let cos = n.dot(ls);
                 if cos > 0.0 {
                     let tr = self.transmittance(frame, o, ls);
-                    radiance += w * self.ground_albedo / PI * cos * tr * e;
+                    radiance += w * albedo / PI * cos * tr * e;
                 }
-                w *= self.ground_albedo;
+                w *= albedo;
                 if events >= self.max_bounces || !self.roulette(events, &mut w, rng) {
                     break;
                 }
@@ -223,7 +248,8 @@ impl Channel<'_> {
     }
 
     /// One photon from offset `o` (on the top of the atmosphere) along `d` (= −sun),
-    /// tallied as fractions of its power: see the `T_*` indices.
+    /// tallied as fractions of its power: see the `T_*` indices. The planet alone: the flux
+    /// budget traces no surfaces.
     pub(crate) fn budget_sample(
         &self,
         frame: &Frame,
@@ -232,6 +258,7 @@ impl Channel<'_> {
         rng: &mut Rng,
         scratch: &mut Scratch,
     ) -> [f64; BUDGET_TALLIES] {
+        debug_assert!(!self.has_surfaces(), "the flux budget traces no surfaces");
         let mut tally = [0.0; BUDGET_TALLIES];
         let mut w = 1.0;
         let mut events = 0usize;
