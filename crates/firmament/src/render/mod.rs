@@ -115,6 +115,7 @@ impl<'s> Shader<'s> {
         match hit {
             Some((i, hit)) => with_channel_buffers(n, |[l, t, albedo, direct, sky]| {
                 scene.surfaces[i].albedo(&hit, albedo);
+                let visible_sky = scene.surfaces[i].sky_visibility(&hit);
                 for view in &self.views {
                     let (shadow, lit_at_end) = self.shadow(ray, view.light(), end, scratch);
                     view.sun_and_sky_irradiance(hit.position, hit.normal, direct, sky);
@@ -124,7 +125,7 @@ impl<'s> Shader<'s> {
                     view.sky_radiance_to_point(hit.position, shadow, l, t);
                     for k in 0..n {
                         out[k] += l[k];
-                        out[k] += albedo[k] / PI * (direct[k] + sky[k]) * t[k];
+                        out[k] += albedo[k] / PI * (direct[k] + visible_sky * sky[k]) * t[k];
                     }
                 }
             }),

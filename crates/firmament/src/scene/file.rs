@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::camera::{Camera, Projection};
+use super::terrain::TerrainConfig;
 use crate::render::tonemap::ToneCurve;
 use crate::{Error, Result};
 
@@ -141,24 +142,29 @@ pub struct SceneFile {
     /// When: the sun, the moon and the night sky from the date.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub time: Option<SceneTime>,
+    /// Mountains around the observer (none: the planet's smooth sphere). The camera's
+    /// altitude is then above the terrain's surface below it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub terrain: Option<TerrainConfig>,
     /// Output.
     pub output: SceneOutput,
 }
 
 impl Default for SceneSun {
-    /// Low in the west-south-west: late afternoon.
+    /// 5.5° high in the south-west, behind a peak from the default camera: golden hour.
     fn default() -> Self {
         SceneSun {
-            zenith_deg: 84.0,
-            azimuth_deg: 250.0,
+            zenith_deg: 84.5,
+            azimuth_deg: 237.0,
             disk: true,
         }
     }
 }
 
 impl Default for SceneFile {
-    /// Late afternoon from a hill 1.5 km up, looking west-south-west towards the low sun
-    /// over the planet's curved horizon.
+    /// Golden hour in an alpine valley: the camera 25 m above the valley floor looking
+    /// west-south-west up the valley towards the low sun behind the ridges, the light
+    /// shafts in the air between them.
     fn default() -> Self {
         SceneFile {
             atmosphere: SceneAtmosphere {
@@ -168,19 +174,20 @@ impl Default for SceneFile {
             },
             camera: Camera {
                 projection: Projection::Perspective,
-                altitude_m: 1500.0,
-                heading_deg: 235.0,
-                pitch_deg: 8.0,
+                altitude_m: 25.0,
+                heading_deg: 250.0,
+                pitch_deg: 6.0,
                 roll_deg: 0.0,
-                fov_deg: 65.0,
+                fov_deg: 55.0,
             },
             image: SceneImage {
-                width: 1280,
-                height: 720,
+                width: 1920,
+                height: 1080,
             },
             sun: SceneSun::default(),
             location: None,
             time: None,
+            terrain: Some(TerrainConfig::default()),
             output: SceneOutput {
                 ev100: None,
                 tonemap: ToneCurve::Aces,
@@ -219,6 +226,9 @@ impl SceneFile {
                 scene.atmosphere.file = Some(dir.join(f));
             }
         }
+        if let (Some(t), Some(dir)) = (&mut scene.terrain, path.parent()) {
+            t.resolve_paths(dir);
+        }
         scene.validate()?;
         Ok(scene)
     }
@@ -234,6 +244,18 @@ impl SceneFile {
         let weather = crate::astro::Weather::new(l.pressure_hpa, l.temperature_c)
             .map_err(|e| e.prefixed("location."))?;
         crate::astro::Sky::at(instant, place, &weather).map(Some)
+    }
+
+    /// The terrain of `[terrain]` on `model`'s planet, its materials at the model's
+    /// wavelengths.
+    pub fn build_terrain(
+        &self,
+        model: &crate::atmosphere::Model,
+    ) -> Result<Option<super::terrain::Heightfield>> {
+        self.terrain
+            .as_ref()
+            .map(|t| t.build(model.bottom_radius_m, model.wavelengths.nm()))
+            .transpose()
     }
 
     /// Check every value; messages name the field.
@@ -279,6 +301,9 @@ impl SceneFile {
             ));
         }
         self.astro()?;
+        if let Some(t) = &self.terrain {
+            t.validate()?;
+        }
         if let Some(ev) = self.output.ev100 {
             if !(ev.is_finite() && (-20.0..=30.0).contains(&ev)) {
                 return Err(Error::invalid("output.ev100", ev, "a number in [-20, 30]"));

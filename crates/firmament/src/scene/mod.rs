@@ -11,6 +11,7 @@ pub mod light;
 pub mod lunar;
 pub mod sky_lights;
 pub mod surface;
+pub mod terrain;
 pub mod volume;
 
 pub use camera::{Camera, PreparedCamera, Projection, Ray};
@@ -21,6 +22,9 @@ pub use volume::{HomogeneousSphere, Volume};
 
 use crate::math::{direction_from_zenith_azimuth, Vec3};
 use crate::sky::SkyMethod;
+
+/// Distance (m) within which two surfaces' hits count as the same point.
+pub const TIE_M: f64 = 1e-2;
 
 /// Everything a frame composes. The renderer asks each part only what its seam offers: the
 /// sky method for the atmosphere's light, each surface for hits and shadows, each volume for
@@ -57,10 +61,12 @@ impl<'a> Scene<'a> {
     }
 
     /// The nearest surface hit of `ray` closer than `max_distance_m`: (surface index, hit).
+    /// An earlier surface wins a tie within [`TIE_M`] (the terrain, listed before the
+    /// planet's sphere, where it lies on it).
     pub fn nearest_hit(&self, ray: &Ray, max_distance_m: f64) -> Option<(usize, SurfaceHit)> {
         let mut best: Option<(usize, SurfaceHit)> = None;
         for (i, s) in self.surfaces.iter().enumerate() {
-            let limit = best.map_or(max_distance_m, |(_, h)| h.distance_m);
+            let limit = best.map_or(max_distance_m, |(_, h)| h.distance_m - TIE_M);
             if let Some(h) = s.intersect(ray, limit) {
                 best = Some((i, h));
             }

@@ -1,6 +1,6 @@
 //! Surfaces: what a ray can hit (distance, position, normal) and how it reflects (a Lambertian
 //! albedo per wavelength), and the shadows it casts. The planet's ground sphere is the first;
-//! a heightfield will be the next.
+//! the terrain's heightfield (`scene/terrain/`) the second.
 
 use crate::atmosphere::Model;
 use crate::math::sphere::ray_sphere;
@@ -39,6 +39,36 @@ pub trait Surface: Send + Sync {
         out: &mut Vec<(f64, f64)>,
     ) {
         let _ = (ray, light, max_distance_m, out);
+    }
+
+    /// The fraction of the sky light that reaches `hit` past the rest of this surface,
+    /// relative to an open plane of the same tilt (ambient occlusion; the plane's own
+    /// (1 + n·up)/2 is the sky method's). 1 by default.
+    fn sky_visibility(&self, hit: &SurfaceHit) -> f64 {
+        let _ = hit;
+        1.0
+    }
+}
+
+/// A borrowed surface is a surface (a scene can hold a terrain built once for many frames).
+impl<T: Surface + ?Sized> Surface for &T {
+    fn intersect(&self, ray: &Ray, max_distance_m: f64) -> Option<SurfaceHit> {
+        (**self).intersect(ray, max_distance_m)
+    }
+    fn albedo(&self, hit: &SurfaceHit, out: &mut [f64]) {
+        (**self).albedo(hit, out)
+    }
+    fn shadowed_intervals(
+        &self,
+        ray: &Ray,
+        light: Vec3,
+        max_distance_m: f64,
+        out: &mut Vec<(f64, f64)>,
+    ) {
+        (**self).shadowed_intervals(ray, light, max_distance_m, out)
+    }
+    fn sky_visibility(&self, hit: &SurfaceHit) -> f64 {
+        (**self).sky_visibility(hit)
     }
 }
 

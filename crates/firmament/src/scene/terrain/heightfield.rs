@@ -1,0 +1,272 @@
+//! The terrain as a surface: heights above the planet's sphere on a grid ([`super::grid`]),
+//! hit exactly by rays (a max-mip walk, then the exact root of the ray against each cell's
+//! bilinear patch), shaded with a smooth normal, coloured by its materials, and casting
+//! shadows into the air and onto itself through the shadow-height field of each light
+//! ([`super::shadow`]).
+
+use std::sync::{Arc, RwLock};
+
+use super::grid::{
+    along_segment, bilinear, first_descent, fractions, walk, CellSpan, Grid, GridRay, MaxPyramid,
+};
+use super::materials::Materials;
+use super::shadow::ShadowField;
+use crate::math::Vec3;
+use crate::scene::camera::Ray;
+use crate::scene::surface::{Surface, SurfaceHit};
+
+/// Shadow fields kept per light direction (a frame has at most a few lights).
+const SHADOW_CACHE: usize = 4;
+
+/// A heightfield on the planet.
+pub struct Heightfield {
+    /// Heights above the sphere (m) at the grid's vertices (axis-aligned: x′ = east).
+    pub heights: Grid,
+    pyramid: MaxPyramid,
+    /// The planet's radius (m).
+    pub radius_m: f64,
+    /// The surface's reflectance.
+    pub materials: Materials,
+    /// Whether the terrain casts shadows (on itself, and into the air when `shafts`).
+    pub casts_shadows: bool,
+    /// Whether its shadows in the air (the light shafts) are computed; off, only the
+    /// surface's shadows are (exact shadow rays at the view rays' ends).
+    pub shafts: bool,
+    /// The fraction of the sky the terrain leaves visible, relative to an open plane of the
+    /// same tilt ([`super::occlusion`]), on the heights' grid; none: 1 everywhere.
+    pub visibility: Option<Grid>,
+    shadows: RwLock<Vec<(Vec3, Arc<ShadowField>)>>,
+}
+
+impl Heightfield {
+    /// A heightfield of `heights` (grid in the plane tangent at the observer's foot) on a
+    /// planet of radius `radius_m`.
+    pub fn new(heights: Grid, radius_m: f64, materials: Materials) -> Heightfield {
+        let pyramid = MaxPyramid::new(&heights);
+        Heightfield {
+            heights,
+            pyramid,
+            radius_m,
+            materials,
+            casts_shadows: true,
+            shafts: true,
+            visibility: None,
+            shadows: RwLock::new(Vec::new()),
+        }
+    }
+
+    /// A copy with no shadow fields cached (each light's is computed again on first use).
+    pub fn clone_without_shadows(&self) -> Heightfield {
+        Heightfield {
+            heights: self.heights.clone(),
+            pyramid: self.pyramid.clone(),
+            radius_m: self.radius_m,
+            materials: self.materials.clone(),
+            casts_shadows: self.casts_shadows,
+            shafts: self.shafts,
+            visibility: self.visibility.clone(),
+            shadows: RwLock::new(Vec::new()),
+        }
+    }
+
+    /// The highest point (m above the sphere).
+    pub fn max_height_m(&self) -> f64 {
+        self.pyramid.max()
+    }
+
+    /// The height (m) at plane coordinates (u, v) (0 off the grid: the sphere).
+    pub fn height_at(&self, u: f64, v: f64) -> f64 {
+        let (gx, gy) = self.heights.cell_coords(u, v);
+        if self.heights.contains(gx, gy) {
+            self.heights.bilinear(gx, gy)
+        } else {
+            0.0
+        }
+    }
+
+    /// The height (m) below a planet-centred point.
+    pub fn height_below(&self, p: Vec3) -> f64 {
+        if p.z <= 0.0 {
+            return 0.0;
+        }
+        let r = self.radius_m;
+        self.height_at(r * p.x / p.z, r * p.y / p.z)
+    }
+
+    fn grid_ray(&self, ray: &Ray) -> GridRay {
+        GridRay {
+            origin: ray.origin,
+            dir: ray.dir,
+            radius_m: self.radius_m,
+        }
+    }
+
+    /// The smooth (shading) normal at a planet-centred point on the surface: the surface
+    /// S(u, v) = (R + H(u, v))·n̂(u, v), n̂ = (u, v, R)/|(u, v, R)|, with H's gradient from
+    /// central differences interpolated bilinearly.
+    pub fn normal_at(&self, p: Vec3) -> Vec3 {
+        let r = self.radius_m;
+        let (u, v) = (r * p.x / p.z, r * p.y / p.z);
+        let (gx, gy) = self.heights.cell_coords(u, v);
+        let (hu, hv) = self.heights.gradient(gx, gy);
+        let h = self.heights.bilinear(gx, gy);
+        let q = Vec3::new(u, v, r);
+        let len = q.length();
+        let n = q / len;
+        // ∂n̂/∂u = (e_x − n̂ n̂_x)/|q|, likewise for v.
+        let dn_du = (Vec3::X - n * n.x) / len;
+        let dn_dv = (Vec3::Y - n * n.y) / len;
+        let su = hu * n + (r + h) * dn_du;
+        let sv = hv * n + (r + h) * dn_dv;
+        su.cross(sv).normalize()
+    }
+
+    /// The shadow-height field for light direction `light` (computed once per direction).
+    pub fn shadow_field(&self, light: Vec3) -> Arc<ShadowField> {
+        if let Some((_, f)) = (self.shadows.read().unwrap().iter()).find(|(d, _)| *d == light) {
+            return f.clone();
+        }
+        let mut cache = self.shadows.write().unwrap();
+        if let Some((_, f)) = cache.iter().find(|(d, _)| *d == light) {
+            return f.clone();
+        }
+        let field = Arc::new(ShadowField::new(self, light));
+        if cache.len() >= SHADOW_CACHE {
+            cache.remove(0);
+        }
+        cache.push((light, field.clone()));
+        field
+    }
+
+    /// Whether the terrain hides direction `light` from point `p` (planet-centred, on or
+    /// above the surface): an exact shadow ray.
+    pub fn occludes(&self, p: Vec3, light: Vec3) -> bool {
+        let ray = Ray {
+            origin: p,
+            dir: light,
+        };
+        self.intersect(&ray, f64::INFINITY).is_some()
+    }
+}
+
+/// Newton steps on the exact ray height minus the patch from the root `s` of the cell's
+/// quadratic `f` (which takes the ray as straight in the cell: to 1e-3 m at grazing
+/// incidence), so a hit on a flat terrain is the sphere's to 1e-9 m.
+fn refine(gr: &GridRay, grid: &Grid, cell: CellSpan, s: f64, f: [f64; 3]) -> f64 {
+    let span = cell.t1 - cell.t0;
+    let mut t = cell.t0 + s * span;
+    if s <= 0.0 {
+        return t;
+    }
+    let slope = (f[1] + 2.0 * f[2] * s) / span;
+    if slope >= 0.0 {
+        return t;
+    }
+    for _ in 0..2 {
+        let (x, y, h) = gr.grid_point(grid, t);
+        let (a, b) = fractions(x, y, cell.i, cell.j);
+        let g = h - bilinear(grid.corners(cell.i, cell.j), a, b);
+        t = (t - g / slope).clamp(cell.t0, cell.t1);
+    }
+    t
+}
+
+impl Heightfield {
+    /// Whether `ray` ends at `max_distance_m` on a surface (the terrain or the sphere under
+    /// it) that `light` does not reach: an exact shadow ray, from 5 cm above the end.
+    pub fn ends_in_shadow(&self, ray: &GridRay, light: Vec3, max_distance_m: f64) -> bool {
+        if !max_distance_m.is_finite() {
+            return false;
+        }
+        let end = ray.at(max_distance_m);
+        if end.length() - self.radius_m > self.height_below(end) + 0.5 {
+            return false;
+        }
+        self.occludes(end + 0.05 * end.normalize(), light)
+    }
+}
+
+impl Surface for Heightfield {
+    fn intersect(&self, ray: &Ray, max_distance_m: f64) -> Option<SurfaceHit> {
+        let gr = self.grid_ray(ray);
+        let grid = &self.heights;
+        let mut hit_t = None;
+        // Rays leaving the surface start a hair above it (no self-hit at t ≈ 0).
+        let t_min = 1e-6 * (1.0 + ray.origin.length() * 1e-9);
+        walk(
+            grid,
+            &self.pyramid,
+            &gr,
+            (t_min, max_distance_m),
+            0.0,
+            &mut |cell| {
+                let (x0, y0, h0) = gr.grid_point(grid, cell.t0);
+                let (x1, y1, h1) = gr.grid_point(grid, cell.t1);
+                let (a0, b0) = fractions(x0, y0, cell.i, cell.j);
+                let (a1, b1) = fractions(x1, y1, cell.i, cell.j);
+                let q = along_segment(grid.corners(cell.i, cell.j), a0, b0, a1, b1);
+                // Ray height minus the patch along the cell (the ray is a straight line in
+                // the cell to 1e-4 m: its height's curvature over 100 m is L²/8R).
+                let f = [h0 - q[0], (h1 - h0) - q[1], -q[2]];
+                match first_descent(f) {
+                    Some(s) => {
+                        hit_t = Some(refine(&gr, grid, cell, s, f));
+                        true
+                    }
+                    None => false,
+                }
+            },
+        );
+        let t = hit_t.filter(|&t| t > t_min && t < max_distance_m)?;
+        let position = ray.origin + t * ray.dir;
+        let mut normal = self.normal_at(position);
+        if normal.dot(ray.dir) > 0.0 {
+            normal = -normal;
+        }
+        Some(SurfaceHit {
+            distance_m: t,
+            position,
+            normal,
+        })
+    }
+
+    fn albedo(&self, hit: &SurfaceHit, out: &mut [f64]) {
+        let p = hit.position;
+        let h = p.length() - self.radius_m;
+        let up = p / p.length();
+        let slope = hit.normal.dot(up).clamp(-1.0, 1.0).acos();
+        self.materials.albedo(p, h, slope, out);
+    }
+
+    fn shadowed_intervals(
+        &self,
+        ray: &Ray,
+        light: Vec3,
+        max_distance_m: f64,
+        out: &mut Vec<(f64, f64)>,
+    ) {
+        if !self.casts_shadows {
+            return;
+        }
+        let ray = self.grid_ray(ray);
+        if self.shafts {
+            self.shadow_field(light)
+                .shadowed_intervals(self, &ray, max_distance_m, out);
+        } else if self.ends_in_shadow(&ray, light, max_distance_m) {
+            out.push((max_distance_m * (1.0 - 1e-12), max_distance_m));
+        }
+    }
+
+    fn sky_visibility(&self, hit: &SurfaceHit) -> f64 {
+        self.visibility.as_ref().map_or(1.0, |ao| {
+            let r = self.radius_m;
+            let p = hit.position;
+            let (gx, gy) = ao.cell_coords(r * p.x / p.z, r * p.y / p.z);
+            if ao.contains(gx, gy) {
+                ao.bilinear(gx, gy)
+            } else {
+                1.0
+            }
+        })
+    }
+}

@@ -1,0 +1,225 @@
+//! The terrain's shadow in the air: for one light direction, the shadow height S at every
+//! vertex, the lowest height above the sphere at which a point over that vertex sees the
+//! light past the terrain (Max 1986, "Atmospheric illumination and shadows", SIGGRAPH;
+//! the horizon sweep of Stewart 1998 / Timonen & Westerholm 2010 "Scalable height field
+//! self-shadowing" along the light's azimuth). A point at height h is lit iff h ≥ S, so the
+//! lit parts of a view ray are where its height is above S interpolated between vertices,
+//! found exactly per cell (a quadratic, as the ray against the terrain): the lit segments
+//! of Bruneton & Neyret 2008 eq. 17–18 in the general form.
+//!
+//! The sweep. On a grid rotated so that x′ points towards the light's azimuth, each row is a
+//! profile of the terrain along the light's path; walking it from the light's side,
+//! S_i = max(H_i, (R + S_{i+1})·cos(e_i + φ)/cos e_i − R) with φ = Δ/R the step's central
+//! angle and e_i the light's elevation at vertex i: the exact rise of a straight ray over a
+//! sphere (law of sines in the plane of the great circle), so the planet's curvature is in.
+//! The rows are parallel in the tangent plane while the light's paths converge on its
+//! vanishing point R·(L_x, L_y)/L_z: at 20 km across the path an error of 1·10⁻⁴ to 1·10⁻³
+//! rad in azimuth (≤ 11 m over a 20 km shadow at a 5° sun), below a cell. The raise
+//! D = S − H is then interpolated back onto the terrain's grid, where the walk runs: where
+//! a vertex is lit D = 0 and the air touching a lit surface is lit, exactly. Only the
+//! shadow's edge inside a cell is interpolated; the shadow on the surface at a ray's end is
+//! decided by an exact shadow ray.
+
+use rayon::prelude::*;
+
+use super::grid::{along_segment, fractions, roots, walk, Grid, GridRay, MaxPyramid};
+use super::heightfield::Heightfield;
+use crate::math::Vec3;
+
+/// Lights within this angle of the zenith (rad) cast no shadow but their own: the sweep has
+/// no azimuth to follow.
+const VERTICAL_LIGHT_RAD: f64 = 1e-4;
+
+/// Sweep samples per terrain cell along and across the light's path.
+const SWEEP_REFINE: f64 = 3.0;
+
+/// The shadow heights of one light over the terrain's grid.
+pub struct ShadowField {
+    /// S (m above the sphere) on the terrain's grid.
+    pub heights: Grid,
+    pyramid: MaxPyramid,
+    light: Vec3,
+}
+
+impl ShadowField {
+    /// The field of `light` (unit, towards the light) over `terrain`.
+    pub fn new(terrain: &Heightfield, light: Vec3) -> ShadowField {
+        let grid = &terrain.heights;
+        let mut heights = grid.clone();
+        let horizontal = (light.x * light.x + light.y * light.y).sqrt();
+        if horizontal > VERTICAL_LIGHT_RAD {
+            let raise = sweep(terrain, [light.x / horizontal, light.y / horizontal], light);
+            heights
+                .values
+                .par_chunks_mut(grid.nx)
+                .enumerate()
+                .for_each(|(j, row)| {
+                    for (i, s) in row.iter_mut().enumerate() {
+                        let (u, v) = grid.plane_coords(i as f64, j as f64);
+                        let (rx, ry) = raise.cell_coords(u, v);
+                        if raise.contains(rx, ry) {
+                            *s += raise.bilinear(rx, ry).max(0.0) as f32;
+                        }
+                    }
+                });
+        }
+        let pyramid = MaxPyramid::new(&heights);
+        ShadowField {
+            heights,
+            pyramid,
+            light,
+        }
+    }
+
+    /// The shadowed intervals of `ray` within [0, `max_distance_m`] (see the module
+    /// documentation), appended to `out`. When the ray ends on a surface (a finite
+    /// `max_distance_m` at the terrain or the sphere), whether its end is in shadow comes
+    /// from an exact shadow ray.
+    pub fn shadowed_intervals(
+        &self,
+        terrain: &Heightfield,
+        ray: &GridRay,
+        max_distance_m: f64,
+        out: &mut Vec<(f64, f64)>,
+    ) {
+        let first = out.len();
+        let grid = &self.heights;
+        let mut last_piece = (0.0, 0.0);
+        walk(
+            grid,
+            &self.pyramid,
+            ray,
+            (0.0, max_distance_m),
+            0.0,
+            &mut |cell| {
+                let (x0, y0, h0) = ray.grid_point(grid, cell.t0);
+                let (x1, y1, h1) = ray.grid_point(grid, cell.t1);
+                let (a0, b0) = fractions(x0, y0, cell.i, cell.j);
+                let (a1, b1) = fractions(x1, y1, cell.i, cell.j);
+                let q = along_segment(grid.corners(cell.i, cell.j), a0, b0, a1, b1);
+                // g(s) = ray height − S: shadowed where negative.
+                let g = [h0 - q[0], (h1 - h0) - q[1], -q[2]];
+                let mut cuts = [0.0, 1.0, 1.0, 1.0];
+                let mut n = 1;
+                for s in roots(g).into_iter().flatten() {
+                    if s > 0.0 && s < 1.0 {
+                        cuts[n] = s;
+                        n += 1;
+                    }
+                }
+                cuts[n] = 1.0;
+                let span = cell.t1 - cell.t0;
+                for k in 0..n {
+                    let (s0, s1) = (cuts[k], cuts[k + 1]);
+                    let m = 0.5 * (s0 + s1);
+                    if g[0] + m * (g[1] + m * g[2]) < 0.0 {
+                        push_merged(out, first, cell.t0 + s0 * span, cell.t0 + s1 * span);
+                    }
+                }
+                last_piece = (cell.t0, cell.t1);
+                false
+            },
+        );
+        if !max_distance_m.is_finite() {
+            return;
+        }
+        // The end: on a surface when at (or below) the terrain's height there.
+        let end = ray.at(max_distance_m);
+        if end.length() - ray.radius_m > terrain.height_below(end) + 0.5 {
+            return;
+        }
+        let shadowed = terrain.ends_in_shadow(ray, self.light, max_distance_m);
+        let touches = out.len() > first && out.last().unwrap().1 >= max_distance_m * (1.0 - 1e-9);
+        match (shadowed, touches) {
+            (false, true) => {
+                // The interpolated edge reaches a lit surface: stop it at the last cell.
+                let last = out.last_mut().unwrap();
+                last.1 = last.1.min(last_piece.0).max(last.0);
+                if last.1 <= last.0 {
+                    out.pop();
+                }
+            }
+            (true, false) => {
+                let from = if last_piece.1 >= max_distance_m * (1.0 - 1e-9) {
+                    last_piece.0
+                } else {
+                    max_distance_m
+                };
+                if from < max_distance_m {
+                    push_merged(out, first, from, max_distance_m);
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
+/// Append [a, b] to `out[first..]`, merging it with the last interval when they touch.
+fn push_merged(out: &mut Vec<(f64, f64)>, first: usize, a: f64, b: f64) {
+    if out.len() > first {
+        let last = out.last_mut().unwrap();
+        if a <= last.1 + 1e-6 * (1.0 + last.1.abs() * 1e-6) {
+            last.1 = last.1.max(b);
+            return;
+        }
+    }
+    out.push((a, b));
+}
+
+/// The raise D = S − H on a grid rotated so that x′ points along `azimuth` (unit, in the
+/// tangent plane) and covering the terrain's rectangle.
+fn sweep(terrain: &Heightfield, azimuth: [f64; 2], light: Vec3) -> Grid {
+    let grid = &terrain.heights;
+    let r = terrain.radius_m;
+    let dx = grid.spacing_m / SWEEP_REFINE;
+    let [c, s] = azimuth;
+    // The terrain's corners in the rotated frame.
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for (gi, gj) in [
+        (0, 0),
+        (grid.nx - 1, 0),
+        (0, grid.ny - 1),
+        (grid.nx - 1, grid.ny - 1),
+    ] {
+        let (u, v) = grid.plane_coords(gi as f64, gj as f64);
+        let (x, y) = (c * u + s * v, -s * u + c * v);
+        lo = [lo[0].min(x), lo[1].min(y)];
+        hi = [hi[0].max(x), hi[1].max(y)];
+    }
+    let nx = ((hi[0] - lo[0]) / dx).ceil() as usize + 1;
+    let ny = ((hi[1] - lo[1]) / dx).ceil() as usize + 1;
+    let mut raise = Grid {
+        nx,
+        ny,
+        origin: lo,
+        spacing_m: dx,
+        axis: azimuth,
+        values: vec![0.0; nx * ny],
+    };
+    // cos(e + φ)/cos e = cos φ − tan e · sin φ.
+    let (sin_phi, cos_phi) = (dx / r).sin_cos();
+    let frame = raise.clone();
+    raise
+        .values
+        .par_chunks_mut(nx)
+        .enumerate()
+        .for_each(|(j, row)| {
+            // From the light's side (high x′) towards the shadows.
+            let mut s_next = f64::NEG_INFINITY;
+            for i in (0..nx).rev() {
+                let (u, v) = frame.plane_coords(i as f64, j as f64);
+                let h = terrain.height_at(u, v);
+                let sin_e = light.dot(Vec3::new(u, v, r)) / (u * u + v * v + r * r).sqrt();
+                let tan_e = sin_e / (1.0 - sin_e * sin_e).max(1e-12).sqrt();
+                let carried = if s_next.is_finite() {
+                    (r + s_next) * (cos_phi - tan_e * sin_phi) - r
+                } else {
+                    f64::NEG_INFINITY
+                };
+                let s_here = h.max(carried);
+                row[i] = (s_here - h) as f32;
+                s_next = s_here;
+            }
+        });
+    raise
+}
