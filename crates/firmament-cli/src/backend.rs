@@ -13,6 +13,7 @@ use firmament::atmosphere::Model;
 use firmament::math::Vec3;
 use firmament::render::{stars, Frame, RenderSettings};
 use firmament::scene::sky_lights::SkySources;
+use firmament::scene::terrain::Heightfield;
 use firmament::scene::Scene;
 use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, Tables};
 use firmament_gpu::Precomputer;
@@ -297,19 +298,29 @@ impl<'a> RenderSky<'a> {
         }
     }
 
-    /// Render one frame of the clear sky under the sun in `sun` (its disk drawn when
-    /// `sun_disk`): the CPU renderer with a progress bar, or the GPU renderer.
+    /// Render one frame of the sky lit by `sources`, over `terrain` when given (CPU only so
+    /// far): the CPU renderer with a progress bar, or the GPU renderer.
     pub fn render(
         &self,
         settings: &RenderSettings,
         sources: &SkySources,
+        terrain: Option<&Heightfield>,
         quiet: bool,
     ) -> Result<Frame> {
+        if terrain.is_some() && matches!(self, RenderSky::Gpu { .. }) {
+            anyhow::bail!(
+                "the terrain renders on the CPU only so far: use `--backend cpu` (or `auto`), or `--no-terrain` for the GPU"
+            );
+        }
         match self {
             RenderSky::Cpu(sky) => {
                 let bar = progress_bar(1000, quiet);
                 bar.set_message("rendering");
                 let mut scene = Scene::clear_sky(sky.as_ref(), Vec3::Z, false);
+                if let Some(t) = terrain {
+                    // Before the sphere: the terrain wins where it lies on it.
+                    scene.surfaces.insert(0, Box::new(t));
+                }
                 scene.lights = sources.lights.clone();
                 scene.background = sources.background.clone();
                 scene.stars = sources.stars.clone();

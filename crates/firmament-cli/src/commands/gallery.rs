@@ -13,7 +13,7 @@ use firmament::scene::file::{SceneLocation, SceneTime};
 use firmament::scene::{Camera, Projection, SceneFile as Scene};
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
-use crate::commands::render::{atmosphere_args, render_scene, write_outputs};
+use crate::commands::render::{atmosphere_args, build_terrain, render_scene, write_outputs};
 
 /// Arguments of `firmament gallery`.
 #[derive(Args, Debug)]
@@ -51,6 +51,8 @@ struct View {
     when: Option<(&'static str, f64, f64)>,
     /// A time-lapse strip: this many frames side by side, this many minutes apart.
     strip: Option<(usize, i64)>,
+    /// Over the default scene's terrain (CPU only so far).
+    terrain: bool,
 }
 
 fn views(width: usize) -> Vec<View> {
@@ -65,18 +67,21 @@ fn views(width: usize) -> Vec<View> {
     };
     use Projection::*;
     vec![
-        View { name: "noon", title: "Noon from the ground, looking north (sun 60° high in the south)", camera: cam(Perspective, 2.0, 0.0, 12.0, 80.0), sun: (30.0, 180.0), size: (width, h), ev_offset: 0.0, when: None, strip: None },
-        View { name: "afternoon", title: "Afternoon, facing the sun (30° high)", camera: cam(Perspective, 2.0, 240.0, 12.0, 80.0), sun: (60.0, 240.0), size: (width, h), ev_offset: 0.0, when: None, strip: None },
-        View { name: "sunset", title: "Sunset (sun 1° high in the west)", camera: cam(Perspective, 2.0, 270.0, 6.0, 80.0), sun: (89.0, 270.0), size: (width, h), ev_offset: 0.0, when: None, strip: None },
-        View { name: "twilight", title: "Twilight, facing east away from the sun 4° below the horizon: Earth's shadow and the Belt of Venus", camera: cam(Perspective, 2.0, 90.0, 8.0, 80.0), sun: (94.0, 270.0), size: (width, h), ev_offset: 0.0, when: None, strip: None },
-        View { name: "altitude-10km", title: "From 10 km, looking down the aerial perspective", camera: cam(Perspective, 10_000.0, 200.0, -8.0, 80.0), sun: (50.0, 160.0), size: (width, h), ev_offset: 0.0, when: None, strip: None },
-        View { name: "low-orbit", title: "From low orbit (400 km), the limb with the sun low", camera: cam(Perspective, 400_000.0, 90.0, -17.0, 60.0), sun: (75.0, 90.0), size: (width, h), ev_offset: 0.0, when: None, strip: None },
-        View { ev_offset: 1.5, name: "planet", title: "The whole planet from 30 000 km: limb, terminator, night side", camera: cam(Orbit, 30_000_000.0, 0.0, 0.0, orbit_fit_fov_deg(6_424_000.0, 36_360_000.0)), sun: (75.0, 90.0), size: (width * 2 / 3, width * 2 / 3), when: None, strip: None },
-        View { name: "fisheye", title: "All-sky fisheye (equidistant, north up, east left), sun 45° high in the south-east", camera: cam(Fisheye, 2.0, 0.0, 0.0, 60.0), sun: (45.0, 135.0), size: (width * 2 / 3, width * 2 / 3), ev_offset: 0.0, when: None, strip: None },
-        View { name: "moonlit", title: "Full-moon night over the Alps (46.5° N, 8° E), 2026-01-03 21:00 CET, facing the moon 38° high in the east", camera: cam(Perspective, 2.0, 92.0, 14.0, 70.0), sun: (0.0, 0.0), size: (width, h), ev_offset: 0.0, when: Some(("2026-01-03T20:00:00Z", 46.5, 8.0)), strip: None },
-        View { name: "starry-twilight", title: "Nautical twilight with a 4 % crescent moon in the west-south-west and the first stars, 2026-01-20 18:20 CET (46.5° N, 8° E), fisheye", camera: cam(Fisheye, 2.0, 0.0, 0.0, 60.0), sun: (0.0, 0.0), size: (width * 2 / 3, width * 2 / 3), ev_offset: 1.0, when: Some(("2026-01-20T17:20:00Z", 46.5, 8.0)), strip: None },
-        View { name: "sunrise-strip", title: "Sunrise time-lapse, 21 June 2026 at 46.5° N, 8° E, facing north-east: 02:40 to 04:20 UTC every 20 min (sunrise 03:35)", camera: cam(Perspective, 2.0, 50.0, 8.0, 60.0), sun: (0.0, 0.0), size: (width / 3, width / 3), ev_offset: 0.0, when: Some(("2026-06-21T02:40:00Z", 46.5, 8.0)), strip: Some((6, 20)) },
-        View { name: "equirect", title: "Equirectangular environment map (north at the centre column), sun 20° high in the east-south-east", camera: cam(Equirect, 2.0, 0.0, 0.0, 60.0), sun: (70.0, 120.0), size: (width, width / 2), ev_offset: 0.0, when: None, strip: None },
+        View { name: "noon", title: "Noon from the ground, looking north (sun 60° high in the south)", camera: cam(Perspective, 2.0, 0.0, 12.0, 80.0), sun: (30.0, 180.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: false },
+        View { name: "afternoon", title: "Afternoon, facing the sun (30° high)", camera: cam(Perspective, 2.0, 240.0, 12.0, 80.0), sun: (60.0, 240.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: false },
+        View { name: "sunset", title: "Sunset (sun 1° high in the west)", camera: cam(Perspective, 2.0, 270.0, 6.0, 80.0), sun: (89.0, 270.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: false },
+        View { name: "twilight", title: "Twilight, facing east away from the sun 4° below the horizon: Earth's shadow and the Belt of Venus", camera: cam(Perspective, 2.0, 90.0, 8.0, 80.0), sun: (94.0, 270.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: false },
+        View { name: "altitude-10km", title: "From 10 km, looking down the aerial perspective", camera: cam(Perspective, 10_000.0, 200.0, -8.0, 80.0), sun: (50.0, 160.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: false },
+        View { name: "low-orbit", title: "From low orbit (400 km), the limb with the sun low", camera: cam(Perspective, 400_000.0, 90.0, -17.0, 60.0), sun: (75.0, 90.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: false },
+        View { ev_offset: 1.5, name: "planet", title: "The whole planet from 30 000 km: limb, terminator, night side", camera: cam(Orbit, 30_000_000.0, 0.0, 0.0, orbit_fit_fov_deg(6_424_000.0, 36_360_000.0)), sun: (75.0, 90.0), size: (width * 2 / 3, width * 2 / 3), when: None, strip: None, terrain: false },
+        View { name: "fisheye", title: "All-sky fisheye (equidistant, north up, east left), sun 45° high in the south-east", camera: cam(Fisheye, 2.0, 0.0, 0.0, 60.0), sun: (45.0, 135.0), size: (width * 2 / 3, width * 2 / 3), ev_offset: 0.0, when: None, strip: None, terrain: false },
+        View { name: "moonlit", title: "Full-moon night over the Alps (46.5° N, 8° E), 2026-01-03 21:00 CET, facing the moon 38° high in the east", camera: cam(Perspective, 2.0, 92.0, 14.0, 70.0), sun: (0.0, 0.0), size: (width, h), ev_offset: 0.0, when: Some(("2026-01-03T20:00:00Z", 46.5, 8.0)), strip: None, terrain: false },
+        View { name: "starry-twilight", title: "Nautical twilight with a 4 % crescent moon in the west-south-west and the first stars, 2026-01-20 18:20 CET (46.5° N, 8° E), fisheye", camera: cam(Fisheye, 2.0, 0.0, 0.0, 60.0), sun: (0.0, 0.0), size: (width * 2 / 3, width * 2 / 3), ev_offset: 1.0, when: Some(("2026-01-20T17:20:00Z", 46.5, 8.0)), strip: None, terrain: false },
+        View { name: "sunrise-strip", title: "Sunrise time-lapse, 21 June 2026 at 46.5° N, 8° E, facing north-east: 02:40 to 04:20 UTC every 20 min (sunrise 03:35)", camera: cam(Perspective, 2.0, 50.0, 8.0, 60.0), sun: (0.0, 0.0), size: (width / 3, width / 3), ev_offset: 0.0, when: Some(("2026-06-21T02:40:00Z", 46.5, 8.0)), strip: Some((6, 20)), terrain: false },
+        View { name: "valley-sunset", title: "Golden hour in the valley (the default scene): the sun 5.5° high behind a peak, its shadow a shaft through the air", camera: cam(Perspective, 25.0, 250.0, 6.0, 55.0), sun: (84.5, 237.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: true },
+        View { name: "valley-noon", title: "The valley at noon (sun 62° high in the south), looking north up the slopes", camera: cam(Perspective, 25.0, 20.0, 4.0, 60.0), sun: (28.0, 175.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: true },
+        View { name: "valley-10km", title: "The mountains from 10 km, afternoon sun in the west-south-west", camera: cam(Perspective, 10_000.0, 30.0, -28.0, 70.0), sun: (70.0, 240.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: true },
+        View { name: "equirect", title: "Equirectangular environment map (north at the centre column), sun 20° high in the east-south-east", camera: cam(Equirect, 2.0, 0.0, 0.0, 60.0), sun: (70.0, 120.0), size: (width, width / 2), ev_offset: 0.0, when: None, strip: None, terrain: false },
     ]
 }
 
@@ -101,7 +106,7 @@ fn write_strip(
         if let Some(t) = &mut s.time {
             t.at = at.to_rfc3339();
         }
-        let (frame, ev100) = render_scene(sky, &s, true)?;
+        let (frame, ev100) = render_scene(sky, &s, None, true)?;
         let rgb = frame.to_srgb8(
             firmament::render::tonemap::exposure_from_ev100(ev100),
             s.output.tonemap,
@@ -121,6 +126,7 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
         .with_context(|| format!("creating {}", args.out.display()))?;
     let mut base = Scene::default();
     base.atmosphere.preset = args.preset.clone();
+    let terrain_config = base.terrain.take();
     let backend = Backend::open(args.backend, args.quiet)?;
     let t = Instant::now();
     let sky = RenderSky::new(
@@ -131,6 +137,22 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
     if !args.quiet {
         eprintln!("tables ready in {:.2} s", t.elapsed().as_secs_f64());
     }
+    // The terrain views run on the CPU only so far.
+    let terrain = match (&sky, terrain_config.clone()) {
+        (RenderSky::Cpu(_), Some(config)) => {
+            let with = Scene {
+                terrain: Some(config),
+                ..base.clone()
+            };
+            build_terrain(sky.model(), &with, args.quiet)?
+        }
+        _ => {
+            if !args.quiet {
+                eprintln!("note: the terrain views are skipped on the GPU (CPU only so far)");
+            }
+            None
+        }
+    };
     let mut html = String::from(
         "<!doctype html><meta charset=utf-8><title>firmament gallery</title>\n<style>body{background:#111;color:#ddd;font-family:sans-serif}figure{display:inline-block;margin:8px;vertical-align:top;max-width:480px}img{max-width:480px}figcaption{font-size:13px}</style>\n<h1>firmament gallery</h1>\n",
     );
@@ -140,7 +162,14 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
         args.preset
     );
     for v in views(args.width) {
+        if v.terrain && terrain.is_none() {
+            continue;
+        }
         let mut scene = base.clone();
+        if v.terrain {
+            scene.terrain = terrain_config.clone();
+        }
+        let terrain = terrain.as_ref().filter(|_| v.terrain);
         scene.camera = v.camera.clone();
         scene.sun.zenith_deg = v.sun.0;
         scene.sun.azimuth_deg = v.sun.1;
@@ -164,7 +193,7 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
         let t = Instant::now();
         let ev100 = match v.strip {
             None => {
-                let (frame, ev100) = render_scene(&sky, &scene, true)?;
+                let (frame, ev100) = render_scene(&sky, &scene, terrain, true)?;
                 let ev100 = ev100 + v.ev_offset;
                 write_outputs(&frame, &scene, ev100, false, true)?;
                 ev100

@@ -11,7 +11,8 @@ use firmament::reference::{self, ReferenceSettings};
 use firmament::render::{self, tonemap, RenderSettings, ToneCurve};
 use firmament::scene::file::{SceneLocation, SceneTime};
 use firmament::scene::sky_lights::{sources_of, SkySources};
-use firmament::scene::{sun_direction, Projection, SceneFile as Scene};
+use firmament::scene::terrain::Heightfield;
+use firmament::scene::{sun_direction, Camera, Projection, SceneFile as Scene};
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
 use crate::commands::astro::AstroArgs;
@@ -66,6 +67,12 @@ pub struct RenderArgs {
     /// Do not draw the moon's disk (its light stays).
     #[arg(long)]
     pub no_moon_disk: bool,
+    /// No terrain: the planet's smooth sphere (the default scene has mountains).
+    #[arg(long)]
+    pub no_terrain: bool,
+    /// No light shafts: the terrain's shadows stay on the ground, the air is lit throughout.
+    #[arg(long)]
+    pub no_light_shafts: bool,
     /// A time-lapse: frames from --time to this instant (ISO 8601), every --every; each
     /// --out needs a frame number (`frames/sky_%04d.exr`).
     #[arg(long, value_name = "ISO8601", requires_all = ["time", "every"])]
@@ -244,6 +251,14 @@ fn scene_from_args(args: &RenderArgs) -> Result<Scene> {
     if !args.outputs.is_empty() {
         scene.output.files = args.outputs.clone();
     }
+    if args.no_terrain {
+        scene.terrain = None;
+    }
+    if args.no_light_shafts {
+        if let Some(t) = &mut scene.terrain {
+            t.light_shafts = false;
+        }
+    }
     scene.validate()?;
     Ok(scene)
 }
@@ -313,11 +328,48 @@ fn ev100(scene: &Scene, frame: &render::Frame) -> f64 {
         .unwrap_or_else(|| tonemap::auto_ev100(frame.log_average_luminance()))
 }
 
-/// Render the scene with a sky on its backend; returns the frame and the EV100 used.
-pub fn render_scene(sky: &RenderSky, scene: &Scene, quiet: bool) -> Result<(render::Frame, f64)> {
+/// The scene's terrain on `model`'s planet (`terrain: …` on stderr unless `quiet`).
+pub fn build_terrain(model: &Model, scene: &Scene, quiet: bool) -> Result<Option<Heightfield>> {
+    let t = Instant::now();
+    let terrain = scene.build_terrain(model)?;
+    if let (Some(h), false) = (&terrain, quiet) {
+        eprintln!(
+            "terrain: {}×{} vertices, {:.0} m spacing, up to {:.0} m, in {:.2} s",
+            h.heights.nx,
+            h.heights.ny,
+            h.heights.spacing_m,
+            h.max_height_m(),
+            t.elapsed().as_secs_f64()
+        );
+    }
+    Ok(terrain)
+}
+
+/// The scene's camera, its altitude taken above the terrain below it when there is one.
+fn camera_over(scene: &Scene, terrain: Option<&Heightfield>) -> Camera {
+    let mut camera = scene.camera.clone();
+    if let Some(t) = terrain {
+        camera.altitude_m += t.height_at(0.0, 0.0);
+    }
+    camera
+}
+
+/// Render the scene with a sky on its backend over its terrain (built by
+/// [`build_terrain`]); returns the frame and the EV100 used.
+pub fn render_scene(
+    sky: &RenderSky,
+    scene: &Scene,
+    terrain: Option<&Heightfield>,
+    quiet: bool,
+) -> Result<(render::Frame, f64)> {
     let sources = sources_of_scene(sky.model(), scene)?;
+    let camera = camera_over(scene, terrain);
+    let settings = RenderSettings {
+        camera: &camera,
+        ..render_settings(scene)
+    };
     let frame = sky
-        .render(&render_settings(scene), &sources, quiet)
+        .render(&settings, &sources, terrain, quiet)
         .context("rendering")?;
     let ev100 = ev100(scene, &frame);
     Ok((frame, ev100))
@@ -378,12 +430,20 @@ fn render_scene_reference(
         );
     }
     let sun = &lights[0];
+    let terrain = build_terrain(model, scene, quiet)?;
+    let surfaces: Vec<Box<dyn firmament::scene::Surface + '_>> =
+        terrain.iter().map(|t| Box::new(t) as _).collect();
+    let camera = camera_over(scene, terrain.as_ref());
     let bar = progress_bar(1000, quiet);
     bar.set_message(format!("reference, {samples} paths/λ"));
     let result = reference::render_frame(
         model,
         &[],
-        &render_settings(scene),
+        &surfaces,
+        &RenderSettings {
+            camera: &camera,
+            ..render_settings(scene)
+        },
         sun,
         &ReferenceSettings::with_samples(samples),
         &|f| bar.set_position((f * 1000.0) as u64),
@@ -457,7 +517,20 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
         other => anyhow::bail!("invalid value for `--method`: {other} (accepted: lut, reference)"),
     }
-    let backend = Backend::open(args.backend, args.quiet)?;
+    let backend = match Backend::open(args.backend, args.quiet)? {
+        Backend::Gpu(_) if scene.terrain.is_some() && args.backend == BackendChoice::Gpu => {
+            anyhow::bail!(
+                "the terrain renders on the CPU only so far: `--backend gpu` needs `--no-terrain` (or a scene without [terrain]); `--backend cpu` or `auto` render it"
+            )
+        }
+        Backend::Gpu(_) if scene.terrain.is_some() => {
+            if !args.quiet {
+                eprintln!("note: the terrain renders on the CPU only so far: using the CPU");
+            }
+            Backend::Cpu
+        }
+        backend => backend,
+    };
     let t = Instant::now();
     let sky = RenderSky::new(
         &backend,
@@ -478,10 +551,18 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if !args.quiet && times.is_none() {
         twilight_note(sky.model(), &scene)?;
     }
+    let terrain = build_terrain(sky.model(), &scene, args.quiet)?;
     if let Some(times) = times {
         let t = Instant::now();
-        let (rendered, _) =
-            timelapse::run(&sky, &scene, &times, args.resume, args.exr_half, args.quiet)?;
+        let (rendered, _) = timelapse::run(
+            &sky,
+            &scene,
+            terrain.as_ref(),
+            &times,
+            args.resume,
+            args.exr_half,
+            args.quiet,
+        )?;
         if !args.quiet && rendered > 0 {
             eprintln!(
                 "time-lapse: {:.2} s per frame",
@@ -491,7 +572,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         return Ok(());
     }
     let t = Instant::now();
-    let (frame, ev100) = render_scene(&sky, &scene, args.quiet)?;
+    let (frame, ev100) = render_scene(&sky, &scene, terrain.as_ref(), args.quiet)?;
     if !args.quiet {
         eprintln!(
             "render: {}×{} {:?}{} in {:.2} s (EV100 {:.1}{})",

@@ -14,6 +14,7 @@ use serde_json::json;
 use crate::backend::RenderSky;
 use crate::commands::render::{render_scene, write_outputs};
 use crate::common::{cancel_flag, progress_bar};
+use firmament::scene::terrain::Heightfield;
 
 /// The most frames one sequence may have.
 const MAX_FRAMES: usize = 100_000;
@@ -68,6 +69,7 @@ pub fn numbered(pattern: &Path, index: usize) -> Result<PathBuf> {
 pub fn run(
     sky: &RenderSky,
     scene: &Scene,
+    terrain: Option<&Heightfield>,
     times: &[Instant],
     resume: bool,
     half: bool,
@@ -112,7 +114,7 @@ pub fn run(
             continue;
         }
         frame_scene.output.files = files;
-        let (frame, ev100) = render_scene(sky, &frame_scene, true)?;
+        let (frame, ev100) = render_scene(sky, &frame_scene, terrain, true)?;
         write_outputs(&frame, &frame_scene, ev100, half, true)?;
         rendered += 1;
         bar.inc(1);

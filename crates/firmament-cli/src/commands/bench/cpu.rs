@@ -91,7 +91,35 @@ pub fn frame_timings(sky: &Bruneton4d, runs: usize) -> Result<CpuFrames> {
             runs,
         )?),
         cpu_frame_1080p_night_s: Some(night_seconds(sky, runs)?),
+        cpu_frame_1080p_terrain_s: Some(terrain_seconds(sky, runs)?),
     })
+}
+
+/// Median seconds of the default scene's frame: the valley at golden hour, the light
+/// shafts' shadow field computed in each run, the terrain built once before.
+fn terrain_seconds(sky: &Bruneton4d, runs: usize) -> Result<f64> {
+    let default = firmament::scene::SceneFile::default();
+    let terrain = default
+        .build_terrain(&sky.model)?
+        .expect("the default scene has a terrain");
+    let mut camera = default.camera.clone();
+    camera.altitude_m += terrain.height_at(0.0, 0.0);
+    let settings = render::RenderSettings {
+        camera: &camera,
+        width: 1920,
+        height: 1080,
+        white_balance: false,
+    };
+    let sun = sun_direction(default.sun.zenith_deg, default.sun.azimuth_deg);
+    let seconds = time_runs(runs.clamp(1, 3), || {
+        let terrain = terrain.clone_without_shadows();
+        let mut scene = Scene::clear_sky(sky, sun, true);
+        scene.surfaces.insert(0, Box::new(terrain));
+        let image = render::render(&scene, &settings, &|_| {}, None)?;
+        let _ = image.to_srgb8(1e-4, ToneCurve::Aces);
+        Ok(())
+    })?;
+    Ok(median(seconds))
 }
 
 /// Median seconds of the night frame: the date's sun, moon and stars computed, then the

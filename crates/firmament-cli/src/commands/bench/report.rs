@@ -55,6 +55,9 @@ pub struct CpuFrames {
     /// The 1080p view at night (full moon as a second light, the stars and the glow), the
     /// astronomy of the date included.
     pub cpu_frame_1080p_night_s: Option<f64>,
+    /// The default scene (the valley at golden hour, light shafts), 1920×1080: the shadow
+    /// field of the sun and the frame; the terrain built once beforehand.
+    pub cpu_frame_1080p_terrain_s: Option<f64>,
 }
 
 /// The reference path tracer's throughput: one earth RGB pixel (the zenith from 1 m, the
