@@ -1,36 +1,23 @@
 //! The night sky against published photometry: the full moon's illuminance on the ground,
 //! the dark sky's zenith brightness at new moon, the moon's disk and phase.
 
-use std::sync::OnceLock;
+mod common;
+
+use common::sky;
 
 use chrono::{DateTime, Utc};
 use firmament::astro::photometry::luminance_from_surface_brightness;
 use firmament::astro::refraction_deg;
 use firmament::astro::{Instant, Place, Sky, Weather};
-use firmament::atmosphere::Atmosphere;
 use firmament::math::Vec3;
 use firmament::render::{self, RenderSettings};
 use firmament::render::{ShadeScratch, Shader};
 use firmament::scene::sky_lights::{lights_of, night_sky_background, sources_of};
 use firmament::scene::{Camera, Projection};
 use firmament::scene::{Ray, Scene, Sphere};
-use firmament::sky::bruneton4d::{Bruneton4d, MieStorage, TableConfig, TableSizes, Tables};
+use firmament::sky::bruneton4d::Bruneton4d;
 use firmament::sky::SkyMethod;
-use firmament::spectrum::{ColourMatrix, Wavelengths};
-
-fn sky() -> &'static Bruneton4d {
-    static SKY: OnceLock<Bruneton4d> = OnceLock::new();
-    SKY.get_or_init(|| {
-        let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
-        let config = TableConfig {
-            sizes: TableSizes::small(),
-            orders: 4,
-            mie: MieStorage::Separate,
-            order_tail: true,
-        };
-        Bruneton4d::new(model.clone(), Tables::compute(&model, &config).unwrap()).unwrap()
-    })
-}
+use firmament::spectrum::ColourMatrix;
 
 /// The place along latitude `lat` where the moon stands closest to `altitude` degrees at
 /// `time` in astronomical night (the sun below −18°; longitudes in 0.25° steps).

@@ -1,34 +1,16 @@
 //! Image statistics of rendered scenes (not golden pixels): colours and brightness
 //! orderings every clear-sky photograph shows, the sun disk's energy, HDR files.
 
-use std::sync::OnceLock;
+mod common;
 
-use firmament::atmosphere::Atmosphere;
+use common::sky;
+
 use firmament::math::{direction_from_zenith_azimuth, Vec3};
 use firmament::render::{self, RenderSettings, ShadeScratch, Shader};
 use firmament::scene::camera::orbit_fit_fov_deg;
 use firmament::scene::{sun_direction, Camera, Light, Projection, Ray, Scene};
-use firmament::sky::bruneton4d::{Bruneton4d, MieStorage, TableConfig, TableSizes, Tables};
 use firmament::sky::SkyMethod;
-use firmament::spectrum::{ColourMatrix, Wavelengths};
-
-fn sky() -> &'static Bruneton4d {
-    static SKY: OnceLock<Bruneton4d> = OnceLock::new();
-    SKY.get_or_init(|| {
-        let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
-        let tables = Tables::compute(
-            &model,
-            &TableConfig {
-                sizes: TableSizes::small(),
-                orders: 4,
-                mie: MieStorage::Separate,
-                order_tail: true,
-            },
-        )
-        .unwrap();
-        Bruneton4d::new(model, tables).unwrap()
-    })
-}
+use firmament::spectrum::ColourMatrix;
 
 /// Linear sRGB (Y in cd/m²) seen from 2 m along (elevation, azimuth) in degrees.
 fn look(sun: (f64, f64), elevation: f64, azimuth: f64) -> [f64; 3] {

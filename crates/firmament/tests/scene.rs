@@ -4,30 +4,15 @@
 
 mod common;
 
-use std::sync::OnceLock;
+use common::sky;
 
 use firmament::atmosphere::Atmosphere;
 use firmament::math::Vec3;
 use firmament::render::{self, RenderSettings};
 use firmament::scene::{sun_direction, Camera, Light, Projection, Ray, Scene, Sphere, Surface};
-use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, TableSizes};
+use firmament::sky::bruneton4d::{Bruneton4d, TableConfig};
 use firmament::sky::{Shadow, SkyMethod};
 use firmament::spectrum::Wavelengths;
-
-fn earth(orders: usize) -> Bruneton4d {
-    let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
-    let config = TableConfig {
-        sizes: TableSizes::small(),
-        orders,
-        ..Default::default()
-    };
-    Bruneton4d::compute(model, &config).unwrap()
-}
-
-fn sky() -> &'static Bruneton4d {
-    static SKY: OnceLock<Bruneton4d> = OnceLock::new();
-    SKY.get_or_init(|| earth(4))
-}
 
 const CAMERA_ALTITUDE_M: f64 = 2.0;
 

@@ -2,9 +2,10 @@
 //! (thin ridges included), a flat terrain against the sphere's ground, the lit segments
 //! against shadow rays cast along the view ray, and a fully shadowed valley's light.
 
-use std::sync::OnceLock;
+mod common;
 
-use firmament::atmosphere::Atmosphere;
+use common::sky;
+
 use firmament::math::{direction_from_zenith_azimuth, Vec3};
 use firmament::reference::rng::Rng;
 use firmament::render::{ShadeScratch, Shader};
@@ -12,25 +13,9 @@ use firmament::scene::surface::lit_intervals;
 use firmament::scene::terrain::grid::Grid;
 use firmament::scene::terrain::{Heightfield, Materials, ReliefParams, TerrainConfig};
 use firmament::scene::{sun_direction, Ray, Scene, Surface};
-use firmament::sky::bruneton4d::{Bruneton4d, MieStorage, TableConfig, TableSizes, Tables};
 use firmament::sky::{Shadow, SkyMethod};
-use firmament::spectrum::Wavelengths;
 
 const R: f64 = 6_360_000.0;
-
-fn sky() -> &'static Bruneton4d {
-    static SKY: OnceLock<Bruneton4d> = OnceLock::new();
-    SKY.get_or_init(|| {
-        let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
-        let config = TableConfig {
-            sizes: TableSizes::small(),
-            orders: 4,
-            mie: MieStorage::Separate,
-            order_tail: true,
-        };
-        Bruneton4d::new(model.clone(), Tables::compute(&model, &config).unwrap()).unwrap()
-    })
-}
 
 /// A rough relief 6 km across with a one-vertex-wide wall (a ridge thinner than a cell's
 /// diagonal) through it.

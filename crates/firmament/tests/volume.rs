@@ -4,28 +4,15 @@
 
 mod common;
 
-use std::sync::OnceLock;
+use common::sky;
 
-use firmament::atmosphere::Atmosphere;
 use firmament::math::Vec3;
 use firmament::medium::PhaseFunction;
 use firmament::reference::{self, ReferenceSettings};
 use firmament::scene::{sun_direction, HomogeneousSphere, Ray, Scene, Volume};
-use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, TableSizes};
+use firmament::sky::bruneton4d::Bruneton4d;
 use firmament::sky::{Shadow, SkyMethod};
-use firmament::spectrum::{ColourMatrix, Wavelengths};
-
-fn sky() -> &'static Bruneton4d {
-    static SKY: OnceLock<Bruneton4d> = OnceLock::new();
-    SKY.get_or_init(|| {
-        let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
-        let config = TableConfig {
-            sizes: TableSizes::small(),
-            ..Default::default()
-        };
-        Bruneton4d::compute(model, &config).unwrap()
-    })
-}
+use firmament::spectrum::ColourMatrix;
 
 /// A ball 1 km across, 1.5 km up, 5 km north of the observer: optical depth 0.2 through its
 /// centre, single-scattering albedo `albedo`, forward-scattering HG phase.

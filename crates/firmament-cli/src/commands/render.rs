@@ -12,7 +12,7 @@ use firmament::render::{self, tonemap, RenderSettings, ToneCurve};
 use firmament::scene::file::{SceneLocation, SceneTime};
 use firmament::scene::sky_lights::{sources_of, SkySources};
 use firmament::scene::terrain::Heightfield;
-use firmament::scene::{sun_direction, Camera, Projection, SceneFile as Scene};
+use firmament::scene::{sun_direction, Projection, SceneFile as Scene};
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
 use crate::commands::astro::AstroArgs;
@@ -345,15 +345,6 @@ pub fn build_terrain(model: &Model, scene: &Scene, quiet: bool) -> Result<Option
     Ok(terrain)
 }
 
-/// The scene's camera, its altitude taken above the terrain below it when there is one.
-fn camera_over(scene: &Scene, terrain: Option<&Heightfield>) -> Camera {
-    let mut camera = scene.camera.clone();
-    if let Some(t) = terrain {
-        camera.altitude_m += t.height_at(0.0, 0.0);
-    }
-    camera
-}
-
 /// Render the scene with a sky on its backend over its terrain (built by
 /// [`build_terrain`]); returns the frame and the EV100 used.
 pub fn render_scene(
@@ -363,7 +354,7 @@ pub fn render_scene(
     quiet: bool,
 ) -> Result<(render::Frame, f64)> {
     let sources = sources_of_scene(sky.model(), scene)?;
-    let camera = camera_over(scene, terrain);
+    let camera = scene.camera_over(terrain);
     let settings = RenderSettings {
         camera: &camera,
         ..render_settings(scene)
@@ -433,7 +424,7 @@ fn render_scene_reference(
     let terrain = build_terrain(model, scene, quiet)?;
     let surfaces: Vec<Box<dyn firmament::scene::Surface + '_>> =
         terrain.iter().map(|t| Box::new(t) as _).collect();
-    let camera = camera_over(scene, terrain.as_ref());
+    let camera = scene.camera_over(terrain.as_ref());
     let bar = progress_bar(1000, quiet);
     bar.set_message(format!("reference, {samples} paths/λ"));
     let result = reference::render_frame(

@@ -258,6 +258,16 @@ impl SceneFile {
             .transpose()
     }
 
+    /// The camera, its altitude taken above `terrain`'s surface below the observer when
+    /// there is one (as `[terrain]` documents).
+    pub fn camera_over(&self, terrain: Option<&super::terrain::Heightfield>) -> Camera {
+        let mut camera = self.camera.clone();
+        if let Some(t) = terrain {
+            camera.altitude_m += t.height_at(0.0, 0.0);
+        }
+        camera
+    }
+
     /// Check every value; messages name the field.
     pub fn validate(&self) -> Result<()> {
         self.camera.validate()?;

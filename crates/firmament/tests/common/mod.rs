@@ -1,13 +1,36 @@
-//! Helpers shared by the library's integration tests: one ray through the render loop, and
+//! Helpers shared by the library's integration tests: the small `earth` tables, one ray
+//! through the render loop, and
 //! an independent quadrature of single scattering to test the tables against.
 
 #![allow(dead_code)] // each test file uses its own part
 
-use firmament::atmosphere::Model;
+use std::sync::OnceLock;
+
+use firmament::atmosphere::{Atmosphere, Model};
 use firmament::math::sphere::distance_to_top_atmosphere_boundary;
 use firmament::math::Vec3;
 use firmament::render::{ShadeScratch, Shader};
 use firmament::scene::{Ray, Scene};
+use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, TableSizes};
+use firmament::spectrum::Wavelengths;
+
+/// The `earth` atmosphere in RGB with small tables of `orders` scattering orders (and the
+/// geometric tail), computed.
+pub fn earth_small(orders: usize) -> Bruneton4d {
+    let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
+    let config = TableConfig {
+        sizes: TableSizes::small(),
+        orders,
+        ..Default::default()
+    };
+    Bruneton4d::compute(model, &config).unwrap()
+}
+
+/// [`earth_small`] with 4 orders, computed once per test binary.
+pub fn sky() -> &'static Bruneton4d {
+    static SKY: OnceLock<Bruneton4d> = OnceLock::new();
+    SKY.get_or_init(|| earth_small(4))
+}
 
 /// The radiance (3 channels) `scene` renders along the ray from `origin` in direction `dir`.
 pub fn shade(scene: &Scene, origin: Vec3, dir: Vec3) -> [f64; 3] {

@@ -102,8 +102,7 @@ fn terrain_seconds(sky: &Bruneton4d, runs: usize) -> Result<f64> {
     let terrain = default
         .build_terrain(&sky.model)?
         .expect("the default scene has a terrain");
-    let mut camera = default.camera.clone();
-    camera.altitude_m += terrain.height_at(0.0, 0.0);
+    let camera = default.camera_over(Some(&terrain));
     let settings = render::RenderSettings {
         camera: &camera,
         width: 1920,

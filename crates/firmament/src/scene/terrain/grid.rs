@@ -86,6 +86,12 @@ impl Grid {
         ]
     }
 
+    /// The interpolated value at plane coordinates (u, v), None off the grid.
+    pub fn value_at(&self, u: f64, v: f64) -> Option<f64> {
+        let (gx, gy) = self.cell_coords(u, v);
+        self.contains(gx, gy).then(|| self.bilinear(gx, gy))
+    }
+
     /// Bilinear interpolation at grid coordinates (clamped to the grid).
     pub fn bilinear(&self, gx: f64, gy: f64) -> f64 {
         let (i, a) = split(gx, self.nx);
@@ -233,6 +239,18 @@ impl GridRay {
         let (u, v) = self.plane(t);
         let (gx, gy) = grid.cell_coords(u, v);
         (gx, gy, self.height(t))
+    }
+
+    /// The ray's height minus the grid's bilinear patch across `cell`, as q0 + q1·s + q2·s²
+    /// from where it enters the cell (s = 0) to where it leaves (s = 1). The ray is taken as
+    /// straight in the cell: its height's curvature over 100 m is L²/8R, 2·10⁻⁴ m.
+    pub fn gap_in_cell(&self, grid: &Grid, cell: CellSpan) -> [f64; 3] {
+        let (x0, y0, h0) = self.grid_point(grid, cell.t0);
+        let (x1, y1, h1) = self.grid_point(grid, cell.t1);
+        let (a0, b0) = fractions(x0, y0, cell.i, cell.j);
+        let (a1, b1) = fractions(x1, y1, cell.i, cell.j);
+        let q = along_segment(grid.corners(cell.i, cell.j), a0, b0, a1, b1);
+        [h0 - q[0], (h1 - h0) - q[1], -q[2]]
     }
 
     /// The linear function a + b·t whose sign tells the side of grid line x′ = `gx` (cells)

@@ -6,9 +6,7 @@
 
 use std::sync::{Arc, RwLock};
 
-use super::grid::{
-    along_segment, bilinear, first_descent, fractions, walk, CellSpan, Grid, GridRay, MaxPyramid,
-};
+use super::grid::{bilinear, first_descent, fractions, walk, CellSpan, Grid, GridRay, MaxPyramid};
 use super::materials::Materials;
 use super::shadow::ShadowField;
 use crate::math::Vec3;
@@ -76,21 +74,18 @@ impl Heightfield {
 
     /// The height (m) at plane coordinates (u, v) (0 off the grid: the sphere).
     pub fn height_at(&self, u: f64, v: f64) -> f64 {
-        let (gx, gy) = self.heights.cell_coords(u, v);
-        if self.heights.contains(gx, gy) {
-            self.heights.bilinear(gx, gy)
-        } else {
-            0.0
-        }
+        self.heights.value_at(u, v).unwrap_or(0.0)
+    }
+
+    /// The plane coordinates (u, v) of a planet-centred point (None on the far hemisphere).
+    pub fn plane_of(&self, p: Vec3) -> Option<(f64, f64)> {
+        let r = self.radius_m;
+        (p.z > 0.0).then(|| (r * p.x / p.z, r * p.y / p.z))
     }
 
     /// The height (m) below a planet-centred point.
     pub fn height_below(&self, p: Vec3) -> f64 {
-        if p.z <= 0.0 {
-            return 0.0;
-        }
-        let r = self.radius_m;
-        self.height_at(r * p.x / p.z, r * p.y / p.z)
+        self.plane_of(p).map_or(0.0, |(u, v)| self.height_at(u, v))
     }
 
     fn grid_ray(&self, ray: &Ray) -> GridRay {
@@ -172,17 +167,18 @@ fn refine(gr: &GridRay, grid: &Grid, cell: CellSpan, s: f64, f: [f64; 3]) -> f64
 }
 
 impl Heightfield {
-    /// Whether `ray` ends at `max_distance_m` on a surface (the terrain or the sphere under
-    /// it) that `light` does not reach: an exact shadow ray, from 5 cm above the end.
-    pub fn ends_in_shadow(&self, ray: &GridRay, light: Vec3, max_distance_m: f64) -> bool {
+    /// When `ray` ends at `max_distance_m` on a surface (the terrain or the sphere under it,
+    /// within 0.5 m), whether `light` is hidden from that end: an exact shadow ray from 5 cm
+    /// above it. None when the ray does not end on a surface.
+    pub fn end_in_shadow(&self, ray: &GridRay, light: Vec3, max_distance_m: f64) -> Option<bool> {
         if !max_distance_m.is_finite() {
-            return false;
+            return None;
         }
         let end = ray.at(max_distance_m);
         if end.length() - self.radius_m > self.height_below(end) + 0.5 {
-            return false;
+            return None;
         }
-        self.occludes(end + 0.05 * end.normalize(), light)
+        Some(self.occludes(end + 0.05 * end.normalize(), light))
     }
 }
 
@@ -200,14 +196,7 @@ impl Surface for Heightfield {
             (t_min, max_distance_m),
             0.0,
             &mut |cell| {
-                let (x0, y0, h0) = gr.grid_point(grid, cell.t0);
-                let (x1, y1, h1) = gr.grid_point(grid, cell.t1);
-                let (a0, b0) = fractions(x0, y0, cell.i, cell.j);
-                let (a1, b1) = fractions(x1, y1, cell.i, cell.j);
-                let q = along_segment(grid.corners(cell.i, cell.j), a0, b0, a1, b1);
-                // Ray height minus the patch along the cell (the ray is a straight line in
-                // the cell to 1e-4 m: its height's curvature over 100 m is L²/8R).
-                let f = [h0 - q[0], (h1 - h0) - q[1], -q[2]];
+                let f = gr.gap_in_cell(grid, cell);
                 match first_descent(f) {
                     Some(s) => {
                         hit_t = Some(refine(&gr, grid, cell, s, f));
@@ -252,21 +241,15 @@ impl Surface for Heightfield {
         if self.shafts {
             self.shadow_field(light)
                 .shadowed_intervals(self, &ray, max_distance_m, out);
-        } else if self.ends_in_shadow(&ray, light, max_distance_m) {
+        } else if self.end_in_shadow(&ray, light, max_distance_m) == Some(true) {
             out.push((max_distance_m * (1.0 - 1e-12), max_distance_m));
         }
     }
 
     fn sky_visibility(&self, hit: &SurfaceHit) -> f64 {
-        self.visibility.as_ref().map_or(1.0, |ao| {
-            let r = self.radius_m;
-            let p = hit.position;
-            let (gx, gy) = ao.cell_coords(r * p.x / p.z, r * p.y / p.z);
-            if ao.contains(gx, gy) {
-                ao.bilinear(gx, gy)
-            } else {
-                1.0
-            }
-        })
+        match (&self.visibility, self.plane_of(hit.position)) {
+            (Some(ao), Some((u, v))) => ao.value_at(u, v).unwrap_or(1.0),
+            _ => 1.0,
+        }
     }
 }

@@ -22,7 +22,7 @@
 
 use rayon::prelude::*;
 
-use super::grid::{along_segment, fractions, roots, walk, Grid, GridRay, MaxPyramid};
+use super::grid::{roots, walk, Grid, GridRay, MaxPyramid};
 use super::heightfield::Heightfield;
 use crate::math::Vec3;
 
@@ -56,9 +56,8 @@ impl ShadowField {
                 .for_each(|(j, row)| {
                     for (i, s) in row.iter_mut().enumerate() {
                         let (u, v) = grid.plane_coords(i as f64, j as f64);
-                        let (rx, ry) = raise.cell_coords(u, v);
-                        if raise.contains(rx, ry) {
-                            *s += raise.bilinear(rx, ry).max(0.0) as f32;
+                        if let Some(d) = raise.value_at(u, v) {
+                            *s += d.max(0.0) as f32;
                         }
                     }
                 });
@@ -92,13 +91,8 @@ impl ShadowField {
             (0.0, max_distance_m),
             0.0,
             &mut |cell| {
-                let (x0, y0, h0) = ray.grid_point(grid, cell.t0);
-                let (x1, y1, h1) = ray.grid_point(grid, cell.t1);
-                let (a0, b0) = fractions(x0, y0, cell.i, cell.j);
-                let (a1, b1) = fractions(x1, y1, cell.i, cell.j);
-                let q = along_segment(grid.corners(cell.i, cell.j), a0, b0, a1, b1);
                 // g(s) = ray height − S: shadowed where negative.
-                let g = [h0 - q[0], (h1 - h0) - q[1], -q[2]];
+                let g = ray.gap_in_cell(grid, cell);
                 let mut cuts = [0.0, 1.0, 1.0, 1.0];
                 let mut n = 1;
                 for s in roots(g).into_iter().flatten() {
@@ -120,15 +114,9 @@ impl ShadowField {
                 false
             },
         );
-        if !max_distance_m.is_finite() {
+        let Some(shadowed) = terrain.end_in_shadow(ray, self.light, max_distance_m) else {
             return;
-        }
-        // The end: on a surface when at (or below) the terrain's height there.
-        let end = ray.at(max_distance_m);
-        if end.length() - ray.radius_m > terrain.height_below(end) + 0.5 {
-            return;
-        }
-        let shadowed = terrain.ends_in_shadow(ray, self.light, max_distance_m);
+        };
         let touches = out.len() > first && out.last().unwrap().1 >= max_distance_m * (1.0 - 1e-9);
         match (shadowed, touches) {
             (false, true) => {
