@@ -59,6 +59,10 @@ pub struct AtmosphereArgs {
     /// ratio of the last two orders when --orders ≥ 3): the plain truncated sum.
     #[arg(long = "no-order-tail", action = clap::ArgAction::SetFalse)]
     pub order_tail: bool,
+    /// The ground's albedo per wavelength in place of the atmosphere's (a scene's terrain
+    /// sets it to its own mean, so the tables' ground bounce is the terrain's).
+    #[arg(skip)]
+    pub ground_albedo: Option<Vec<f64>>,
 }
 
 impl Default for AtmosphereArgs {
@@ -86,7 +90,11 @@ impl AtmosphereArgs {
     /// The resolved model.
     pub fn model(&self) -> Result<Model> {
         let wavelengths = Wavelengths::parse(&self.wavelengths)?;
-        Ok(self.atmosphere()?.resolve(&wavelengths)?)
+        let mut model = self.atmosphere()?.resolve(&wavelengths)?;
+        if let Some(albedo) = &self.ground_albedo {
+            model.ground_albedo.clone_from(albedo);
+        }
+        Ok(model)
     }
 
     /// The table configuration for a fresh precomputation.

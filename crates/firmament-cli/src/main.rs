@@ -29,7 +29,7 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Radiometric answers as JSON: radiance, luminance, transmittance, optical depths, irradiance.
-    Query(query::QueryArgs),
+    Query(Box<query::QueryArgs>),
     /// Where the sun and the moon are for a date and a place, and the day's sunrise, sunset and twilights, as JSON.
     Astro(astro::AstroCommandArgs),
     /// Print or check atmosphere definitions.

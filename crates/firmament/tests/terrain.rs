@@ -6,6 +6,7 @@ mod common;
 
 use common::sky;
 
+use firmament::atmosphere::Atmosphere;
 use firmament::math::{direction_from_zenith_azimuth, Vec3};
 use firmament::reference::rng::Rng;
 use firmament::render::{ShadeScratch, Shader};
@@ -13,7 +14,9 @@ use firmament::scene::surface::lit_intervals;
 use firmament::scene::terrain::grid::Grid;
 use firmament::scene::terrain::{Heightfield, Materials, ReliefParams, TerrainConfig};
 use firmament::scene::{sun_direction, Ray, Scene, Surface};
+use firmament::sky::bruneton4d::{Bruneton4d, TableConfig};
 use firmament::sky::{Shadow, SkyMethod};
+use firmament::spectrum::Wavelengths;
 
 const R: f64 = 6_360_000.0;
 
@@ -347,4 +350,119 @@ fn the_valley_scene_file_reads_with_its_terrain() {
     let scene = firmament::scene::SceneFile::from_file(&path).unwrap();
     let terrain = scene.terrain.expect("[terrain]");
     assert_eq!(terrain, TerrainConfig::default());
+}
+
+/// Single scattering through the valley at golden hour, against the reference path tracer
+/// with one scattering event: the terrain's shadows in the air (the light shafts, from the
+/// shadow-height field) and on black ground (exact shadow rays) as ground truth has them.
+/// Black terrain and ground, so the views are the air's single scattering alone.
+#[test]
+fn single_scattering_through_the_shafts_matches_the_reference() {
+    use firmament::reference::{self, ReferenceSettings};
+    let mut atmosphere = Atmosphere::earth();
+    atmosphere.ground_albedo = firmament::atmosphere::Albedo::Grey(0.0);
+    let model = atmosphere.resolve(&Wavelengths::rgb()).unwrap();
+    // Default sizes: the small tables' own error near the horizon is 3–4 %.
+    let config = TableConfig {
+        orders: 1,
+        order_tail: false,
+        ..Default::default()
+    };
+    let sky = Bruneton4d::compute(model.clone(), &config).unwrap();
+    let terrain = TerrainConfig {
+        resolution: 257,
+        albedo: Some(0.0),
+        occlusion: false,
+        ..TerrainConfig::default()
+    }
+    .build(model.bottom_radius_m, model.wavelengths.nm())
+    .unwrap();
+    let surfaces: Vec<Box<dyn Surface + '_>> = vec![Box::new(&terrain)];
+    let settings = ReferenceSettings {
+        samples: 3000,
+        include_ground: true,
+        max_bounces: 1,
+        ..Default::default()
+    };
+    let observer = Vec3::new(
+        0.0,
+        0.0,
+        model.bottom_radius_m + terrain.height_at(0.0, 0.0) + 25.0,
+    );
+    let mut scratch = ShadeScratch::default();
+    let mut shadowed_views = 0;
+    // Golden hour: towards the sun over the ridges, along the shafts, across the valley;
+    // noon: the slopes and the far mountains.
+    let cases = [
+        (
+            (84.5, 237.0),
+            [
+                (86.0, 245.0),
+                (88.5, 260.0),
+                (90.2, 225.0),
+                (92.0, 245.0),
+                (82.0, 290.0),
+                (90.2, 60.0),
+            ],
+        ),
+        (
+            (28.0, 175.0),
+            [
+                (84.0, 0.0),
+                (88.5, 200.0),
+                (90.2, 60.0),
+                (92.0, 200.0),
+                (96.0, 60.0),
+                (70.0, 60.0),
+            ],
+        ),
+    ];
+    for (k, ((sz, sa), views)) in cases.into_iter().enumerate() {
+        let sun = sun_direction(sz, sa);
+        let mut scene = Scene::clear_sky(&sky, sun, false);
+        scene.surfaces.insert(0, Box::new(&terrain));
+        let shader = Shader::new(&scene, observer).unwrap();
+        for (i, (z, a)) in views.into_iter().enumerate() {
+            let dir = direction_from_zenith_azimuth(f64::to_radians(z), f64::to_radians(a));
+            let ray = Ray {
+                origin: observer,
+                dir,
+            };
+            let mut l = [0.0; 3];
+            shader.shade(&ray, &mut scratch, &mut l);
+            let mut shadowed = Vec::new();
+            scene.shadowed_intervals(&ray, sun, 20_000.0, &mut shadowed);
+            shadowed_views += usize::from(!shadowed.is_empty());
+            let key = (10 * k + i) as u64;
+            let e = reference::scene_radiance(
+                &model,
+                &[],
+                &surfaces,
+                observer,
+                dir,
+                sun,
+                &settings,
+                key,
+            );
+            let nm = model.wavelengths.nm();
+            let (lum, (ref_lum, ref_se)) = (
+                firmament::spectrum::luminance_from_spectrum(nm, &l),
+                e.luminance(nm),
+            );
+            let error = lum / ref_lum - 1.0;
+            eprintln!(
+                "single scattering, sun {sz},{sa}, view {z},{a}: {:+.2}% (reference noise {:.2}%)",
+                100.0 * error,
+                100.0 * ref_se / ref_lum
+            );
+            assert!(
+                error.abs() < 0.03 + 3.0 * ref_se / ref_lum,
+                "sun {sz},{sa} view {z},{a}: tables {lum} reference {ref_lum} ± {ref_se}"
+            );
+        }
+    }
+    assert!(
+        shadowed_views >= 3,
+        "only {shadowed_views} views cross a shadow"
+    );
 }

@@ -7,6 +7,7 @@ pub mod bake;
 pub mod bench;
 pub mod gallery;
 pub mod query;
+pub mod query_scene;
 pub mod render;
 pub mod timelapse;
 pub mod validate;

@@ -21,9 +21,13 @@ use crate::common::{check_range, check_reference_samples, AtmosphereArgs};
 pub struct QueryArgs {
     #[command(flatten)]
     pub atmosphere: AtmosphereArgs,
+    /// A scene file: the views are what its camera's observer sees, terrain included, with
+    /// its atmosphere, sun and terrain (the camera's direction and image are not used).
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["altitude_m", "sun_zenith_deg", "sun_azimuth_deg", "time"])]
+    pub scene: Option<std::path::PathBuf>,
     /// Observer altitude above the ground (m); above the atmosphere top is space.
-    #[arg(long, allow_hyphen_values = true)]
-    pub altitude_m: f64,
+    #[arg(long, allow_hyphen_values = true, required_unless_present = "scene")]
+    pub altitude_m: Option<f64>,
     /// Sun zenith angle (degrees, 0–180; above 90 the sun is below the horizon); required
     /// unless --time is given.
     #[arg(long, allow_hyphen_values = true)]
@@ -64,23 +68,23 @@ pub struct QueryArgs {
 
 /// The answer for one `--view`; the last three only with `--method reference`.
 #[derive(Serialize)]
-struct ViewAnswer {
-    zenith_deg: f64,
-    azimuth_deg: f64,
-    radiance: Vec<f64>,
-    luminance_cd_m2: f64,
-    xyz: [f64; 3],
-    srgb_linear: [f64; 3],
-    transmittance: Vec<f64>,
+pub(crate) struct ViewAnswer {
+    pub zenith_deg: f64,
+    pub azimuth_deg: f64,
+    pub radiance: Vec<f64>,
+    pub luminance_cd_m2: f64,
+    pub xyz: [f64; 3],
+    pub srgb_linear: [f64; 3],
+    pub transmittance: Vec<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    radiance_stderr: Option<Vec<f64>>,
+    pub radiance_stderr: Option<Vec<f64>>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    luminance_cd_m2_stderr: Option<f64>,
+    pub luminance_cd_m2_stderr: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    samples: Option<usize>,
+    pub samples: Option<usize>,
 }
 
-fn parse_view(s: &str) -> Result<(f64, f64)> {
+pub(crate) fn parse_view(s: &str) -> Result<(f64, f64)> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     let parsed: Vec<f64> = parts.iter().filter_map(|p| p.parse().ok()).collect();
     if parts.len() != 2 || parsed.len() != 2 {
@@ -131,7 +135,27 @@ fn moon_json(
 
 /// Run the query and return the JSON.
 pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
-    check_range("--altitude-m", args.altitude_m, 0.0, 1e12, "m")?;
+    let reference = match args.method.as_str() {
+        "lut" => None,
+        "reference" => {
+            let settings = ReferenceSettings {
+                samples: args.samples,
+                seed: args.seed,
+                ..Default::default()
+            };
+            // The flag's own wording; the other settings are the defaults.
+            check_reference_samples(settings.samples)?;
+            Some(settings)
+        }
+        other => anyhow::bail!("invalid value for `--method`: {other} (accepted: lut, reference)"),
+    };
+    if args.scene.is_some() {
+        return super::query_scene::run(args, reference);
+    }
+    let altitude_m = args
+        .altitude_m
+        .expect("--altitude-m is required without --scene");
+    check_range("--altitude-m", altitude_m, 0.0, 1e12, "m")?;
     let astro = args.astro.resolve()?;
     let (sun_zenith_deg, sun_azimuth_deg) = match (&astro, args.sun_zenith_deg) {
         (Some(_), _) => (f64::NAN, f64::NAN),
@@ -148,20 +172,6 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
             "degrees",
         )?;
     }
-    let reference = match args.method.as_str() {
-        "lut" => None,
-        "reference" => {
-            let settings = ReferenceSettings {
-                samples: args.samples,
-                seed: args.seed,
-                ..Default::default()
-            };
-            // The flag's own wording; the other settings are the defaults.
-            check_reference_samples(settings.samples)?;
-            Some(settings)
-        }
-        other => anyhow::bail!("invalid value for `--method`: {other} (accepted: lut, reference)"),
-    };
     let views: Vec<(f64, f64)> = args
         .views
         .iter()
@@ -186,7 +196,7 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
     let nm = model.wavelengths.nm().to_vec();
     let n = nm.len();
 
-    let camera = Vec3::new(0.0, 0.0, model.bottom_radius_m + args.altitude_m);
+    let camera = Vec3::new(0.0, 0.0, model.bottom_radius_m + altitude_m);
     let up = Vec3::Z;
     let sky_now = match astro {
         Some((instant, place, weather)) => Some(Sky::at(instant, place, &weather)?),
@@ -205,7 +215,7 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
         None => (sun_zenith_deg, sun_azimuth_deg),
     };
 
-    let optical_depths = model.optical_depths_vertical(args.altitude_m);
+    let optical_depths = model.optical_depths_vertical(altitude_m);
     let mut sun_transmittance = vec![0.0; n];
     let views_of_lights: Vec<_> = (sources.lights.iter())
         .map(|l| sky.view(camera, l))
@@ -270,7 +280,7 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
             "irradiance": "W m-2 nm-1",
             "luminance": "cd m-2 (CIE 1931 2 deg, 683 lm/W; spectrum linearly interpolated between samples)",
         },
-        "altitude_m": args.altitude_m,
+        "altitude_m": altitude_m,
         "sun": { "zenith_deg": sun_zenith_deg, "azimuth_deg": sun_azimuth_deg },
         "moon": moon_json(&sky_now, &views_of_lights, &sources, camera, &nm),
         "optical_depth_zenith": optical_depths,

@@ -345,6 +345,44 @@ pub fn build_terrain(model: &Model, scene: &Scene, quiet: bool) -> Result<Option
     Ok(terrain)
 }
 
+/// The scene's terrain and the atmosphere arguments of its tables. Without --tables the
+/// tables' ground albedo is the terrain's mean, so the ground bounce in the sky's light
+/// (its irradiance, the multiple scattering) is the terrain's and not the preset's grey;
+/// with --tables theirs is kept, with a note. The planet's sphere around the terrain takes
+/// the same albedo.
+pub fn terrain_and_atmosphere(
+    scene: &Scene,
+    tables: Option<PathBuf>,
+    table_size: &str,
+    quiet: bool,
+) -> Result<(Option<Heightfield>, AtmosphereArgs)> {
+    let mut atmosphere = atmosphere_args(scene, tables, table_size);
+    if scene.terrain.is_none() {
+        return Ok((None, atmosphere));
+    }
+    let model = atmosphere.model()?;
+    let terrain = build_terrain(&model, scene, quiet)?;
+    if let Some(t) = &terrain {
+        let albedo = t.mean_albedo(model.channels());
+        let k = model.channels() / 2;
+        if atmosphere.tables.is_none() {
+            if !quiet {
+                eprintln!(
+                    "terrain: the tables' ground albedo is the terrain's mean, {:.3} at {:.0} nm (the atmosphere's: {:.3})",
+                    albedo[k], model.wavelengths.nm()[k], model.ground_albedo[k]
+                );
+            }
+            atmosphere.ground_albedo = Some(albedo);
+        } else if !quiet {
+            eprintln!(
+                "note: the tables' ground albedo ({:.3} at {:.0} nm) is kept; the terrain's mean is {:.3} (without --tables the tables take it)",
+                model.ground_albedo[k], model.wavelengths.nm()[k], albedo[k]
+            );
+        }
+    }
+    Ok((terrain, atmosphere))
+}
+
 /// Render the scene with a sky on its backend over its terrain (built by
 /// [`build_terrain`]); returns the frame and the EV100 used.
 pub fn render_scene(
@@ -409,6 +447,7 @@ pub fn write_outputs(
 fn render_scene_reference(
     model: &Model,
     scene: &Scene,
+    terrain: Option<&Heightfield>,
     samples: usize,
     quiet: bool,
 ) -> Result<(render::Frame, f64)> {
@@ -421,10 +460,9 @@ fn render_scene_reference(
         );
     }
     let sun = &lights[0];
-    let terrain = build_terrain(model, scene, quiet)?;
     let surfaces: Vec<Box<dyn firmament::scene::Surface + '_>> =
-        terrain.iter().map(|t| Box::new(t) as _).collect();
-    let camera = scene.camera_over(terrain.as_ref());
+        terrain.iter().map(|t| Box::new(*t) as _).collect();
+    let camera = scene.camera_over(terrain);
     let bar = progress_bar(1000, quiet);
     bar.set_message(format!("reference, {samples} paths/λ"));
     let result = reference::render_frame(
@@ -491,9 +529,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             if !args.quiet {
                 eprintln!("backend: cpu (the reference path tracer runs on the CPU only)");
             }
-            let model = atmosphere_args(&scene, None, &args.table_size).model()?;
+            let (terrain, atmosphere) =
+                terrain_and_atmosphere(&scene, None, &args.table_size, args.quiet)?;
+            let model = atmosphere.model()?;
             let t = Instant::now();
-            let (frame, ev100) = render_scene_reference(&model, &scene, args.samples, args.quiet)?;
+            let (frame, ev100) =
+                render_scene_reference(&model, &scene, terrain.as_ref(), args.samples, args.quiet)?;
             if !args.quiet {
                 eprintln!(
                     "render (reference): {}×{} {:?} in {:.2} s (EV100 {:.1})",
@@ -522,12 +563,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
         backend => backend,
     };
+    let (terrain, atmosphere) =
+        terrain_and_atmosphere(&scene, args.tables.clone(), &args.table_size, args.quiet)?;
     let t = Instant::now();
-    let sky = RenderSky::new(
-        &backend,
-        &atmosphere_args(&scene, args.tables.clone(), &args.table_size),
-        args.quiet,
-    )?;
+    let sky = RenderSky::new(&backend, &atmosphere, args.quiet)?;
     if !args.quiet && args.tables.is_some() {
         eprintln!(
             "tables: loaded{} in {:.2} s",
@@ -542,7 +581,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if !args.quiet && times.is_none() {
         twilight_note(sky.model(), &scene)?;
     }
-    let terrain = build_terrain(sky.model(), &scene, args.quiet)?;
     if let Some(times) = times {
         let t = Instant::now();
         let (rendered, _) = timelapse::run(

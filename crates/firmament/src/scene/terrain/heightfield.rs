@@ -13,6 +13,10 @@ use crate::math::Vec3;
 use crate::scene::camera::Ray;
 use crate::scene::surface::{Surface, SurfaceHit};
 
+/// The radius (m, one standard deviation) of the terrain around the observer whose albedo
+/// the tables take for the planet's ground ([`Heightfield::mean_albedo`]).
+pub const ALBEDO_RADIUS_M: f64 = 5000.0;
+
 /// Shadow fields kept per light direction (a frame has at most a few lights).
 const SHADOW_CACHE: usize = 4;
 
@@ -65,6 +69,36 @@ impl Heightfield {
             visibility: self.visibility.clone(),
             shadows: RwLock::new(Vec::new()),
         }
+    }
+
+    /// The mean albedo per channel (`channels` of them) of the terrain around the observer,
+    /// weighted by a Gaussian of [`ALBEDO_RADIUS_M`] around its foot (a 64 × 64 subgrid of
+    /// the terrain, the sphere beyond it counted at the same mean): the ground whose
+    /// reflection lights the air and the sky the observer sees.
+    pub fn mean_albedo(&self, channels: usize) -> Vec<f64> {
+        let g = &self.heights;
+        let (mut sum, mut a) = (vec![0.0; channels], vec![0.0; channels]);
+        let mut weights = 0.0;
+        let steps = 64usize;
+        for j in 0..steps {
+            for i in 0..steps {
+                let gx = (i as f64 + 0.5) / steps as f64 * (g.nx - 1) as f64;
+                let gy = (j as f64 + 0.5) / steps as f64 * (g.ny - 1) as f64;
+                let (u, v) = g.plane_coords(gx, gy);
+                let w = (-(u * u + v * v) / (2.0 * ALBEDO_RADIUS_M * ALBEDO_RADIUS_M)).exp();
+                let h = g.bilinear(gx, gy);
+                let position = Vec3::new(u, v, self.radius_m).normalize() * (self.radius_m + h);
+                let hit = SurfaceHit {
+                    distance_m: 0.0,
+                    position,
+                    normal: self.normal_at(position),
+                };
+                self.albedo(&hit, &mut a);
+                sum.iter_mut().zip(&a).for_each(|(s, v)| *s += w * v);
+                weights += w;
+            }
+        }
+        sum.iter().map(|s| s / weights).collect()
     }
 
     /// The highest point (m above the sphere).

@@ -1,0 +1,128 @@
+//! `firmament query --scene FILE`: the radiance a camera at the scene's observer sees in
+//! each `--view`, everything in the scene included (its terrain lit and shadowed, the light
+//! shafts, the ground, aerial perspective; the sun's disk excluded), from the tables through
+//! the renderer's own shading or from the reference path tracer with the same surfaces. The
+//! JSON is `query`'s.
+
+use anyhow::Result;
+use firmament::math::direction_from_zenith_azimuth;
+use firmament::reference::{self, ReferenceSettings};
+use firmament::render::{ShadeScratch, Shader};
+use firmament::scene::{Ray, Scene as RenderScene, SceneFile, Surface};
+use firmament::sky::SkyMethod;
+use firmament::spectrum::{luminance_from_spectrum, spectrum_to_xyz, xyz_to_linear_srgb};
+use serde_json::json;
+
+use super::query::{parse_view, QueryArgs, ViewAnswer};
+use super::render::{sources_of_scene, terrain_and_atmosphere};
+
+/// Run `query --scene`.
+pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<serde_json::Value> {
+    let path = args.scene.as_ref().expect("--scene");
+    let scene = SceneFile::from_file(path)?;
+    let views: Vec<(f64, f64)> = (args.views.iter())
+        .map(|v| parse_view(v))
+        .collect::<Result<_>>()?;
+    let (terrain, atmosphere) = terrain_and_atmosphere(
+        &scene,
+        args.atmosphere.tables.clone(),
+        &args.atmosphere.table_size,
+        args.quiet,
+    )?;
+    let sky = atmosphere.sky(args.quiet)?;
+    let model = &sky.model;
+    let nm = model.wavelengths.nm().to_vec();
+    let sources = sources_of_scene(model, &scene)?;
+    if reference.is_some() && (sources.lights.len() > 1 || sources.background.is_some()) {
+        anyhow::bail!("`--method reference` traces the sun's light only so far: a [time] with the moon up or the sun down is not supported with it");
+    }
+    let camera = scene.camera_over(terrain.as_ref());
+    let observer = firmament::math::Vec3::new(0.0, 0.0, model.bottom_radius_m + camera.altitude_m);
+    let mut render_scene = RenderScene::clear_sky(&sky, sources.lights[0].direction, false);
+    render_scene.lights = sources.lights.clone();
+    render_scene
+        .lights
+        .iter_mut()
+        .for_each(|l| l.visible_disk = false);
+    render_scene.background = sources.background.clone();
+    if let Some(t) = &terrain {
+        render_scene.surfaces.insert(0, Box::new(t));
+    }
+    let shader = Shader::new(&render_scene, observer)?;
+    let first_view = sky.view(observer, &render_scene.lights[0]);
+    let surfaces: Vec<Box<dyn Surface + '_>> = terrain.iter().map(|t| Box::new(t) as _).collect();
+    let settings = reference.map(|s| ReferenceSettings {
+        include_ground: true,
+        ..s
+    });
+    let n = nm.len();
+    let mut scratch = ShadeScratch::default();
+    let mut answers = Vec::new();
+    for (i, &(zenith_deg, azimuth_deg)) in views.iter().enumerate() {
+        let dir = direction_from_zenith_azimuth(zenith_deg.to_radians(), azimuth_deg.to_radians());
+        let ray = Ray {
+            origin: observer,
+            dir,
+        };
+        let mut radiance = vec![0.0; n];
+        shader.shade(&ray, &mut scratch, &mut radiance);
+        // The air's transmittance to the first surface, or out of the atmosphere.
+        let mut transmittance = vec![0.0; n];
+        match render_scene.nearest_hit(&ray, f64::INFINITY) {
+            Some((_, hit)) => first_view.transmittance_to_point(hit.position, &mut transmittance),
+            None => first_view.sky_radiance(
+                dir,
+                firmament::sky::Shadow::None,
+                &mut vec![0.0; n],
+                &mut transmittance,
+            ),
+        }
+        let estimate = settings.as_ref().map(|s| {
+            let sun = render_scene.lights[0].direction;
+            let e =
+                reference::scene_radiance(model, &[], &surfaces, observer, dir, sun, s, i as u64);
+            radiance.copy_from_slice(&e.radiance);
+            e
+        });
+        let xyz = spectrum_to_xyz(&nm, &radiance);
+        answers.push(ViewAnswer {
+            zenith_deg,
+            azimuth_deg,
+            luminance_cd_m2: xyz[1],
+            xyz,
+            srgb_linear: xyz_to_linear_srgb(xyz),
+            radiance,
+            transmittance,
+            luminance_cd_m2_stderr: estimate.as_ref().map(|e| e.luminance(&nm).1),
+            samples: estimate.as_ref().map(|e| e.samples),
+            radiance_stderr: estimate.map(|e| e.stderr),
+        });
+    }
+    let sun = &render_scene.lights[0];
+    let up = sun.direction.z.clamp(-1.0, 1.0);
+    let method = match &settings {
+        None => "views: the renderer's shading of the scene from the tables (terrain, shadows, light shafts, ground, aerial perspective; the sun's disk excluded)".to_string(),
+        Some(s) => format!(
+            "views: spectral Monte Carlo reference path tracer through the same scene (the terrain intersected as a Lambertian surface), {} paths per wavelength and view, seed {} (view i uses stream key i); the sun's disk excluded",
+            s.samples, s.seed
+        ),
+    };
+    Ok(json!({
+        "method": args.method,
+        "scene": path.display().to_string(),
+        "wavelengths_nm": nm,
+        "units": {
+            "radiance": "W m-2 sr-1 nm-1",
+            "luminance": "cd m-2 (CIE 1931 2 deg, 683 lm/W; spectrum linearly interpolated between samples)",
+        },
+        "altitude_m": camera.altitude_m,
+        "terrain_height_m": terrain.as_ref().map(|t| t.height_at(0.0, 0.0)),
+        "sun": {
+            "zenith_deg": up.acos().to_degrees(),
+            "azimuth_deg": sun.direction.x.atan2(sun.direction.y).to_degrees().rem_euclid(360.0),
+        },
+        "solar_illuminance_toa_lux": luminance_from_spectrum(&nm, &sun.irradiance),
+        "views": answers,
+        "notes": [method, "transmittance (per view): the air's, from the tables, to the first surface the view meets or out of the atmosphere"],
+    }))
+}

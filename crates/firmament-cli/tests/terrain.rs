@@ -1,0 +1,164 @@
+//! Terrain scenes end to end: `query --scene` with the tables and the reference, `render`
+//! over a terrain, and the refusals of bad `[terrain]` input (no output left behind).
+
+mod common;
+
+use std::path::PathBuf;
+
+use common::{fails_with, run, stderr, succeeds, tables_arg, tmp_subdir};
+
+/// A small terrain scene (8 km, 65² vertices) in `dir`, with `terrain` lines added.
+fn scene(dir: &std::path::Path, name: &str, terrain: &str) -> PathBuf {
+    let path = dir.join(format!("{name}.toml"));
+    let text = format!(
+        r#"[atmosphere]
+preset = "earth"
+
+[camera]
+projection = "perspective"
+altitude_m = 25.0
+heading_deg = 250.0
+pitch_deg = 5.0
+fov_deg = 50.0
+
+[image]
+width = 32
+height = 18
+
+[sun]
+zenith_deg = 80.0
+azimuth_deg = 240.0
+
+[terrain]
+extent_m = 8000
+resolution = 65
+feature_size_m = 3000
+height_scale_m = 900
+{terrain}
+
+[output]
+files = ["{name}.png"]
+"#
+    );
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn query(args: &[&str]) -> serde_json::Value {
+    let o = run(args);
+    succeeds(&o);
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+#[test]
+fn query_scene_answers_the_terrain_with_the_tables_and_the_reference() {
+    let dir = tmp_subdir("terrain-query");
+    let s = scene(&dir, "valley", "");
+    let s = s.to_str().unwrap();
+    let views = ["--view", "60,240", "--view", "95,60", "--view", "91,240"];
+    let mut args = vec!["query", "--scene", s, "--tables", tables_arg(), "-q"];
+    args.extend_from_slice(&views);
+    let lut = query(&args);
+    let ground = lut["terrain_height_m"].as_f64().unwrap();
+    assert!(ground > 0.0, "{lut}");
+    assert!((lut["altitude_m"].as_f64().unwrap() - (ground + 25.0)).abs() < 1e-6);
+    let v = lut["views"].as_array().unwrap();
+    assert_eq!(v.len(), 3);
+    for view in v {
+        assert!(view["luminance_cd_m2"].as_f64().unwrap() > 0.0, "{view}");
+    }
+    // Looking down at the terrain: the air's transmittance to it is high; to the sky lower.
+    let t = |i: usize| v[i]["transmittance"][1].as_f64().unwrap();
+    assert!(t(1) > 0.9 && t(1) > t(0), "{} {}", t(0), t(1));
+    args.extend_from_slice(&["--method", "reference", "--samples", "400"]);
+    let reference = query(&args);
+    for (r, l) in reference["views"].as_array().unwrap().iter().zip(v) {
+        let (y, se) = (
+            r["luminance_cd_m2"].as_f64().unwrap(),
+            r["luminance_cd_m2_stderr"].as_f64().unwrap(),
+        );
+        assert!(se > 0.0 && se < 0.2 * y, "{r}");
+        // The same scene: the two agree to tens of per cent at this noise.
+        let lum = l["luminance_cd_m2"].as_f64().unwrap();
+        assert!((lum / y - 1.0).abs() < 0.5, "lut {lum} reference {y}");
+    }
+    // A scene's observer is the scene's: --altitude-m with --scene is refused.
+    fails_with(
+        &run(&[
+            "query",
+            "--scene",
+            s,
+            "--altitude-m",
+            "10",
+            "--view",
+            "60,0",
+        ]),
+        &["--scene", "--altitude-m"],
+    );
+}
+
+#[test]
+fn render_draws_a_terrain_and_refuses_bad_terrain_input() {
+    let dir = tmp_subdir("terrain-render");
+    let good = scene(&dir, "good", "");
+    let out = dir.join("good.png");
+    let o = run(&[
+        "render",
+        "--scene",
+        good.to_str().unwrap(),
+        "--tables",
+        tables_arg(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    succeeds(&o);
+    assert!(out.exists());
+    assert!(
+        stderr(&o).contains("terrain: 65×65 vertices"),
+        "{}",
+        stderr(&o)
+    );
+    // An 8-bit heightmap, a zero extent, a negative height scale, a missing file.
+    let png8 = dir.join("grey8.png");
+    image::GrayImage::new(4, 4).save(&png8).unwrap();
+    let cases = [
+        (
+            format!(
+                "heightmap = \"{}\"\nheight_range_m = [0, 500]",
+                png8.display()
+            ),
+            vec!["terrain.heightmap", "16-bit greyscale"],
+        ),
+        ("extent_m = 0".to_string(), vec!["terrain.extent_m"]),
+        (
+            "height_scale_m = -5".to_string(),
+            vec!["terrain.height_scale_m"],
+        ),
+        (
+            "heightmap = \"missing.png\"\nheight_range_m = [0, 500]".to_string(),
+            vec!["missing.png"],
+        ),
+    ];
+    for (k, (lines, words)) in cases.iter().enumerate() {
+        // The keys replace the defaults above (TOML refuses duplicates): a fresh section.
+        let text = std::fs::read_to_string(&good)
+            .unwrap()
+            .replace("extent_m = 8000\n", "")
+            .replace("height_scale_m = 900\n", "")
+            .replace("[terrain]\n", &format!("[terrain]\n{lines}\n"));
+        let bad = dir.join(format!("bad{k}.toml"));
+        std::fs::write(&bad, text).unwrap();
+        let out = dir.join(format!("bad{k}.png"));
+        let o = run(&[
+            "render",
+            "--scene",
+            bad.to_str().unwrap(),
+            "--tables",
+            tables_arg(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        fails_with(&o, words);
+        assert!(!out.exists(), "case {k} left {}", out.display());
+    }
+}
