@@ -233,6 +233,13 @@ impl GridRay {
         (self.radius_m * p.x / p.z, self.radius_m * p.y / p.z)
     }
 
+    /// Grid coordinates at `t`.
+    #[inline]
+    pub fn grid_xy(&self, grid: &Grid, t: f64) -> (f64, f64) {
+        let (u, v) = self.plane(t);
+        grid.cell_coords(u, v)
+    }
+
     /// Grid coordinates and height at `t`.
     #[inline]
     pub fn grid_point(&self, grid: &Grid, t: f64) -> (f64, f64, f64) {
@@ -318,9 +325,13 @@ impl GridRay {
     }
 }
 
-/// A cell the walk reaches: its indices and the ray's parameters where it enters and leaves.
+/// A cell the walk reaches: its indices and the ray's parameters where it enters and leaves
+/// (or, with `below`, a whole node the ray crosses below the lowest value in it).
 #[derive(Clone, Copy, Debug)]
 pub struct CellSpan {
+    /// The span is a whole node the ray crosses below its lowest value ([`walk`]'s
+    /// `floors`); `i` and `j` are then the node's, not a cell's.
+    pub below: bool,
     /// Cell index along x′.
     pub i: usize,
     /// Cell index along y′.
@@ -332,72 +343,115 @@ pub struct CellSpan {
 }
 
 /// Walk the cells of `grid` that `ray` crosses within [t0, t1], nearest first, skipping the
-/// nodes of `pyramid` whose maximum is below the ray's lowest height over them by more than
-/// `margin` (the maximum plus `margin` is compared); `visit` returns true to stop.
-/// Returns true when stopped.
+/// nodes of `pyramid` whose maximum is below the ray's lowest height over them, and the
+/// nodes whose maximum in `nonzero` (a pyramid over the same grid, when given) is 0 or
+/// less; a node the ray crosses below its lowest value (`floors`: the pyramid of the
+/// negated values, when given) is visited whole (`CellSpan::below`); `visit` returns true
+/// to stop. Returns true when stopped.
 pub fn walk(
     grid: &Grid,
     pyramid: &MaxPyramid,
+    nonzero: Option<&MaxPyramid>,
+    floors: Option<&MaxPyramid>,
     ray: &GridRay,
     (t0, t1): (f64, f64),
-    margin: f64,
     visit: &mut dyn FnMut(CellSpan) -> bool,
 ) -> bool {
-    let Some((a, b)) = ray.clip(grid, t0, t1, pyramid.max() + margin) else {
+    let Some((a, b)) = ray.clip(grid, t0, t1, pyramid.max()) else {
         return false;
     };
     let top = pyramid.levels.len() - 1;
-    walk_node(grid, pyramid, ray, top, 0, 0, a, b, margin, visit)
+    let walk = Walk {
+        grid,
+        pyramid,
+        nonzero,
+        floors,
+        ray,
+    };
+    walk.node(top, 0, 0, a, b, visit)
 }
 
-#[allow(clippy::too_many_arguments)]
-fn walk_node(
-    grid: &Grid,
-    pyramid: &MaxPyramid,
-    ray: &GridRay,
-    level: usize,
-    i: usize,
-    j: usize,
-    t0: f64,
-    t1: f64,
-    margin: f64,
-    visit: &mut dyn FnMut(CellSpan) -> bool,
-) -> bool {
-    let Some(max) = pyramid.node(level, i, j) else {
-        return false;
-    };
-    if t1 <= t0 || ray.min_height(t0, t1) > max + margin {
-        return false;
-    }
-    if level == 0 {
-        return visit(CellSpan { i, j, t0, t1 });
-    }
-    let half = 1usize << (level - 1);
-    let (mx, my) = ((2 * i + 1) * half, (2 * j + 1) * half);
-    let mut cuts = [t0, t1, t1, t1];
-    let mut n = 1;
-    for (g, along_y) in [(mx, false), (my, true)] {
-        let t = ray.crossing(grid, g as f64, along_y);
-        if t > t0 && t < t1 {
-            cuts[n] = t;
-            n += 1;
+/// What [`walk`] walks.
+struct Walk<'a> {
+    grid: &'a Grid,
+    pyramid: &'a MaxPyramid,
+    nonzero: Option<&'a MaxPyramid>,
+    floors: Option<&'a MaxPyramid>,
+    ray: &'a GridRay,
+}
+
+impl Walk<'_> {
+    fn node(
+        &self,
+        level: usize,
+        i: usize,
+        j: usize,
+        t0: f64,
+        t1: f64,
+        visit: &mut dyn FnMut(CellSpan) -> bool,
+    ) -> bool {
+        let Some(max) = self.pyramid.node(level, i, j) else {
+            return false;
+        };
+        if t1 <= t0 || self.ray.min_height(t0, t1) > max {
+            return false;
         }
-    }
-    cuts[1..n].sort_by(f64::total_cmp);
-    cuts[n] = t1;
-    for k in 0..n {
-        let (a, b) = (cuts[k], cuts[k + 1]);
-        if b <= a {
-            continue;
+        if self
+            .nonzero
+            .is_some_and(|z| z.node(level, i, j).unwrap_or(0.0) <= 0.0)
+        {
+            return false;
         }
-        let (gx, gy, _) = ray.grid_point(grid, 0.5 * (a + b));
-        let ci = 2 * i + usize::from(gx >= mx as f64);
-        let cj = 2 * j + usize::from(gy >= my as f64);
-        if walk_node(grid, pyramid, ray, level - 1, ci, cj, a, b, margin, visit) {
-            return true;
+        if let Some(floor) = self.floors.and_then(|f| f.node(level, i, j)) {
+            // The height along a line is convex: its highest over [t0, t1] is at an end.
+            let top = self.ray.height(t0).max(self.ray.height(t1));
+            if top < -floor {
+                return visit(CellSpan {
+                    below: true,
+                    i,
+                    j,
+                    t0,
+                    t1,
+                });
+            }
         }
+        if level == 0 {
+            return visit(CellSpan {
+                below: false,
+                i,
+                j,
+                t0,
+                t1,
+            });
+        }
+        let (grid, ray) = (self.grid, self.ray);
+        let half = 1usize << (level - 1);
+        let (mx, my) = ((2 * i + 1) * half, (2 * j + 1) * half);
+        let mut cuts = [t0, t1, t1, t1];
+        let mut n = 1;
+        for (g, along_y) in [(mx, false), (my, true)] {
+            let t = ray.crossing(grid, g as f64, along_y);
+            if t > t0 && t < t1 {
+                cuts[n] = t;
+                n += 1;
+            }
+        }
+        cuts[1..n].sort_by(f64::total_cmp);
+        cuts[n] = t1;
+        for k in 0..n {
+            let (a, b) = (cuts[k], cuts[k + 1]);
+            if b <= a {
+                continue;
+            }
+            let (gx, gy) = ray.grid_xy(grid, 0.5 * (a + b));
+            let ci = 2 * i + usize::from(gx >= mx as f64);
+            let cj = 2 * j + usize::from(gy >= my as f64);
+            if self.node(level - 1, ci, cj, a, b, visit) {
+                return true;
+            }
+        }
+        false
     }
-    false
 }
 
 /// The fractions (a, b) within cell (i, j) of grid coordinates, clamped to [0, 1].

@@ -226,9 +226,10 @@ impl Surface for Heightfield {
         walk(
             grid,
             &self.pyramid,
+            None,
+            None,
             &gr,
             (t_min, max_distance_m),
-            0.0,
             &mut |cell| {
                 let f = gr.gap_in_cell(grid, cell);
                 match first_descent(f) {

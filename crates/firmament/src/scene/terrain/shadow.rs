@@ -38,6 +38,11 @@ pub struct ShadowField {
     /// S (m above the sphere) on the terrain's grid.
     pub heights: Grid,
     pyramid: MaxPyramid,
+    /// The maximum of the raise S − H per node: where it is 0 the air is lit down to the
+    /// ground, and the walk skips the node (a view ray there is above S where it is above H).
+    raised: MaxPyramid,
+    /// The pyramid of −S: a node the ray crosses below its lowest S is in shadow whole.
+    floors: MaxPyramid,
     light: Vec3,
 }
 
@@ -63,7 +68,15 @@ impl ShadowField {
                 });
         }
         let pyramid = MaxPyramid::new(&heights);
+        let mut raise = heights.clone();
+        for (d, h) in raise.values.iter_mut().zip(&grid.values) {
+            *d -= h;
+        }
+        let mut negated = heights.clone();
+        negated.values.iter_mut().for_each(|v| *v = -*v);
         ShadowField {
+            raised: MaxPyramid::new(&raise),
+            floors: MaxPyramid::new(&negated),
             heights,
             pyramid,
             light,
@@ -83,14 +96,23 @@ impl ShadowField {
     ) {
         let first = out.len();
         let grid = &self.heights;
+        // The last span walked, and whether it was a whole node in shadow.
         let mut last_piece = (0.0, 0.0);
+        let mut last_whole = false;
         walk(
             grid,
             &self.pyramid,
+            Some(&self.raised),
+            Some(&self.floors),
             ray,
             (0.0, max_distance_m),
-            0.0,
             &mut |cell| {
+                if cell.below {
+                    push_merged(out, first, cell.t0, cell.t1);
+                    last_piece = (cell.t0, cell.t1);
+                    last_whole = true;
+                    return false;
+                }
                 // g(s) = ray height − S: shadowed where negative.
                 let g = ray.gap_in_cell(grid, cell);
                 let mut cuts = [0.0, 1.0, 1.0, 1.0];
@@ -111,6 +133,7 @@ impl ShadowField {
                     }
                 }
                 last_piece = (cell.t0, cell.t1);
+                last_whole = false;
                 false
             },
         );
@@ -120,22 +143,28 @@ impl ShadowField {
         let touches = out.len() > first && out.last().unwrap().1 >= max_distance_m * (1.0 - 1e-9);
         match (shadowed, touches) {
             (false, true) => {
-                // The interpolated edge reaches a lit surface: stop it at the last cell.
+                // The interpolated edge reaches a lit surface: stop it at the end's cell
+                // (a cell's length before the end when that was a whole node).
+                let cut = if last_whole {
+                    max_distance_m - grid.spacing_m
+                } else {
+                    last_piece.0
+                };
                 let last = out.last_mut().unwrap();
-                last.1 = last.1.min(last_piece.0).max(last.0);
+                last.1 = last.1.min(cut).max(last.0);
                 if last.1 <= last.0 {
                     out.pop();
                 }
             }
             (true, false) => {
+                // The exact shadow ray hides the end the interpolated field lit: shadow from
+                // the end's cell (or a sliver at the end when the walk skipped it).
                 let from = if last_piece.1 >= max_distance_m * (1.0 - 1e-9) {
                     last_piece.0
                 } else {
-                    max_distance_m
+                    max_distance_m * (1.0 - 1e-12)
                 };
-                if from < max_distance_m {
-                    push_merged(out, first, from, max_distance_m);
-                }
+                push_merged(out, first, from, max_distance_m);
             }
             _ => {}
         }
