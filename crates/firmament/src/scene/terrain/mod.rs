@@ -208,7 +208,7 @@ impl TerrainConfig {
         };
         let visibility = self
             .occlusion
-            .then(|| occlusion::sky_visibility(&heights, radius_m));
+            .then(|| occlusion::sky_visibility(&heights, radius_m, occlusion::STRIDE));
         let mut field = Heightfield::new(heights, radius_m, materials);
         field.casts_shadows = self.shadows;
         field.shafts = self.light_shafts;

@@ -15,12 +15,17 @@ use super::grid::Grid;
 
 /// Azimuths searched for the horizon.
 pub const AZIMUTHS: usize = 8;
+/// The occlusion is computed at every STRIDE-th vertex each way (it varies over the
+/// horizon's scale, hundreds of metres, not a cell's) and interpolated between.
+pub const STRIDE: usize = 2;
 /// How far the horizon is searched (m).
 pub const HORIZON_RANGE_M: f64 = 4000.0;
 
-/// The visibility of the sky (0 to 1) at each vertex of `heights` on a planet of radius
-/// `radius_m`.
-pub fn sky_visibility(heights: &Grid, radius_m: f64) -> Grid {
+/// The visibility of the sky (0 to 1) at every `stride`-th vertex of `heights` (both ways)
+/// on a planet of radius `radius_m`: a grid `stride` times coarser over the same rectangle
+/// (the horizons searched on the full one), read by bilinear interpolation.
+pub fn sky_visibility(heights: &Grid, radius_m: f64, stride: usize) -> Grid {
+    let stride = stride.max(1);
     let dx = heights.spacing_m;
     let mut steps = Vec::new();
     let mut d = dx;
@@ -32,14 +37,29 @@ pub fn sky_visibility(heights: &Grid, radius_m: f64) -> Grid {
         .map(|k| (std::f64::consts::TAU * k as f64 / AZIMUTHS as f64).sin_cos())
         .map(|(s, c)| (c, s))
         .collect();
-    let mut out = heights.clone();
+    let (nx, ny) = (
+        (heights.nx - 1).div_ceil(stride) + 1,
+        (heights.ny - 1).div_ceil(stride) + 1,
+    );
+    let mut out = Grid {
+        nx,
+        ny,
+        origin: heights.origin,
+        spacing_m: dx * stride as f64,
+        axis: heights.axis,
+        values: vec![1.0; nx * ny],
+    };
+    let (last_x, last_y) = ((heights.nx - 1) as f64, (heights.ny - 1) as f64);
     out.values
-        .par_chunks_mut(heights.nx)
+        .par_chunks_mut(nx)
         .enumerate()
         .for_each(|(j, row)| {
             for (i, v) in row.iter_mut().enumerate() {
-                let (gx, gy) = (i as f64, j as f64);
-                let h0 = heights.at(i, j);
+                // The coarse vertex on the fine grid (the last row and column clamped: the
+                // coarse grid may reach a little beyond the fine one's edge).
+                let gx = ((i * stride) as f64).min(last_x);
+                let gy = ((j * stride) as f64).min(last_y);
+                let h0 = heights.bilinear(gx, gy);
                 let (hu, hv) = heights.gradient(gx, gy);
                 let norm = (1.0 + hu * hu + hv * hv).sqrt();
                 let (nx, ny, nz) = (-hu / norm, -hv / norm, 1.0 / norm);
@@ -93,7 +113,7 @@ mod tests {
             axis: [1.0, 0.0],
             values: vec![0.0; 41 * 41],
         };
-        let flat = sky_visibility(&g, 6.36e6);
+        let flat = sky_visibility(&g, 6.36e6, 1);
         assert!((flat.at(20, 20) - 1.0).abs() < 1e-6);
         // A ring wall 500 m high from 500 m: a horizon at 45° seen from the centre, so the
         // open share ∫ sin e cos e de from β to 90° is cos²β of the plain's: 1/2. The
@@ -107,7 +127,7 @@ mod tests {
                 }
             }
         }
-        let pit = sky_visibility(&g, 1e12);
+        let pit = sky_visibility(&g, 1e12, 1);
         let v = pit.at(20, 20);
         assert!((0.49..0.67).contains(&v), "{v}");
     }
