@@ -13,7 +13,9 @@ use firmament::scene::file::{SceneLocation, SceneTime};
 use firmament::scene::{Camera, Projection, SceneFile as Scene};
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
-use crate::commands::render::{atmosphere_args, build_terrain, render_scene, write_outputs};
+use crate::commands::render::{
+    atmosphere_args, render_scene, terrain_and_atmosphere, write_outputs,
+};
 
 /// Arguments of `firmament gallery`.
 #[derive(Args, Debug)]
@@ -137,20 +139,27 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
     if !args.quiet {
         eprintln!("tables ready in {:.2} s", t.elapsed().as_secs_f64());
     }
-    // The terrain views run on the CPU only so far.
-    let terrain = match (&sky, terrain_config.clone()) {
+    // The terrain views run on the CPU only so far, with tables of their own whose ground
+    // albedo is the terrain's (as `render` computes them), unless --tables are given.
+    let (terrain, terrain_sky) = match (&sky, terrain_config.clone()) {
         (RenderSky::Cpu(_), Some(config)) => {
             let with = Scene {
                 terrain: Some(config),
                 ..base.clone()
             };
-            build_terrain(sky.model(), &with, args.quiet)?
+            let (terrain, atmosphere) =
+                terrain_and_atmosphere(&with, args.tables.clone(), "default", args.quiet)?;
+            let terrain_sky = match args.tables {
+                Some(_) => None,
+                None => Some(RenderSky::new(&backend, &atmosphere, args.quiet)?),
+            };
+            (terrain, terrain_sky)
         }
         _ => {
             if !args.quiet {
                 eprintln!("note: the terrain views are skipped on the GPU (CPU only so far)");
             }
-            None
+            (None, None)
         }
     };
     let mut html = String::from(
@@ -170,6 +179,10 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
             scene.terrain = terrain_config.clone();
         }
         let terrain = terrain.as_ref().filter(|_| v.terrain);
+        let sky = match (&terrain_sky, v.terrain) {
+            (Some(terrain_sky), true) => terrain_sky,
+            _ => &sky,
+        };
         scene.camera = v.camera.clone();
         scene.sun.zenith_deg = v.sun.0;
         scene.sun.azimuth_deg = v.sun.1;
@@ -193,13 +206,13 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
         let t = Instant::now();
         let ev100 = match v.strip {
             None => {
-                let (frame, ev100) = render_scene(&sky, &scene, terrain, true)?;
+                let (frame, ev100) = render_scene(sky, &scene, terrain, true)?;
                 let ev100 = ev100 + v.ev_offset;
                 write_outputs(&frame, &scene, ev100, false, true)?;
                 ev100
             }
             Some((frames, minutes)) => {
-                write_strip(&sky, &scene, frames, minutes, &args.out.join(&file))?;
+                write_strip(sky, &scene, frames, minutes, &args.out.join(&file))?;
                 f64::NAN
             }
         };
