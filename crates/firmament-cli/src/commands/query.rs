@@ -69,19 +69,46 @@ pub struct QueryArgs {
 /// The answer for one `--view`; the last three only with `--method reference`.
 #[derive(Serialize)]
 pub(crate) struct ViewAnswer {
-    pub zenith_deg: f64,
-    pub azimuth_deg: f64,
-    pub radiance: Vec<f64>,
-    pub luminance_cd_m2: f64,
-    pub xyz: [f64; 3],
-    pub srgb_linear: [f64; 3],
-    pub transmittance: Vec<f64>,
+    zenith_deg: f64,
+    azimuth_deg: f64,
+    radiance: Vec<f64>,
+    luminance_cd_m2: f64,
+    xyz: [f64; 3],
+    srgb_linear: [f64; 3],
+    transmittance: Vec<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub radiance_stderr: Option<Vec<f64>>,
+    radiance_stderr: Option<Vec<f64>>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub luminance_cd_m2_stderr: Option<f64>,
+    luminance_cd_m2_stderr: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub samples: Option<usize>,
+    samples: Option<usize>,
+}
+
+impl ViewAnswer {
+    /// The answer for the view (zenith, azimuth) in degrees: its radiance per wavelength
+    /// (`nm`) with luminance and colours, its transmittance, and the reference's estimate
+    /// when there is one (whose radiance `radiance` already holds).
+    pub(crate) fn new(
+        (zenith_deg, azimuth_deg): (f64, f64),
+        nm: &[f64],
+        radiance: Vec<f64>,
+        transmittance: Vec<f64>,
+        estimate: Option<reference::RadianceEstimate>,
+    ) -> ViewAnswer {
+        let xyz = spectrum_to_xyz(nm, &radiance);
+        ViewAnswer {
+            zenith_deg,
+            azimuth_deg,
+            luminance_cd_m2: xyz[1],
+            xyz,
+            srgb_linear: xyz_to_linear_srgb(xyz),
+            radiance,
+            transmittance,
+            luminance_cd_m2_stderr: estimate.as_ref().map(|e| e.luminance(nm).1),
+            samples: estimate.as_ref().map(|e| e.samples),
+            radiance_stderr: estimate.map(|e| e.stderr),
+        }
+    }
 }
 
 pub(crate) fn parse_view(s: &str) -> Result<(f64, f64)> {
@@ -248,19 +275,13 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
             radiance.copy_from_slice(&e.radiance);
             e
         });
-        let xyz = spectrum_to_xyz(&nm, &radiance);
-        answers.push(ViewAnswer {
-            zenith_deg,
-            azimuth_deg,
-            luminance_cd_m2: xyz[1],
-            xyz,
-            srgb_linear: xyz_to_linear_srgb(xyz),
+        answers.push(ViewAnswer::new(
+            (zenith_deg, azimuth_deg),
+            &nm,
             radiance,
             transmittance,
-            luminance_cd_m2_stderr: estimate.as_ref().map(|e| e.luminance(&nm).1),
-            samples: estimate.as_ref().map(|e| e.samples),
-            radiance_stderr: estimate.map(|e| e.stderr),
-        });
+            estimate,
+        ));
     }
     let notes = match &reference {
         None => json!([]),

@@ -10,7 +10,7 @@ use firmament::reference::{self, ReferenceSettings};
 use firmament::render::{ShadeScratch, Shader};
 use firmament::scene::{Ray, Scene as RenderScene, SceneFile, Surface};
 use firmament::sky::SkyMethod;
-use firmament::spectrum::{luminance_from_spectrum, spectrum_to_xyz, xyz_to_linear_srgb};
+use firmament::spectrum::luminance_from_spectrum;
 use serde_json::json;
 
 use super::query::{parse_view, QueryArgs, ViewAnswer};
@@ -84,19 +84,13 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
             radiance.copy_from_slice(&e.radiance);
             e
         });
-        let xyz = spectrum_to_xyz(&nm, &radiance);
-        answers.push(ViewAnswer {
-            zenith_deg,
-            azimuth_deg,
-            luminance_cd_m2: xyz[1],
-            xyz,
-            srgb_linear: xyz_to_linear_srgb(xyz),
+        answers.push(ViewAnswer::new(
+            (zenith_deg, azimuth_deg),
+            &nm,
             radiance,
             transmittance,
-            luminance_cd_m2_stderr: estimate.as_ref().map(|e| e.luminance(&nm).1),
-            samples: estimate.as_ref().map(|e| e.samples),
-            radiance_stderr: estimate.map(|e| e.stderr),
-        });
+            estimate,
+        ));
     }
     let sun = &render_scene.lights[0];
     let up = sun.direction.z.clamp(-1.0, 1.0);
