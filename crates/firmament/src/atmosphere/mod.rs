@@ -3,6 +3,7 @@
 //! grid into a [`Model`] that the tables, the renderer and the reference path tracer share.
 
 pub mod groups;
+mod lift;
 pub mod model;
 pub mod presets;
 

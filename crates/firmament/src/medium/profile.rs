@@ -130,6 +130,40 @@ impl DensityProfile {
         0.0
     }
 
+    /// The same air seen from a ground `lift_m` higher: the density at altitude h of the
+    /// result is this profile's at h + `lift_m` (layers wholly below the new ground dropped,
+    /// the first one left shortened, each term re-expressed about the new ground:
+    /// a·e^{−(h+l)/H} = (a·e^{−l/H})·e^{−h/H}, b·(h+l) + c = b·h + (b·l + c)).
+    pub fn lifted(&self, lift_m: f64) -> DensityProfile {
+        let n = self.layers.len();
+        let mut layers = Vec::with_capacity(n);
+        let mut base = 0.0;
+        for (i, layer) in self.layers.iter().enumerate() {
+            let last = i + 1 == n;
+            let top = base + layer.width_m;
+            if last || top > lift_m {
+                let exp_term = if layer.exp_term != 0.0 {
+                    layer.exp_term * (-lift_m / layer.scale_height_m).exp()
+                } else {
+                    0.0
+                };
+                layers.push(DensityLayer {
+                    width_m: if last {
+                        layer.width_m
+                    } else {
+                        top - base.max(lift_m)
+                    },
+                    exp_term,
+                    scale_height_m: layer.scale_height_m,
+                    linear_term_per_m: layer.linear_term_per_m,
+                    constant_term: layer.constant_term + layer.linear_term_per_m * lift_m,
+                });
+            }
+            base = top;
+        }
+        DensityProfile { layers }
+    }
+
     /// Altitudes (m) where the profile may have a kink (layer boundaries, and where linear
     /// terms cross zero), within [0, top_m]; used to split quadratures.
     pub fn breakpoints(&self, top_m: f64) -> Vec<f64> {
@@ -215,6 +249,40 @@ mod tests {
         let p = DensityProfile::exponential(8000.0);
         let exact = 8000.0 * (1.0 - (-60_000.0f64 / 8000.0).exp());
         assert!((p.column_m(0.0, 60_000.0) / exact - 1.0).abs() < 1e-10);
+    }
+
+    #[test]
+    fn a_lifted_profile_is_the_same_air_from_higher_ground() {
+        // The earth preset's three shapes: exponential, tent, and a slab under a decay.
+        let slab = DensityProfile {
+            layers: vec![
+                DensityLayer::constant(2000.0, 1.0),
+                DensityLayer {
+                    exp_term: 2.0,
+                    ..DensityLayer::exponential(3000.0)
+                },
+            ],
+        };
+        let profiles = [
+            DensityProfile::exponential(8434.0),
+            DensityProfile::tent(10_000.0, 25_000.0, 40_000.0),
+            slab,
+        ];
+        for p in &profiles {
+            for lift in [0.0, 705.0, 2000.0, 12_000.0, 30_000.0] {
+                let q = p.lifted(lift);
+                for k in 0..200 {
+                    let h = k as f64 * 250.0;
+                    let (a, b) = (q.density(h), p.density(h + lift));
+                    assert!(
+                        (a - b).abs() < 1e-12 * (1.0 + b),
+                        "{p:?} lift {lift} h {h}: {a} vs {b}"
+                    );
+                }
+                let (a, b) = (q.column_m(0.0, 60_000.0 - lift), p.column_m(lift, 60_000.0));
+                assert!((a / b - 1.0).abs() < 1e-9, "{a} vs {b}");
+            }
+        }
     }
 
     #[test]
