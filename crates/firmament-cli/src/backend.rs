@@ -318,8 +318,7 @@ impl<'a> RenderSky<'a> {
                 bar.set_message("rendering");
                 let mut scene = Scene::clear_sky(sky.as_ref(), Vec3::Z, false);
                 if let Some(t) = terrain {
-                    // Before the sphere: the terrain wins where it lies on it.
-                    scene.surfaces.insert(0, Box::new(t));
+                    scene.add_terrain(t, t.radius_m);
                 }
                 scene.lights = sources.lights.clone();
                 scene.background = sources.background.clone();

@@ -63,6 +63,11 @@ pub struct AtmosphereArgs {
     /// sets it to its own mean, so the tables' ground bounce is the terrain's).
     #[arg(skip)]
     pub ground_albedo: Option<Vec<f64>>,
+    /// The tables' ground raised this far (m) above the planet's sphere, the air below it
+    /// taken away (`Atmosphere::lifted`): a scene's terrain sets it to its floor, so the
+    /// tables' light comes from the air that the terrain leaves.
+    #[arg(skip)]
+    pub ground_lift_m: Option<f64>,
 }
 
 impl Default for AtmosphereArgs {
@@ -90,11 +95,24 @@ impl AtmosphereArgs {
     /// The resolved model.
     pub fn model(&self) -> Result<Model> {
         let wavelengths = Wavelengths::parse(&self.wavelengths)?;
-        let mut model = self.atmosphere()?.resolve(&wavelengths)?;
+        let mut atmosphere = self.atmosphere()?;
+        if let Some(lift) = self.ground_lift_m {
+            atmosphere = atmosphere.lifted(lift, &wavelengths)?;
+        }
+        let mut model = atmosphere.resolve(&wavelengths)?;
         if let Some(albedo) = &self.ground_albedo {
             model.ground_albedo.clone_from(albedo);
         }
         Ok(model)
+    }
+
+    /// The same arguments with the planet's own ground (no lift): the atmosphere as it is,
+    /// for the reference path tracer, which meets the terrain itself.
+    pub fn unlifted(&self) -> AtmosphereArgs {
+        AtmosphereArgs {
+            ground_lift_m: None,
+            ..self.clone()
+        }
     }
 
     /// The table configuration for a fresh precomputation.

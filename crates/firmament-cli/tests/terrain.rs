@@ -82,6 +82,23 @@ fn query_scene_answers_the_terrain_with_the_tables_and_the_reference() {
         let lum = l["luminance_cd_m2"].as_f64().unwrap();
         assert!((lum / y - 1.0).abs() < 0.5, "lut {lum} reference {y}");
     }
+    // Without --tables the tables' ground is lifted to the terrain's floor (at most the
+    // ground under the observer), the observer staying 25 m above the terrain.
+    let own = query(&[
+        "query",
+        "--scene",
+        s,
+        "--table-size",
+        "small",
+        "-q",
+        "--view",
+        "95,60",
+    ]);
+    let floor = own["tables_ground_m"].as_f64().unwrap();
+    // (This terrain, 8 km across, fades to the sphere within 10 km: its floor is 0.)
+    assert!((0.0..=ground).contains(&floor), "{own}");
+    assert!((own["altitude_m"].as_f64().unwrap() - (ground + 25.0)).abs() < 1e-6);
+    assert!(lut["tables_ground_m"].is_null());
     // A scene's observer is the scene's: --altitude-m with --scene is refused.
     fails_with(
         &run(&[

@@ -251,7 +251,9 @@ fn a_fully_blocked_sun_leaves_only_the_sky_light() {
         values,
     };
     let albedo = 0.3;
-    let hf = Heightfield::new(grid, r, Materials::Uniform(vec![albedo; 3]));
+    let mut hf = Heightfield::new(grid, r, Materials::Uniform(vec![albedo; 3]));
+    // The tables' light alone: without the wall's change of the air's light.
+    hf.air_light = false;
     // The sun 10° up in the west, behind the wall (which rises 56° seen from the valley).
     let sun = sun_direction(80.0, 270.0);
     let mut scene = Scene::clear_sky(sky, sun, false);
@@ -373,6 +375,8 @@ fn single_scattering_through_the_shafts_matches_the_reference() {
         resolution: 257,
         albedo: Some(0.0),
         occlusion: false,
+        // One order in the tables: no multiple scattering for the terrain to change.
+        air_light: false,
         ..TerrainConfig::default()
     }
     .build(model.bottom_radius_m, model.wavelengths.nm())

@@ -36,7 +36,7 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
     if reference.is_some() && (sources.lights.len() > 1 || sources.background.is_some()) {
         anyhow::bail!("`--method reference` traces the sun's light only so far: a [time] with the moon up or the sun down is not supported with it");
     }
-    let camera = scene.camera_over(terrain.as_ref());
+    let camera = scene.camera_over(terrain.as_ref(), model.bottom_radius_m);
     let observer = firmament::math::Vec3::new(0.0, 0.0, model.bottom_radius_m + camera.altitude_m);
     let mut render_scene = RenderScene::clear_sky(&sky, sources.lights[0].direction, false);
     render_scene.lights = sources.lights.clone();
@@ -46,7 +46,7 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
         .for_each(|l| l.visible_disk = false);
     render_scene.background = sources.background.clone();
     if let Some(t) = &terrain {
-        render_scene.surfaces.insert(0, Box::new(t));
+        render_scene.add_terrain(t, t.radius_m);
     }
     let shader = Shader::new(&render_scene, observer)?;
     let first_view = sky.view(observer, &render_scene.lights[0]);
@@ -55,6 +55,12 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
         include_ground: true,
         ..s
     });
+    // The reference meets the terrain in the atmosphere as it is (the tables' ground may be
+    // lifted to the terrain's floor).
+    let truth = match settings {
+        Some(_) => Some(atmosphere.unlifted().model()?),
+        None => None,
+    };
     let n = nm.len();
     let mut scratch = ShadeScratch::default();
     let mut answers = Vec::new();
@@ -79,8 +85,9 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
         }
         let estimate = settings.as_ref().map(|s| {
             let sun = render_scene.lights[0].direction;
+            let truth = truth.as_ref().expect("the reference's model");
             let e =
-                reference::scene_radiance(model, &[], &surfaces, observer, dir, sun, s, i as u64);
+                reference::scene_radiance(truth, &[], &surfaces, observer, dir, sun, s, i as u64);
             radiance.copy_from_slice(&e.radiance);
             e
         });
@@ -109,8 +116,11 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
             "radiance": "W m-2 sr-1 nm-1",
             "luminance": "cd m-2 (CIE 1931 2 deg, 683 lm/W; spectrum linearly interpolated between samples)",
         },
-        "altitude_m": camera.altitude_m,
+        // Above the planet's sphere (the camera's is above the tables' ground).
+        "altitude_m": camera.altitude_m + atmosphere.ground_lift_m.unwrap_or(0.0),
         "terrain_height_m": terrain.as_ref().map(|t| t.height_at(0.0, 0.0)),
+        // The tables' ground above the planet's sphere (the terrain's floor), when lifted.
+        "tables_ground_m": atmosphere.ground_lift_m,
         "sun": {
             "zenith_deg": up.acos().to_degrees(),
             "azimuth_deg": sun.direction.x.atan2(sun.direction.y).to_degrees().rem_euclid(360.0),

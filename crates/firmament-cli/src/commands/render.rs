@@ -73,6 +73,10 @@ pub struct RenderArgs {
     /// No light shafts: the terrain's shadows stay on the ground, the air is lit throughout.
     #[arg(long)]
     pub no_light_shafts: bool,
+    /// Without the terrain's change of the air's light: the tables' multiply scattered
+    /// light as over a smooth planet (about 1 s faster a 1080p frame, less accurate).
+    #[arg(long)]
+    pub no_air_light: bool,
     /// A time-lapse: frames from --time to this instant (ISO 8601), every --every; each
     /// --out needs a frame number (`frames/sky_%04d.exr`).
     #[arg(long, value_name = "ISO8601", requires_all = ["time", "every"])]
@@ -254,10 +258,9 @@ fn scene_from_args(args: &RenderArgs) -> Result<Scene> {
     if args.no_terrain {
         scene.terrain = None;
     }
-    if args.no_light_shafts {
-        if let Some(t) = &mut scene.terrain {
-            t.light_shafts = false;
-        }
+    if let Some(t) = &mut scene.terrain {
+        t.light_shafts &= !args.no_light_shafts;
+        t.air_light &= !args.no_air_light;
     }
     scene.validate()?;
     Ok(scene)
@@ -373,6 +376,13 @@ pub fn terrain_and_atmosphere(
                 );
             }
             atmosphere.ground_albedo = Some(albedo);
+            let lift = t.floor_m();
+            if !quiet && lift > 0.0 {
+                eprintln!(
+                    "terrain: the tables' ground is lifted to the terrain's floor, {lift:.0} m (the air below it is the terrain's)"
+                );
+            }
+            atmosphere.ground_lift_m = Some(lift);
         } else if !quiet {
             eprintln!(
                 "note: the tables' ground albedo ({:.3} at {:.0} nm) is kept; the terrain's mean is {:.3} (without --tables the tables take it)",
@@ -392,7 +402,7 @@ pub fn render_scene(
     quiet: bool,
 ) -> Result<(render::Frame, f64)> {
     let sources = sources_of_scene(sky.model(), scene)?;
-    let camera = scene.camera_over(terrain);
+    let camera = scene.camera_over(terrain, sky.model().bottom_radius_m);
     let settings = RenderSettings {
         camera: &camera,
         ..render_settings(scene)
@@ -462,7 +472,7 @@ fn render_scene_reference(
     let sun = &lights[0];
     let surfaces: Vec<Box<dyn firmament::scene::Surface + '_>> =
         terrain.iter().map(|t| Box::new(*t) as _).collect();
-    let camera = scene.camera_over(terrain);
+    let camera = scene.camera_over(terrain, model.bottom_radius_m);
     let bar = progress_bar(1000, quiet);
     bar.set_message(format!("reference, {samples} paths/λ"));
     let result = reference::render_frame(
@@ -531,7 +541,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             }
             let (terrain, atmosphere) =
                 terrain_and_atmosphere(&scene, None, &args.table_size, args.quiet)?;
-            let model = atmosphere.model()?;
+            let model = atmosphere.unlifted().model()?;
             let t = Instant::now();
             let (frame, ev100) =
                 render_scene_reference(&model, &scene, terrain.as_ref(), args.samples, args.quiet)?;

@@ -7,8 +7,10 @@
 //! surfaces for the nearest hit and for the shadows they cast, the volumes for their medium,
 //! the lights for their disks. A second surface or light needs no change here.
 
+pub mod air_volume;
 pub mod frame;
 pub mod stars;
+pub mod terrain_air;
 pub mod tonemap;
 mod volumes;
 
@@ -71,6 +73,9 @@ pub struct Shader<'s> {
     /// The lights whose disks images show, with the cosine of their angular radius.
     disks: Vec<(usize, f64)>,
     channels: usize,
+    /// The terrain's change of the air's light along this observer's views, when a surface
+    /// reshapes the planet ([`terrain_air`]).
+    air: Option<air_volume::AirVolume>,
 }
 
 /// Per-thread scratch space of [`Shader::shade`] (no allocation per pixel).
@@ -81,8 +86,28 @@ pub struct ShadeScratch {
 }
 
 impl<'s> Shader<'s> {
-    /// The views of `scene`'s sky method from `observer`, one per light.
+    /// The views of `scene`'s sky method from `observer`, one per light, and the terrain's
+    /// change of the air's light ([`terrain_air`]) when a surface has a relief.
     pub fn new(scene: &'s Scene<'s>, observer: crate::math::Vec3) -> Result<Shader<'s>> {
+        let mut shader = Shader::plain(scene, observer)?;
+        if let Some(field) = terrain_air::AirField::new(scene)? {
+            let model = scene.sky.model();
+            let volume =
+                air_volume::AirVolume::new(&field, shader.views[0].as_ref(), model, observer);
+            shader.air = Some(volume);
+        }
+        Ok(shader)
+    }
+
+    /// The lights' disks left out of the sky.
+    pub fn without_disks(mut self) -> Shader<'s> {
+        self.disks.clear();
+        self
+    }
+
+    /// [`Shader::new`] without the terrain's change of the air's light: the sky method's
+    /// air over a smooth planet, with the surfaces' shadows.
+    pub fn plain(scene: &'s Scene<'s>, observer: crate::math::Vec3) -> Result<Shader<'s>> {
         let channels = scene.sky.model().channels();
         crate::spectrum::check_channels(channels, "rendering")?;
         let views = scene
@@ -99,6 +124,7 @@ impl<'s> Shader<'s> {
             views,
             disks,
             channels,
+            air: None,
         })
     }
 
@@ -159,6 +185,11 @@ impl<'s> Shader<'s> {
                     }
                 }
             }),
+        }
+        if let Some(air) = &self.air {
+            if (ray.origin - air.observer()).length_squared() < 1.0 {
+                air.add(ray.dir, end, &mut out[..n]);
+            }
         }
         if !scene.volumes.is_empty() {
             volumes::composite(scene, &self.views, ray, end, &mut out[..n]);

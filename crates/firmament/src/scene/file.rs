@@ -259,11 +259,16 @@ impl SceneFile {
     }
 
     /// The camera, its altitude taken above `terrain`'s surface below the observer when
-    /// there is one (as `[terrain]` documents).
-    pub fn camera_over(&self, terrain: Option<&super::terrain::Heightfield>) -> Camera {
+    /// there is one (as `[terrain]` documents), as an altitude above a sky method's bottom
+    /// sphere of radius `bottom_radius_m` (the terrain's planet, or its lifted ground).
+    pub fn camera_over(
+        &self,
+        terrain: Option<&super::terrain::Heightfield>,
+        bottom_radius_m: f64,
+    ) -> Camera {
         let mut camera = self.camera.clone();
         if let Some(t) = terrain {
-            camera.altitude_m += t.height_at(0.0, 0.0);
+            camera.altitude_m += t.height_at(0.0, 0.0) - (bottom_radius_m - t.radius_m);
         }
         camera
     }

@@ -17,7 +17,7 @@ pub mod volume;
 pub use camera::{Camera, PreparedCamera, Projection, Ray};
 pub use file::SceneFile;
 pub use light::{DiskProfile, Light};
-pub use surface::{Sphere, Surface, SurfaceHit};
+pub use surface::{Relief, Sphere, Surface, SurfaceHit};
 pub use volume::{HomogeneousSphere, Volume};
 
 use crate::math::{direction_from_zenith_azimuth, Vec3};
@@ -58,6 +58,21 @@ impl<'a> Scene<'a> {
             background: None,
             stars: Vec::new(),
         }
+    }
+
+    /// Put `terrain` into a [`Scene::clear_sky`] scene on a planet of radius
+    /// `planet_radius_m`: the terrain first (it wins where it lies on the sphere), and the
+    /// ground sphere at the planet's radius, which is the sky method's bottom unless the
+    /// method's ground is lifted to the terrain's floor ([`Atmosphere::lifted`]).
+    ///
+    /// [`Atmosphere::lifted`]: crate::atmosphere::Atmosphere::lifted
+    pub fn add_terrain(&mut self, terrain: impl Surface + 'a, planet_radius_m: f64) {
+        let model = self.sky.model();
+        self.surfaces[0] = Box::new(Sphere {
+            radius_m: planet_radius_m,
+            ..Sphere::ground(model)
+        });
+        self.surfaces.insert(0, Box::new(terrain));
     }
 
     /// The nearest surface hit of `ray` closer than `max_distance_m`: (surface index, hit).

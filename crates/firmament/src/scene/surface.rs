@@ -48,6 +48,26 @@ pub trait Surface: Send + Sync {
         let _ = hit;
         1.0
     }
+
+    /// The relief this surface gives the planet, when it reshapes it enough to change the
+    /// light of the air around it (`render::terrain_air`); None by default.
+    fn relief(&self) -> Option<&dyn Relief> {
+        None
+    }
+}
+
+/// A surface that reshapes the planet over a region: heights above the planet's sphere over
+/// a rectangle of the gnomonic plane tangent at the observer's foot (plane coordinates
+/// (u, v) = R·(p_x, p_y)/p_z, m; `scene::terrain::grid`).
+pub trait Relief: Send + Sync {
+    /// The planet's radius R (m) the heights stand on.
+    fn planet_radius_m(&self) -> f64;
+    /// The region: [u_min, v_min, u_max, v_max] (m).
+    fn bounds_m(&self) -> [f64; 4];
+    /// The highest point (m above the sphere).
+    fn top_m(&self) -> f64;
+    /// The height (m above the sphere) at plane coordinates (u, v).
+    fn height_m(&self, u: f64, v: f64) -> f64;
 }
 
 /// A borrowed surface is a surface (a scene can hold a terrain built once for many frames).
@@ -69,6 +89,9 @@ impl<T: Surface + ?Sized> Surface for &T {
     }
     fn sky_visibility(&self, hit: &SurfaceHit) -> f64 {
         (**self).sky_visibility(hit)
+    }
+    fn relief(&self) -> Option<&dyn Relief> {
+        (**self).relief()
     }
 }
 

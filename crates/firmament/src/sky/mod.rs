@@ -36,7 +36,10 @@ pub enum Shadow<'a> {
     Length(f64),
     /// The lit intervals [start, end] (m from the observer along the ray), increasing and
     /// disjoint; the rest of the ray is in shadow. Exact light shafts from the CPU's lit
-    /// segments.
+    /// segments: the single scattering is taken over the lit intervals only, the multiple
+    /// over the whole ray (the air in a shadow is still lit by the sky; what the shadowing
+    /// surface hides of the sky is `render::terrain_air`'s). `Length` leaves both out, as
+    /// the paper does.
     Lit(&'a [(f64, f64)]),
 }
 

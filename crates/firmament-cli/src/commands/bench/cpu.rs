@@ -102,7 +102,7 @@ fn terrain_seconds(sky: &Bruneton4d, runs: usize) -> Result<f64> {
     let terrain = default
         .build_terrain(&sky.model)?
         .expect("the default scene has a terrain");
-    let camera = default.camera_over(Some(&terrain));
+    let camera = default.camera_over(Some(&terrain), sky.model.bottom_radius_m);
     let settings = render::RenderSettings {
         camera: &camera,
         width: 1920,
@@ -113,7 +113,8 @@ fn terrain_seconds(sky: &Bruneton4d, runs: usize) -> Result<f64> {
     let seconds = time_runs(runs.clamp(1, 3), || {
         let terrain = terrain.clone_without_shadows();
         let mut scene = Scene::clear_sky(sky, sun, true);
-        scene.surfaces.insert(0, Box::new(terrain));
+        let radius = terrain.radius_m;
+        scene.add_terrain(terrain, radius);
         let image = render::render(&scene, &settings, &|_| {}, None)?;
         let _ = image.to_srgb8(1e-4, ToneCurve::Aces);
         Ok(())

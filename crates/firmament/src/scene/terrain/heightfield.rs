@@ -11,7 +11,7 @@ use super::materials::Materials;
 use super::shadow::ShadowField;
 use crate::math::Vec3;
 use crate::scene::camera::Ray;
-use crate::scene::surface::{Surface, SurfaceHit};
+use crate::scene::surface::{Relief, Surface, SurfaceHit};
 
 /// The radius (m, one standard deviation) of the terrain around the observer whose albedo
 /// the tables take for the planet's ground ([`Heightfield::mean_albedo`]).
@@ -37,6 +37,8 @@ pub struct Heightfield {
     /// The fraction of the sky the terrain leaves visible, relative to an open plane of the
     /// same tilt ([`super::occlusion`]), on the heights' grid; none: 1 everywhere.
     pub visibility: Option<Grid>,
+    /// Whether it changes the air's light around it ([`Surface::relief`] is None without).
+    pub air_light: bool,
     shadows: RwLock<Vec<(Vec3, Arc<ShadowField>)>>,
 }
 
@@ -53,6 +55,7 @@ impl Heightfield {
             casts_shadows: true,
             shafts: true,
             visibility: None,
+            air_light: true,
             shadows: RwLock::new(Vec::new()),
         }
     }
@@ -67,6 +70,7 @@ impl Heightfield {
             casts_shadows: self.casts_shadows,
             shafts: self.shafts,
             visibility: self.visibility.clone(),
+            air_light: self.air_light,
             shadows: RwLock::new(Vec::new()),
         }
     }
@@ -99,6 +103,25 @@ impl Heightfield {
             }
         }
         sum.iter().map(|s| s / weights).collect()
+    }
+
+    /// The floor under the observer: the lowest vertex within 2·[`ALBEDO_RADIUS_M`] of
+    /// its foot, and no higher than the ground beneath it (m above the sphere). A sky
+    /// method's ground lifted there ([`crate::atmosphere::Atmosphere::lifted`]) holds only
+    /// the air the terrain leaves around the observer.
+    pub fn floor_m(&self) -> f64 {
+        let g = &self.heights;
+        let reach = 2.0 * ALBEDO_RADIUS_M;
+        let mut floor = self.height_at(0.0, 0.0);
+        for j in 0..g.ny {
+            for i in 0..g.nx {
+                let (u, v) = g.plane_coords(i as f64, j as f64);
+                if u * u + v * v <= reach * reach {
+                    floor = floor.min(g.at(i, j));
+                }
+            }
+        }
+        floor.max(0.0)
     }
 
     /// The highest point (m above the sphere).
@@ -286,5 +309,35 @@ impl Surface for Heightfield {
             (Some(ao), Some((u, v))) => ao.value_at(u, v).unwrap_or(1.0),
             _ => 1.0,
         }
+    }
+
+    fn relief(&self) -> Option<&dyn Relief> {
+        self.air_light.then_some(self as &dyn Relief)
+    }
+}
+
+impl Relief for Heightfield {
+    fn planet_radius_m(&self) -> f64 {
+        self.radius_m
+    }
+
+    fn bounds_m(&self) -> [f64; 4] {
+        let g = &self.heights;
+        let (w, h) = ((g.nx - 1) as f64, (g.ny - 1) as f64);
+        let corners = [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)].map(|(x, y)| g.plane_coords(x, y));
+        let (us, vs) = (corners.map(|c| c.0), corners.map(|c| c.1));
+        let (min, max) = (
+            |a: [f64; 4]| a.iter().copied().fold(f64::INFINITY, f64::min),
+            |a: [f64; 4]| a.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        );
+        [min(us), min(vs), max(us), max(vs)]
+    }
+
+    fn top_m(&self) -> f64 {
+        self.max_height_m()
+    }
+
+    fn height_m(&self, u: f64, v: f64) -> f64 {
+        self.height_at(u, v)
     }
 }

@@ -65,6 +65,9 @@ pub struct TerrainConfig {
     pub light_shafts: bool,
     /// Ambient occlusion of the sky light by the terrain.
     pub occlusion: bool,
+    /// The terrain's change of the air's multiply scattered light: the sky the mountains
+    /// hide from the air and the light they send into it (`render::terrain_air`).
+    pub air_light: bool,
 }
 
 impl Default for TerrainConfig {
@@ -88,6 +91,7 @@ impl Default for TerrainConfig {
             shadows: true,
             light_shafts: true,
             occlusion: true,
+            air_light: true,
         }
     }
 }
@@ -212,6 +216,7 @@ impl TerrainConfig {
         let mut field = Heightfield::new(heights, radius_m, materials);
         field.casts_shadows = self.shadows;
         field.shafts = self.light_shafts;
+        field.air_light = self.air_light;
         field.visibility = visibility;
         Ok(field)
     }

@@ -59,6 +59,14 @@ enum At<'s> {
     Table([f64; 4]),
 }
 
+/// Which orders of the tables a lookup sums: the single scattering, the multiple, or both.
+#[derive(Clone, Copy, PartialEq)]
+enum Orders {
+    All,
+    Single,
+    Multiple,
+}
+
 /// A view ray at its start: (r, μ, μ_s, ν), whether it meets the ground, whether it starts
 /// at the observer.
 struct RayGeometry {
@@ -136,13 +144,16 @@ impl<'a> Bruneton4dView<'a> {
     /// Mie scattering, without phase functions, at distance `d` (m) along the ray (Bruneton
     /// 2017 `GetCombinedScattering`; the ratio rule for red-only Mie). `at_start` (d = 0):
     /// the ray's start, from the slice when the ray starts at the observer. `rayleigh_phase`:
-    /// the molecular phase function at the ray's ν.
+    /// the molecular phase function at the ray's ν. `orders`: the single scattering only
+    /// (Rayleigh and Mie), the multiple only (into `scat`, `mie` zero), or both.
+    #[allow(clippy::too_many_arguments)]
     fn combined_scattering(
         &self,
         ray: &RayGeometry,
         d: f64,
         at_start: bool,
         rayleigh_phase: f64,
+        orders: Orders,
         scat: &mut [f64],
         mie: &mut [f64],
     ) {
@@ -198,10 +209,18 @@ impl<'a> Bruneton4dView<'a> {
             // function to `scat`, so it goes in divided by it.
             let p = rayleigh_phase.max(1e-30);
             for k in 0..n {
-                scat[k] += both[n + k] / p;
+                scat[k] = match orders {
+                    Orders::All => scat[k] + both[n + k] / p,
+                    Orders::Single => scat[k],
+                    Orders::Multiple => both[n + k] / p,
+                };
             }
             at
         });
+        if orders == Orders::Multiple {
+            mie.iter_mut().for_each(|v| *v = 0.0);
+            return;
+        }
         let single_mie = &tables.single_mie;
         let sample = |out: &mut [f64]| match at {
             At::Slice(s, u_nu, u_mu) => single_mie.sample_slice_into(&s.mie, u_nu, u_mu, out),
@@ -229,6 +248,7 @@ impl<'a> Bruneton4dView<'a> {
     /// reaches it subtracts nothing when `open_end` (a ray to the sky: nothing is scattered
     /// beyond the boundary). `t_end`: T(0, end) when the caller has it (else empty), saving
     /// a lookup for the interval that ends there. Single Mie is multiplied by `mie_fade`.
+    /// `orders`: which of the tables' orders.
     #[allow(clippy::too_many_arguments)]
     fn lit_radiance(
         &self,
@@ -238,6 +258,7 @@ impl<'a> Bruneton4dView<'a> {
         open_end: bool,
         t_end: &[f64],
         mie_fade: f64,
+        orders: Orders,
         radiance: &mut [f64],
     ) {
         let n = self.channels();
@@ -251,7 +272,7 @@ impl<'a> Bruneton4dView<'a> {
                 if b <= a {
                     continue;
                 }
-                self.combined_scattering(ray, a, a == 0.0, pr, scat, mie);
+                self.combined_scattering(ray, a, a == 0.0, pr, orders, scat, mie);
                 if a > 0.0 {
                     lk.transmittance(ray.r, ray.mu, a, ray.ground, t);
                     for k in 0..n {
@@ -260,7 +281,7 @@ impl<'a> Bruneton4dView<'a> {
                     }
                 }
                 if b < end || !open_end {
-                    self.combined_scattering(ray, b, false, pr, scat_b, mie_b);
+                    self.combined_scattering(ray, b, false, pr, orders, scat_b, mie_b);
                     let t: &[f64] = if b == end && !t_end.is_empty() {
                         t_end
                     } else {
@@ -280,6 +301,50 @@ impl<'a> Bruneton4dView<'a> {
         for (v, s) in radiance[..n].iter_mut().zip(&self.scale) {
             *v *= s;
         }
+    }
+
+    /// The radiance scattered towards the observer along `ray` up to `end` with the light
+    /// reaching only the `lit` intervals: the single scattering over those, the multiple
+    /// over the whole ray (the shadowed air is still lit by the sky; what the shadowing
+    /// surfaces hide of the sky is `render::terrain_air`'s).
+    #[allow(clippy::too_many_arguments)]
+    fn shafted_radiance(
+        &self,
+        ray: &RayGeometry,
+        lit: impl IntoIterator<Item = (f64, f64)>,
+        end: f64,
+        open_end: bool,
+        t_end: &[f64],
+        mie_fade: f64,
+        radiance: &mut [f64],
+    ) {
+        let n = self.channels();
+        with_channel_buffers(n, |[multiple]| {
+            let whole = [(0.0, end)];
+            self.lit_radiance(
+                ray,
+                whole,
+                end,
+                open_end,
+                t_end,
+                mie_fade,
+                Orders::Multiple,
+                multiple,
+            );
+            self.lit_radiance(
+                ray,
+                lit,
+                end,
+                open_end,
+                t_end,
+                mie_fade,
+                Orders::Single,
+                radiance,
+            );
+            for k in 0..n {
+                radiance[k] += multiple[k];
+            }
+        });
     }
 
     /// Distance from the start along the ray to the nearest boundary (ground or top).
@@ -325,16 +390,25 @@ impl SkyView for Bruneton4dView<'_> {
         let end = f64::INFINITY;
         match shadow {
             Shadow::Length(l) if l > 0.0 => {
-                self.lit_radiance(&ray, [(l, end)], end, true, &[], 1.0, radiance)
+                self.lit_radiance(&ray, [(l, end)], end, true, &[], 1.0, Orders::All, radiance)
             }
             Shadow::Lit(intervals) => {
                 // A camera in space starts where the ray enters the top.
                 let offset = (start.point - self.observer).length();
                 let shifted = intervals.iter().map(|&(a, b)| (a - offset, b - offset));
                 let length = self.boundary_distance(&ray);
-                self.lit_radiance(&ray, shifted, length, true, &[], 1.0, radiance)
+                self.shafted_radiance(&ray, shifted, length, true, &[], 1.0, radiance)
             }
-            _ => self.lit_radiance(&ray, [(0.0, end)], end, true, &[], 1.0, radiance),
+            _ => self.lit_radiance(
+                &ray,
+                [(0.0, end)],
+                end,
+                true,
+                &[],
+                1.0,
+                Orders::All,
+                radiance,
+            ),
         }
     }
 
@@ -361,17 +435,33 @@ impl SkyView for Bruneton4dView<'_> {
         // artefacts).
         let fade = smoothstep(0.0, 0.01, ray.mu_s);
         match shadow {
-            Shadow::None => {
-                self.lit_radiance(&ray, [(0.0, d_total)], d_total, false, t, fade, radiance)
-            }
+            Shadow::None => self.lit_radiance(
+                &ray,
+                [(0.0, d_total)],
+                d_total,
+                false,
+                t,
+                fade,
+                Orders::All,
+                radiance,
+            ),
             Shadow::Length(l) => {
                 let d = (d_total - l.max(0.0)).max(0.0);
-                self.lit_radiance(&ray, [(0.0, d)], d_total, false, t, fade, radiance)
+                self.lit_radiance(
+                    &ray,
+                    [(0.0, d)],
+                    d_total,
+                    false,
+                    t,
+                    fade,
+                    Orders::All,
+                    radiance,
+                )
             }
             Shadow::Lit(intervals) => {
                 let offset = (start.point - self.observer).length();
                 let shifted = intervals.iter().map(|&(a, b)| (a - offset, b - offset));
-                self.lit_radiance(&ray, shifted, d_total, false, t, fade, radiance)
+                self.shafted_radiance(&ray, shifted, d_total, false, t, fade, radiance)
             }
         }
     }
