@@ -90,11 +90,13 @@ impl<'s> Shader<'s> {
     /// change of the air's light ([`terrain_air`]) when a surface has a relief.
     pub fn new(scene: &'s Scene<'s>, observer: crate::math::Vec3) -> Result<Shader<'s>> {
         let mut shader = Shader::plain(scene, observer)?;
-        if let Some(field) = terrain_air::AirField::new(scene)? {
-            let model = scene.sky.model();
-            let volume =
-                air_volume::AirVolume::new(&field, shader.views[0].as_ref(), model, observer);
-            shader.air = Some(volume);
+        // (A scene without lights has no air light to change.)
+        if let Some(view) = shader.views.first() {
+            if let Some(field) = terrain_air::AirField::new(scene)? {
+                let model = scene.sky.model();
+                let volume = air_volume::AirVolume::new(&field, view.as_ref(), model, observer);
+                shader.air = Some(volume);
+            }
         }
         Ok(shader)
     }
