@@ -99,6 +99,22 @@ fn query_scene_answers_the_terrain_with_the_tables_and_the_reference() {
     assert!((0.0..=ground).contains(&floor), "{own}");
     assert!((own["altitude_m"].as_f64().unwrap() - (ground + 25.0)).abs() < 1e-6);
     assert!(lut["tables_ground_m"].is_null());
+    // `air_light = false`: the tables' light as over a smooth planet; in this valley under a
+    // low sun the terrain's change of it is several per cent of the view across it.
+    let plain = scene(&dir, "plain", "air_light = false");
+    let mut args = vec![
+        "query",
+        "--scene",
+        plain.to_str().unwrap(),
+        "--tables",
+        tables_arg(),
+    ];
+    args.extend_from_slice(&["-q", "--view", "95,60"]);
+    let without = query(&args)["views"][0]["luminance_cd_m2"]
+        .as_f64()
+        .unwrap();
+    let with = v[1]["luminance_cd_m2"].as_f64().unwrap();
+    assert!((with / without - 1.0).abs() > 0.005, "{with} vs {without}");
     // A scene's observer is the scene's: --altitude-m with --scene is refused.
     fails_with(
         &run(&[
@@ -135,6 +151,19 @@ fn render_draws_a_terrain_and_refuses_bad_terrain_input() {
         "{}",
         stderr(&o)
     );
+    let plain = dir.join("plain.png");
+    let (g, p) = (good.to_str().unwrap(), plain.to_str().unwrap());
+    succeeds(&run(&[
+        "render",
+        "--scene",
+        g,
+        "--tables",
+        tables_arg(),
+        "--no-air-light",
+        "--out",
+        p,
+    ]));
+    assert!(plain.exists());
     // An 8-bit heightmap, a zero extent, a negative height scale, a missing file.
     let png8 = dir.join("grey8.png");
     image::GrayImage::new(4, 4).save(&png8).unwrap();
