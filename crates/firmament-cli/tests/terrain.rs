@@ -5,7 +5,7 @@ mod common;
 
 use std::path::PathBuf;
 
-use common::{fails_with, run, stderr, succeeds, tables_arg, tmp_subdir};
+use common::{fails_with, render_scene, run, stderr, succeeds, tables_arg, tmp_subdir};
 
 /// A small terrain scene (8 km, 65² vertices) in `dir`, with `terrain` lines added.
 fn scene(dir: &std::path::Path, name: &str, terrain: &str) -> PathBuf {
@@ -135,15 +135,7 @@ fn render_draws_a_terrain_and_refuses_bad_terrain_input() {
     let dir = tmp_subdir("terrain-render");
     let good = scene(&dir, "good", "");
     let out = dir.join("good.png");
-    let o = run(&[
-        "render",
-        "--scene",
-        good.to_str().unwrap(),
-        "--tables",
-        tables_arg(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = render_scene(&good, &out, &[]);
     succeeds(&o);
     assert!(out.exists());
     assert!(
@@ -152,17 +144,7 @@ fn render_draws_a_terrain_and_refuses_bad_terrain_input() {
         stderr(&o)
     );
     let plain = dir.join("plain.png");
-    let (g, p) = (good.to_str().unwrap(), plain.to_str().unwrap());
-    succeeds(&run(&[
-        "render",
-        "--scene",
-        g,
-        "--tables",
-        tables_arg(),
-        "--no-air-light",
-        "--out",
-        p,
-    ]));
+    succeeds(&render_scene(&good, &plain, &["--no-air-light"]));
     assert!(plain.exists());
     // An 8-bit heightmap, a zero extent, a negative height scale, a missing file.
     let png8 = dir.join("grey8.png");
@@ -195,15 +177,7 @@ fn render_draws_a_terrain_and_refuses_bad_terrain_input() {
         let bad = dir.join(format!("bad{k}.toml"));
         std::fs::write(&bad, text).unwrap();
         let out = dir.join(format!("bad{k}.png"));
-        let o = run(&[
-            "render",
-            "--scene",
-            bad.to_str().unwrap(),
-            "--tables",
-            tables_arg(),
-            "--out",
-            out.to_str().unwrap(),
-        ]);
+        let o = render_scene(&bad, &out, &[]);
         fails_with(&o, words);
         assert!(!out.exists(), "case {k} left {}", out.display());
     }

@@ -33,11 +33,18 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
     let model = &sky.model;
     let nm = model.wavelengths.nm().to_vec();
     let sources = sources_of_scene(model, &scene)?;
+    if reference.is_some() && scene.surface.is_some() {
+        anyhow::bail!("`--method reference` does not trace the planet's surface map ([surface]) so far: its ground is the atmosphere's uniform albedo");
+    }
     if reference.is_some() && (sources.lights.len() > 1 || sources.background.is_some()) {
         anyhow::bail!("`--method reference` traces the sun's light only so far: a [time] with the moon up or the sun down is not supported with it");
     }
     let camera = scene.camera_over(terrain.as_ref(), model.bottom_radius_m);
     let observer = firmament::math::Vec3::new(0.0, 0.0, model.bottom_radius_m + camera.altitude_m);
+    let radius = terrain
+        .as_ref()
+        .map_or(model.bottom_radius_m, |t| t.radius_m);
+    let planet = scene.build_surface(radius, &nm)?;
     let mut render_scene = RenderScene::clear_sky(&sky, sources.lights[0].direction, false);
     render_scene.lights = sources.lights.clone();
     render_scene
@@ -47,6 +54,9 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
     render_scene.background = sources.background.clone();
     if let Some(t) = &terrain {
         render_scene.add_terrain(t, t.radius_m);
+    }
+    if let Some(p) = &planet {
+        render_scene.set_ground(p);
     }
     let shader = Shader::new(&render_scene, observer)?;
     let first_view = sky.view(observer, &render_scene.lights[0]);

@@ -403,12 +403,14 @@ pub fn render_scene(
 ) -> Result<(render::Frame, f64)> {
     let sources = sources_of_scene(sky.model(), scene)?;
     let camera = scene.camera_over(terrain, sky.model().bottom_radius_m);
+    let radius = terrain.map_or(sky.model().bottom_radius_m, |t| t.radius_m);
+    let planet = scene.build_surface(radius, sky.model().wavelengths.nm())?;
     let settings = RenderSettings {
         camera: &camera,
         ..render_settings(scene)
     };
     let frame = sky
-        .render(&settings, &sources, terrain, quiet)
+        .render(&settings, &sources, terrain, planet.as_ref(), quiet)
         .context("rendering")?;
     let ev100 = ev100(scene, &frame);
     Ok((frame, ev100))
@@ -560,12 +562,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         other => anyhow::bail!("invalid value for `--method`: {other} (accepted: lut, reference)"),
     }
     let backend = match Backend::open(args.backend, args.quiet)? {
+        Backend::Gpu(_) if scene.surface.is_some() && args.backend == BackendChoice::Gpu => {
+            anyhow::bail!(
+                "the planet's surface map ([surface]) renders on the CPU only so far: `--backend cpu` or `auto` render it"
+            )
+        }
         Backend::Gpu(_) if scene.terrain.is_some() && args.backend == BackendChoice::Gpu => {
             anyhow::bail!(
                 "the terrain renders on the CPU only so far: `--backend gpu` needs `--no-terrain` (or a scene without [terrain]); `--backend cpu` or `auto` render it"
             )
         }
-        Backend::Gpu(_) if scene.terrain.is_some() => {
+        Backend::Gpu(_) if scene.terrain.is_some() || scene.surface.is_some() => {
             if !args.quiet {
                 eprintln!("note: the terrain renders on the CPU only so far: using the CPU");
             }

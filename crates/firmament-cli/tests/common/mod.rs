@@ -40,6 +40,20 @@ pub fn run(args: &[&str]) -> Output {
     bin().args(args).output().expect("run the firmament binary")
 }
 
+/// `firmament render --scene SCENE --tables (the small tables) --out OUT`, and `extra`.
+pub fn render_scene(scene: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "render",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--tables",
+        tables_arg(),
+    ];
+    args.extend_from_slice(&["--out", out.to_str().unwrap()]);
+    args.extend_from_slice(extra);
+    run(&args)
+}
+
 /// What the command printed on stderr.
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()

@@ -70,3 +70,21 @@ pub fn read_png_srgb8(path: impl AsRef<Path>) -> Result<(usize, usize, Vec<[u8; 
         .collect();
     Ok((w, h, data))
 }
+
+/// Decodes the PNG an input field names (a heightmap, a surface map): errors name `field`
+/// and say what it must be (`wanted`, e.g. "a 16-bit greyscale PNG file") when the file is
+/// not a PNG.
+pub fn decode_png_input(path: &Path, field: &str, wanted: &str) -> Result<image::DynamicImage> {
+    let file_error = |reason: String| Error::File {
+        path: path.display().to_string(),
+        reason: format!("{field}: {reason}"),
+    };
+    let reader = image::ImageReader::open(path)
+        .map_err(|e| file_error(e.to_string()))?
+        .with_guessed_format()
+        .map_err(|e| file_error(e.to_string()))?;
+    if reader.format() != Some(image::ImageFormat::Png) {
+        return Err(Error::invalid(field, path.display(), wanted));
+    }
+    reader.decode().map_err(|e| file_error(e.to_string()))
+}

@@ -151,9 +151,13 @@ impl<'s> Shader<'s> {
                         direct.iter_mut().for_each(|v| *v = 0.0);
                     }
                     view.sky_radiance_to_point(hit.position, shadow, l, t);
+                    // A specular lobe (the sea's glint) on the direct beam.
+                    let to_light = view.light().direction;
+                    let glint = scene.surfaces[i].specular(&hit, -ray.dir, to_light);
                     for k in 0..n {
                         out[k] += l[k];
                         out[k] += albedo[k] / PI * (direct[k] + visible_sky * sky[k]) * t[k];
+                        out[k] += glint * direct[k] * t[k];
                     }
                 }
             }),

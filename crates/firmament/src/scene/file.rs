@@ -146,6 +146,10 @@ pub struct SceneFile {
     /// altitude is then above the terrain's surface below it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub terrain: Option<TerrainConfig>,
+    /// The planet's ground seen from afar: a map (procedural by default) with oceans, land
+    /// and ice, and the sun's glint (none: the atmosphere's uniform ground albedo).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface: Option<super::planet_config::SurfaceConfig>,
     /// Output.
     pub output: SceneOutput,
 }
@@ -188,6 +192,7 @@ impl Default for SceneFile {
             location: None,
             time: None,
             terrain: Some(TerrainConfig::default()),
+            surface: None,
             output: SceneOutput {
                 ev100: None,
                 tonemap: ToneCurve::Aces,
@@ -229,6 +234,9 @@ impl SceneFile {
         if let (Some(t), Some(dir)) = (&mut scene.terrain, path.parent()) {
             t.resolve_paths(dir);
         }
+        if let (Some(s), Some(dir)) = (&mut scene.surface, path.parent()) {
+            s.resolve_paths(dir);
+        }
         scene.validate()?;
         Ok(scene)
     }
@@ -255,6 +263,24 @@ impl SceneFile {
         self.terrain
             .as_ref()
             .map(|t| t.build(model.bottom_radius_m, model.wavelengths.nm()))
+            .transpose()
+    }
+
+    /// The planet's ground of `[surface]` on a planet of radius `radius_m` (the terrain's,
+    /// when there is one), the observer at `[location]` (or 0° N, 0° E), its spectra at
+    /// `wavelengths_nm`.
+    pub fn build_surface(
+        &self,
+        radius_m: f64,
+        wavelengths_nm: &[f64],
+    ) -> Result<Option<super::planet::PlanetSurface>> {
+        let (lat, lon) = self
+            .location
+            .as_ref()
+            .map_or((0.0, 0.0), |l| (l.lat_deg, l.lon_deg));
+        self.surface
+            .as_ref()
+            .map(|s| s.build(radius_m, lat, lon, wavelengths_nm))
             .transpose()
     }
 
@@ -318,6 +344,9 @@ impl SceneFile {
         self.astro()?;
         if let Some(t) = &self.terrain {
             t.validate()?;
+        }
+        if let Some(s) = &self.surface {
+            s.validate()?;
         }
         if let Some(ev) = self.output.ev100 {
             if !(ev.is_finite() && (-20.0..=30.0).contains(&ev)) {

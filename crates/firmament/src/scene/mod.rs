@@ -9,6 +9,8 @@ pub mod camera;
 pub mod file;
 pub mod light;
 pub mod lunar;
+pub mod planet;
+pub mod planet_config;
 pub mod sky_lights;
 pub mod surface;
 pub mod terrain;
@@ -73,6 +75,13 @@ impl<'a> Scene<'a> {
             ..Sphere::ground(model)
         });
         self.surfaces.insert(0, Box::new(terrain));
+    }
+
+    /// Replace the planet's ground sphere of a [`Scene::clear_sky`] scene (its last surface,
+    /// after any terrain) with `ground` (a map: `scene::planet`).
+    pub fn set_ground(&mut self, ground: impl Surface + 'a) {
+        let last = self.surfaces.len() - 1;
+        self.surfaces[last] = Box::new(ground);
     }
 
     /// The nearest surface hit of `ray` closer than `max_distance_m`: (surface index, hit).

@@ -54,6 +54,14 @@ pub trait Surface: Send + Sync {
     fn relief(&self) -> Option<&dyn Relief> {
         None
     }
+
+    /// A specular BRDF (sr⁻¹) at `hit` for the light from `to_light` seen from `to_viewer`
+    /// (unit vectors), added to the Lambertian albedo for the lights' direct beams (the
+    /// sea's glint); 0 by default.
+    fn specular(&self, hit: &SurfaceHit, to_viewer: Vec3, to_light: Vec3) -> f64 {
+        let _ = (hit, to_viewer, to_light);
+        0.0
+    }
 }
 
 /// A surface that reshapes the planet over a region: heights above the planet's sphere over
@@ -92,6 +100,9 @@ impl<T: Surface + ?Sized> Surface for &T {
     }
     fn relief(&self) -> Option<&dyn Relief> {
         (**self).relief()
+    }
+    fn specular(&self, hit: &SurfaceHit, to_viewer: Vec3, to_light: Vec3) -> f64 {
+        (**self).specular(hit, to_viewer, to_light)
     }
 }
 

@@ -136,7 +136,7 @@ fn srgb_decision_levels() -> Vec<f32> {
 }
 
 /// The sRGB transfer function's inverse on [0, 1] (IEC 61966-2-1).
-fn srgb_to_linear(e: f64) -> f64 {
+pub fn srgb_to_linear(e: f64) -> f64 {
     if e <= 0.04045 {
         e / 12.92
     } else {

@@ -7,7 +7,7 @@
 
 pub mod colour;
 mod rayleigh;
-mod table;
+pub(crate) mod table;
 
 pub use colour::{xyz_to_linear_srgb, ColourMatrix};
 pub use rayleigh::{

@@ -15,22 +15,8 @@ pub fn read_heightmap(
     range_m: [f64; 2],
     centre_m: [f64; 2],
 ) -> Result<Grid> {
-    let file_error = |reason: String| Error::File {
-        path: path.display().to_string(),
-        reason: format!("terrain.heightmap: {reason}"),
-    };
-    let reader = image::ImageReader::open(path)
-        .map_err(|e| file_error(e.to_string()))?
-        .with_guessed_format()
-        .map_err(|e| file_error(e.to_string()))?;
-    if reader.format() != Some(image::ImageFormat::Png) {
-        return Err(Error::invalid(
-            "terrain.heightmap",
-            path.display(),
-            "a 16-bit greyscale PNG file",
-        ));
-    }
-    let img = reader.decode().map_err(|e| file_error(e.to_string()))?;
+    let img =
+        crate::io::png::decode_png_input(path, "terrain.heightmap", "a 16-bit greyscale PNG file")?;
     let image::DynamicImage::ImageLuma16(img) = img else {
         return Err(Error::invalid(
             "terrain.heightmap",

@@ -167,7 +167,7 @@ fn noise(seed: u64, x: f64, y: f64) -> (f64, f64, f64) {
 
 /// A 64-bit hash of a lattice point and the seed (SplitMix64 finaliser).
 #[inline]
-pub(super) fn hash(seed: u64, x: i64, y: i64) -> u64 {
+pub(crate) fn hash(seed: u64, x: i64, y: i64) -> u64 {
     let mut z = seed
         ^ (x as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
         ^ (y as u64).wrapping_mul(0xc2b2_ae3d_27d4_eb4f);
