@@ -82,6 +82,26 @@ fn the_sea_shows_the_suns_glint_and_a_map_its_colour() {
         mirror > 1.5 * mirror_off,
         "glint {mirror} without {mirror_off}"
     );
+    // The reference traces the map as a Lambertian surface (the glint off): the sea's
+    // nadir agrees with the tables to the small tables' and the ground bounce's error.
+    let f = flat.to_str().unwrap();
+    let reference = luminance(&[
+        "query",
+        "--scene",
+        f,
+        "--view",
+        "180,0",
+        "-q",
+        "--method",
+        "reference",
+        "--samples",
+        "300",
+    ]);
+    let lut = q(&flat, "180,0");
+    assert!(
+        (lut / reference - 1.0).abs() < 0.15,
+        "lut {lut} reference {reference}"
+    );
     // A map: a white planet reflects more than the sea.
     let white = dir.join("white.png");
     image::RgbImage::from_pixel(8, 4, image::Rgb([255, 255, 255]))

@@ -33,8 +33,8 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
     let model = &sky.model;
     let nm = model.wavelengths.nm().to_vec();
     let sources = sources_of_scene(model, &scene)?;
-    if reference.is_some() && scene.surface.is_some() {
-        anyhow::bail!("`--method reference` does not trace the planet's surface map ([surface]) so far: its ground is the atmosphere's uniform albedo");
+    if reference.is_some() && scene.surface.as_ref().is_some_and(|s| s.glint) {
+        anyhow::bail!("`--method reference` traces Lambertian surfaces only: the sun's glint on the sea is not in it (set `glint = false` in [surface] to compare the map)");
     }
     if reference.is_some() && (sources.lights.len() > 1 || sources.background.is_some()) {
         anyhow::bail!("`--method reference` traces the sun's light only so far: a [time] with the moon up or the sun down is not supported with it");
@@ -60,7 +60,13 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
     }
     let shader = Shader::new(&render_scene, observer)?;
     let first_view = sky.view(observer, &render_scene.lights[0]);
-    let surfaces: Vec<Box<dyn Surface + '_>> = terrain.iter().map(|t| Box::new(t) as _).collect();
+    // The reference meets the terrain and the planet's map as Lambertian surfaces (the map's
+    // sphere lies on its ground sphere and wins the tie).
+    let mut surfaces: Vec<Box<dyn Surface + '_>> =
+        terrain.iter().map(|t| Box::new(t) as _).collect();
+    if let Some(p) = &planet {
+        surfaces.push(Box::new(p));
+    }
     let settings = reference.map(|s| ReferenceSettings {
         include_ground: true,
         ..s
