@@ -8,10 +8,11 @@
 mod common;
 
 use firmament::atmosphere::{Albedo, Atmosphere};
+use firmament::math::lattice::sphere_directions;
 use firmament::math::sphere::ray_sphere;
 use firmament::math::{direction_from_zenith_azimuth, Vec3};
 use firmament::reference::{self, ReferenceSettings};
-use firmament::render::terrain_air::{quadrature, scattering_change, sphere_directions};
+use firmament::render::terrain_air::{quadrature, scattering_change};
 use firmament::render::{ShadeScratch, Shader};
 use firmament::scene::terrain::{Heightfield, TerrainConfig};
 use firmament::scene::{sun_direction, Ray, Scene, Surface};

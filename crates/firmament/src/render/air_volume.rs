@@ -118,8 +118,8 @@ impl AirVolume {
         let s = elevation.signum() * (elevation.abs() / 90.0).sqrt();
         let row = ((s + 1.0) * 0.5 * (ELEVATIONS - 1) as f64).clamp(0.0, (ELEVATIONS - 1) as f64);
         let col = azimuth / std::f64::consts::TAU * AZIMUTHS as f64;
-        let (r0, fr) = ((row as usize).min(ELEVATIONS - 2), 0.0);
-        let fr = fr + row - r0 as f64;
+        let r0 = (row as usize).min(ELEVATIONS - 2);
+        let fr = row - r0 as f64;
         let c0 = (col as usize) % AZIMUTHS;
         let fc = col - col.floor();
         let per_dir = (STEPS + 1) * n;
@@ -138,8 +138,8 @@ impl AirVolume {
                 continue;
             }
             let j = (STEPS as f64 * (end.min(reach) / reach).sqrt()).min(STEPS as f64);
-            let (j0, f) = ((j as usize).min(STEPS - 1), 0.0);
-            let f = f + j - j0 as f64;
+            let j0 = (j as usize).min(STEPS - 1);
+            let f = j - j0 as f64;
             let v = &self.values[d * per_dir..(d + 1) * per_dir];
             for k in 0..n {
                 let (a, b) = (v[j0 * n + k] as f64, v[(j0 + 1) * n + k] as f64);

@@ -32,6 +32,7 @@
 use rayon::prelude::*;
 
 use crate::atmosphere::groups::{AEROSOLS, MOLECULES};
+use crate::math::lattice::band_directions;
 use crate::math::Vec3;
 use crate::scene::{Ray, Scene};
 use crate::spectrum::MAX_CHANNELS;
@@ -57,28 +58,6 @@ pub const CAP_DIRECTIONS: usize = 32;
 
 /// The cap's half-angle (degrees).
 pub const CAP_HALF_ANGLE_DEG: f64 = 12.0;
-
-/// `n` directions spread evenly over the sphere (the Fibonacci lattice; González 2010,
-/// "Measurement of areas on a sphere using Fibonacci and latitude–longitude lattices",
-/// Math. Geosci. 42), each standing for 4π/n sr.
-pub fn sphere_directions(n: usize) -> Vec<Vec3> {
-    band_directions(Vec3::Z, -1.0, 1.0, n)
-}
-
-/// `n` directions spread evenly over the band of directions d with `z0` < d·`axis` <
-/// `z1` (the lattice on the band of z), each standing for 2π(z1 − z0)/n sr.
-fn band_directions(axis: Vec3, z0: f64, z1: f64, n: usize) -> Vec<Vec3> {
-    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-    let (e1, e2) = axis.any_orthonormal_pair();
-    (0..n)
-        .map(|i| {
-            let z = z1 - (z1 - z0) * (i as f64 + 0.5) / n as f64;
-            let s = (1.0 - z * z).max(0.0).sqrt();
-            let phi = golden * i as f64;
-            s * phi.cos() * e1 + s * phi.sin() * e2 + z * axis
-        })
-        .collect()
-}
 
 /// The directions and their solid angles (sr) for lights in `lights` (unit): a cap around
 /// each, the sphere's lattice outside the caps; the weights sum to 4π.

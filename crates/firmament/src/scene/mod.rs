@@ -69,10 +69,9 @@ impl<'a> Scene<'a> {
     ///
     /// [`Atmosphere::lifted`]: crate::atmosphere::Atmosphere::lifted
     pub fn add_terrain(&mut self, terrain: impl Surface + 'a, planet_radius_m: f64) {
-        let model = self.sky.model();
-        self.surfaces[0] = Box::new(Sphere {
+        self.set_ground(Sphere {
             radius_m: planet_radius_m,
-            ..Sphere::ground(model)
+            ..Sphere::ground(self.sky.model())
         });
         self.surfaces.insert(0, Box::new(terrain));
     }

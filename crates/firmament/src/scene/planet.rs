@@ -12,10 +12,11 @@
 //! (deserts) spectra; ice is the terrain's snow. A user map's linear sRGB is spread over the
 //! wavelengths by interpolating its channels at 680, 550 and 440 nm (held beyond).
 
-use super::surface::{Surface, SurfaceHit};
+use super::surface::{Sphere, Surface, SurfaceHit};
 use super::terrain::materials::material_spectra;
 use super::terrain::relief::hash;
 use super::Ray;
+use crate::math::lattice::sphere_directions;
 use crate::math::{smoothstep, Vec3};
 use crate::spectrum::table::Table;
 
@@ -57,8 +58,8 @@ pub enum SurfaceMap {
 /// The planet's ground with a map.
 #[derive(Clone, Debug)]
 pub struct PlanetSurface {
-    /// Radius (m).
-    pub radius_m: f64,
+    /// The sphere (its albedo unused: the map's).
+    sphere: Sphere,
     /// The map.
     pub map: SurfaceMap,
     /// The observer's east, north and up in the map's planet-fixed frame (z to 90° N, x to
@@ -100,7 +101,12 @@ impl PlanetSurface {
         let north = up.cross(east);
         let [ice, rock, grass, forest] = material_spectra(wavelengths_nm);
         let mut planet = PlanetSurface {
-            radius_m,
+            sphere: Sphere {
+                centre: Vec3::ZERO,
+                radius_m,
+                albedo: Vec::new(),
+                casts_shadows: false,
+            },
             map,
             frame: [east, north, up],
             ocean: ocean_spectrum(wavelengths_nm),
@@ -118,13 +124,9 @@ impl PlanetSurface {
         } = planet.map
         {
             // The quantile of the continents' noise over 8192 evenly spread points.
-            let mut v: Vec<f64> = (0..8192)
-                .map(|i| {
-                    let z = 1.0 - (2.0 * i as f64 + 1.0) / 8192.0;
-                    let s = (1.0 - z * z).sqrt();
-                    let a = std::f64::consts::PI * (3.0 - 5f64.sqrt()) * i as f64;
-                    continents(seed, Vec3::new(s * a.cos(), s * a.sin(), z))
-                })
+            let mut v: Vec<f64> = sphere_directions(8192)
+                .into_iter()
+                .map(|d| continents(seed, d))
                 .collect();
             v.sort_by(f64::total_cmp);
             let k = ((ocean_fraction.clamp(0.0, 1.0) * v.len() as f64) as usize).min(v.len() - 1);
@@ -153,16 +155,9 @@ impl PlanetSurface {
 
     /// The sea's share of the sphere's area in this map, by 20 000 evenly spread points.
     pub fn sea_fraction(&self) -> f64 {
-        let n = 20_000;
-        let sea = (0..n)
-            .filter(|&i| {
-                let z = 1.0 - (2.0 * i as f64 + 1.0) / n as f64;
-                let s = (1.0 - z * z).sqrt();
-                let a = std::f64::consts::PI * (3.0 - 5f64.sqrt()) * i as f64;
-                self.is_sea(Vec3::new(s * a.cos(), s * a.sin(), z))
-            })
-            .count();
-        sea as f64 / n as f64
+        let points = sphere_directions(20_000);
+        let sea = points.iter().filter(|&&d| self.is_sea(d)).count();
+        sea as f64 / points.len() as f64
     }
 
     /// The Cox & Munk (1954) glint BRDF (sr⁻¹) of the sea for light from `to_light` seen
@@ -186,13 +181,7 @@ impl PlanetSurface {
 
 impl Surface for PlanetSurface {
     fn intersect(&self, ray: &Ray, max_distance_m: f64) -> Option<SurfaceHit> {
-        super::Sphere {
-            centre: Vec3::ZERO,
-            radius_m: self.radius_m,
-            albedo: Vec::new(),
-            casts_shadows: false,
-        }
-        .intersect(ray, max_distance_m)
+        self.sphere.intersect(ray, max_distance_m)
     }
 
     fn albedo(&self, hit: &SurfaceHit, out: &mut [f64]) {
@@ -361,11 +350,8 @@ mod tests {
         // Land by zone: ice near the poles, none at the equator.
         let (mut ice_polar, mut ice_tropic, mut n_polar, mut n_tropic) = (0, 0, 0, 0);
         let mut out = [0.0; 3];
-        for i in 0..20_000 {
-            let z = 1.0 - (2.0 * i as f64 + 1.0) / 20_000.0;
-            let s = (1.0 - z * z).sqrt();
-            let a = 2.399_963 * i as f64;
-            let d = Vec3::new(s * a.cos(), s * a.sin(), z);
+        for d in sphere_directions(20_000) {
+            let z = d.z;
             if p.is_sea(d) {
                 continue;
             }
