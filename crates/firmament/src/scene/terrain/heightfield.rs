@@ -6,7 +6,7 @@
 
 use std::sync::{Arc, RwLock};
 
-use super::grid::{bilinear, first_descent, fractions, walk, CellSpan, Grid, GridRay, MaxPyramid};
+use super::grid::{bilinear, first_descent, fractions, CellSpan, Grid, GridRay, MaxPyramid, Walk};
 use super::materials::Materials;
 use super::shadow::ShadowField;
 use crate::math::Vec3;
@@ -122,6 +122,11 @@ impl Heightfield {
             }
         }
         floor.max(0.0)
+    }
+
+    /// The max-mip pyramid of the heights (for a GPU copy of the walk).
+    pub fn pyramid(&self) -> &MaxPyramid {
+        &self.pyramid
     }
 
     /// The highest point (m above the sphere).
@@ -246,24 +251,20 @@ impl Surface for Heightfield {
         let mut hit_t = None;
         // Rays leaving the surface start a hair above it (no self-hit at t ≈ 0).
         let t_min = 1e-6 * (1.0 + ray.origin.length() * 1e-9);
-        walk(
+        for cell in Walk::new(
             grid,
             &self.pyramid,
             None,
             None,
             &gr,
             (t_min, max_distance_m),
-            &mut |cell| {
-                let f = gr.gap_in_cell(grid, cell);
-                match first_descent(f) {
-                    Some(s) => {
-                        hit_t = Some(refine(&gr, grid, cell, s, f));
-                        true
-                    }
-                    None => false,
-                }
-            },
-        );
+        ) {
+            let f = gr.gap_in_cell(grid, cell);
+            if let Some(s) = first_descent(f) {
+                hit_t = Some(refine(&gr, grid, cell, s, f));
+                break;
+            }
+        }
         let t = hit_t.filter(|&t| t > t_min && t < max_distance_m)?;
         let position = ray.origin + t * ray.dir;
         let mut normal = self.normal_at(position);

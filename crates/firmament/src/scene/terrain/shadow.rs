@@ -22,7 +22,7 @@
 
 use rayon::prelude::*;
 
-use super::grid::{roots, walk, Grid, GridRay, MaxPyramid};
+use super::grid::{roots, Grid, GridRay, MaxPyramid, Walk};
 use super::heightfield::Heightfield;
 use crate::math::Vec3;
 
@@ -83,6 +83,12 @@ impl ShadowField {
         }
     }
 
+    /// The pyramids the walk through the field uses (for a GPU copy of it): the maxima of
+    /// S, of the raise S − H (0: lit down to the ground) and of −S (the floors).
+    pub fn pyramids(&self) -> [&MaxPyramid; 3] {
+        [&self.pyramid, &self.raised, &self.floors]
+    }
+
     /// The shadowed intervals of `ray` within [0, `max_distance_m`] (see the module
     /// documentation), appended to `out`. When the ray ends on a surface (a finite
     /// `max_distance_m` at the terrain or the sphere), whether its end is in shadow comes
@@ -99,44 +105,43 @@ impl ShadowField {
         // The last span walked, and whether it was a whole node in shadow.
         let mut last_piece = (0.0, 0.0);
         let mut last_whole = false;
-        walk(
+        let cells = Walk::new(
             grid,
             &self.pyramid,
             Some(&self.raised),
             Some(&self.floors),
             ray,
             (0.0, max_distance_m),
-            &mut |cell| {
-                if cell.below {
-                    push_merged(out, first, cell.t0, cell.t1);
-                    last_piece = (cell.t0, cell.t1);
-                    last_whole = true;
-                    return false;
-                }
-                // g(s) = ray height − S: shadowed where negative.
-                let g = ray.gap_in_cell(grid, cell);
-                let mut cuts = [0.0, 1.0, 1.0, 1.0];
-                let mut n = 1;
-                for s in roots(g).into_iter().flatten() {
-                    if s > 0.0 && s < 1.0 {
-                        cuts[n] = s;
-                        n += 1;
-                    }
-                }
-                cuts[n] = 1.0;
-                let span = cell.t1 - cell.t0;
-                for k in 0..n {
-                    let (s0, s1) = (cuts[k], cuts[k + 1]);
-                    let m = 0.5 * (s0 + s1);
-                    if g[0] + m * (g[1] + m * g[2]) < 0.0 {
-                        push_merged(out, first, cell.t0 + s0 * span, cell.t0 + s1 * span);
-                    }
-                }
-                last_piece = (cell.t0, cell.t1);
-                last_whole = false;
-                false
-            },
         );
+        for cell in cells {
+            if cell.below {
+                push_merged(out, first, cell.t0, cell.t1);
+                last_piece = (cell.t0, cell.t1);
+                last_whole = true;
+                continue;
+            }
+            // g(s) = ray height − S: shadowed where negative.
+            let g = ray.gap_in_cell(grid, cell);
+            let mut cuts = [0.0, 1.0, 1.0, 1.0];
+            let mut n = 1;
+            for s in roots(g).into_iter().flatten() {
+                if s > 0.0 && s < 1.0 {
+                    cuts[n] = s;
+                    n += 1;
+                }
+            }
+            cuts[n] = 1.0;
+            let span = cell.t1 - cell.t0;
+            for k in 0..n {
+                let (s0, s1) = (cuts[k], cuts[k + 1]);
+                let m = 0.5 * (s0 + s1);
+                if g[0] + m * (g[1] + m * g[2]) < 0.0 {
+                    push_merged(out, first, cell.t0 + s0 * span, cell.t0 + s1 * span);
+                }
+            }
+            last_piece = (cell.t0, cell.t1);
+            last_whole = false;
+        }
         let Some(shadowed) = terrain.end_in_shadow(ray, self.light, max_distance_m) else {
             return;
         };
