@@ -3,7 +3,6 @@
 //! PROSAIL's dry soil, and Kokhanovsky & Zege 2004 snow with Warren & Brandt 2008 ice),
 //! mixed by height and slope, or one albedo everywhere.
 
-use super::relief::hash;
 use crate::math::{smoothstep, Vec3};
 
 const TERRAIN_ALBEDO_CSV: &str = include_str!("../../../data/terrain_albedo.csv");
@@ -82,7 +81,7 @@ impl Materials {
             Materials::ByHeightAndSlope(z) => {
                 let slope = slope_rad.to_degrees();
                 // Patchy edges: value noise over ~150 m and ~40 m cells.
-                let n = 0.65 * patch(point, 150.0, 1) + 0.35 * patch(point, 40.0, 2);
+                let n = 0.65 * patchiness(point, 150.0, 1) + 0.35 * patchiness(point, 40.0, 2);
                 let snow = smoothstep(-150.0, 150.0, height_m - z.snow_line_m + 260.0 * n)
                     * (1.0 - smoothstep(38.0, 52.0, slope - 8.0 * n));
                 let rock = smoothstep(28.0, 42.0, slope + 10.0 * n).max(smoothstep(
@@ -103,19 +102,34 @@ impl Materials {
     }
 }
 
-/// Smooth value noise in [−1, 1] over cells of `cell_m` (planet-centred coordinates).
-fn patch(p: Vec3, cell_m: f64, salt: u64) -> f64 {
+/// Smooth value noise in [−1, 1) over cells of `cell_m` (planet-centred coordinates; the
+/// WGSL twin `patchiness` in `terrain/materials.wgsl` gives the same values to f32 rounding).
+pub fn patchiness(p: Vec3, cell_m: f64, salt: u32) -> f64 {
     let (x, y) = (p.x / cell_m, p.y / cell_m);
     let (xi, yi) = (x.floor(), y.floor());
     let (fx, fy) = (x - xi, y - yi);
-    let v = |dx: i64, dy: i64| {
-        let h = hash(0x007e_44a1 ^ salt, xi as i64 + dx, yi as i64 + dy);
-        (h >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+    let v = |dx: i32, dy: i32| {
+        let h = hash32(salt, xi as i32 + dx, yi as i32 + dy);
+        (h >> 8) as f64 / (1u32 << 23) as f64 - 1.0
     };
     let (sx, sy) = (fx * fx * (3.0 - 2.0 * fx), fy * fy * (3.0 - 2.0 * fy));
     let low = v(0, 0) + (v(1, 0) - v(0, 0)) * sx;
     let high = v(0, 1) + (v(1, 1) - v(0, 1)) * sx;
     low + (high - low) * sy
+}
+
+/// A 32-bit integer hash of a lattice point (32-bit so that WGSL computes the same):
+/// Wellons's "lowbias32" finaliser (C. Wellons 2018, "Prospecting for hash functions",
+/// bias 0.17), chained over the salt and the two coordinates.
+pub fn hash32(salt: u32, x: i32, y: i32) -> u32 {
+    fn lowbias32(mut v: u32) -> u32 {
+        v ^= v >> 16;
+        v = v.wrapping_mul(0x7feb_352d);
+        v ^= v >> 15;
+        v = v.wrapping_mul(0x846c_a68b);
+        v ^ (v >> 16)
+    }
+    lowbias32(x as u32 ^ lowbias32(y as u32 ^ lowbias32(salt)))
 }
 
 #[cfg(test)]
