@@ -5,6 +5,7 @@
 //! With `commands/bench/gpu.rs`, the only place that calls `firmament_gpu`: the commands
 //! see [`Backend`], [`Gpu`] and [`RenderSky`].
 
+use std::sync::OnceLock;
 use std::time::Instant;
 
 use anyhow::Result;
@@ -15,10 +16,10 @@ use firmament::render::{stars, Frame, RenderSettings};
 use firmament::scene::planet::PlanetSurface;
 use firmament::scene::sky_lights::SkySources;
 use firmament::scene::terrain::Heightfield;
-use firmament::scene::Scene;
+use firmament::scene::{Scene, Surface};
 use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, Tables};
 use firmament_gpu::Precomputer;
-use firmament_gpu::{GpuContext, GpuError, GpuRenderer, GpuSky, RenderInputs};
+use firmament_gpu::{GpuContext, GpuError, GpuRenderer, GpuSky, GpuTerrain, RenderInputs};
 
 use crate::common::{cancel_flag, print_tables_time, progress_bar, spinner, AtmosphereArgs};
 
@@ -258,6 +259,11 @@ pub enum RenderSky<'a> {
         /// The model the sky was computed for (lights are built from it).
         sky_model: Box<Model>,
         renderer: Box<GpuRenderer>,
+        /// The tables on the CPU (the file's, or read back from the device on first use):
+        /// the terrain's change of the air's light is computed on the CPU from them.
+        cpu_sky: Box<OnceLock<Bruneton4d>>,
+        /// The tables' configuration (to read them back).
+        config: TableConfig,
     },
 }
 
@@ -269,16 +275,20 @@ impl<'a> RenderSky<'a> {
             Backend::Cpu => return Ok(RenderSky::Cpu(Box::new(atmosphere.sky(quiet)?))),
             Backend::Gpu(gpu) => gpu,
         };
-        let (sky, sky_model) = match &atmosphere.tables {
+        let cpu_sky = Box::new(OnceLock::new());
+        let (sky, sky_model, config) = match &atmosphere.tables {
             Some(_) => {
                 let cpu = atmosphere.sky(quiet)?;
                 let sky = GpuSky::from_sky(&gpu.ctx, &cpu)
                     .map_err(|e| gpu_failure("uploading the tables", e))?;
-                (sky, cpu.model)
+                let (model, config) = (cpu.model.clone(), cpu.tables.config);
+                let _ = cpu_sky.set(cpu);
+                (sky, model, config)
             }
             None => {
                 let model = atmosphere.model()?;
-                (gpu.sky(&model, &atmosphere.table_config()?, quiet)?, model)
+                let config = atmosphere.table_config()?;
+                (gpu.sky(&model, &config, quiet)?, model, config)
             }
         };
         let renderer = GpuRenderer::new(&gpu.ctx)
@@ -288,6 +298,8 @@ impl<'a> RenderSky<'a> {
             sky: Box::new(sky),
             sky_model: Box::new(sky_model),
             renderer: Box::new(renderer),
+            cpu_sky,
+            config,
         })
     }
 
@@ -299,8 +311,9 @@ impl<'a> RenderSky<'a> {
         }
     }
 
-    /// Render one frame of the sky lit by `sources`, over `terrain` when given (CPU only so
-    /// far): the CPU renderer with a progress bar, or the GPU renderer.
+    /// Render one frame of the sky lit by `sources`, over `terrain` when given: the CPU
+    /// renderer with a progress bar, or the GPU renderer (the terrain's shadow fields and
+    /// its change of the air's light computed on the CPU and uploaded with it).
     pub fn render(
         &self,
         settings: &RenderSettings,
@@ -309,11 +322,6 @@ impl<'a> RenderSky<'a> {
         planet: Option<&PlanetSurface>,
         quiet: bool,
     ) -> Result<Frame> {
-        if terrain.is_some() && matches!(self, RenderSky::Gpu { .. }) {
-            anyhow::bail!(
-                "the terrain renders on the CPU only so far: use `--backend cpu` (or `auto`), or `--no-terrain` for the GPU"
-            );
-        }
         if planet.is_some() && matches!(self, RenderSky::Gpu { .. }) {
             anyhow::bail!(
                 "the planet's surface map ([surface]) renders on the CPU only so far: use `--backend cpu` (or `auto`)"
@@ -323,16 +331,7 @@ impl<'a> RenderSky<'a> {
             RenderSky::Cpu(sky) => {
                 let bar = progress_bar(1000, quiet);
                 bar.set_message("rendering");
-                let mut scene = Scene::clear_sky(sky.as_ref(), Vec3::Z, false);
-                if let Some(t) = terrain {
-                    scene.add_terrain(t, t.radius_m);
-                }
-                if let Some(p) = planet {
-                    scene.set_ground(p);
-                }
-                scene.lights = sources.lights.clone();
-                scene.background = sources.background.clone();
-                scene.stars = sources.stars.clone();
+                let scene = cpu_scene(sky.as_ref(), sources, terrain, planet);
                 let frame = firmament::render::render(
                     &scene,
                     settings,
@@ -347,9 +346,15 @@ impl<'a> RenderSky<'a> {
                 sky,
                 renderer,
                 sky_model,
+                ..
             } => {
+                let gpu_terrain = match terrain {
+                    Some(t) => Some(self.gpu_terrain(t, settings, sources, quiet)?),
+                    None => None,
+                };
                 let inputs = RenderInputs {
                     background: sources.background.as_ref(),
+                    terrain: gpu_terrain.as_ref(),
                     ..RenderInputs::default()
                 };
                 let mut frame = on_gpu("rendering on the GPU", quiet, || {
@@ -357,11 +362,71 @@ impl<'a> RenderSky<'a> {
                         .render_with(&gpu.ctx, sky, &sources.lights, settings, inputs)
                         .map_err(|e| gpu_failure("rendering", e))
                 })?;
-                // The stars are points: splatted on the CPU into the frame read back.
-                stars::draw_points_into(&mut frame, &sources.stars, sky_model, settings);
+                // The stars are points: splatted on the CPU into the frame read back, hidden
+                // by the terrain.
+                let occluders: Vec<&dyn Surface> =
+                    terrain.iter().map(|t| *t as &dyn Surface).collect();
+                stars::draw_points_into(
+                    &mut frame,
+                    &sources.stars,
+                    sky_model,
+                    settings,
+                    &occluders,
+                );
                 Ok(frame)
             }
         }
+    }
+
+    /// `terrain` on the device for a GPU frame: its shadow fields for the frame's lights and,
+    /// when it changes the air's light, the observer's air volume, both computed on the CPU
+    /// (the tables read back from the device for it, once).
+    fn gpu_terrain(
+        &self,
+        terrain: &Heightfield,
+        settings: &RenderSettings,
+        sources: &SkySources,
+        quiet: bool,
+    ) -> Result<GpuTerrain> {
+        let RenderSky::Gpu {
+            gpu,
+            sky,
+            sky_model,
+            cpu_sky,
+            config,
+            ..
+        } = self
+        else {
+            unreachable!("gpu_terrain is called for GPU skies")
+        };
+        let bar = spinner("the terrain's shadows and air light (CPU)", quiet);
+        let air = if terrain.air_light && !sources.lights.is_empty() {
+            let cpu = match cpu_sky.get() {
+                Some(c) => c,
+                None => {
+                    let tables = sky
+                        .tables()
+                        .read_back(&gpu.ctx, sky_model, config)
+                        .map_err(|e| gpu_failure("reading the tables back", e))?;
+                    let _ = cpu_sky.set(Bruneton4d::new(sky_model.as_ref().clone(), tables)?);
+                    cpu_sky.get().expect("just set")
+                }
+            };
+            let scene = cpu_scene(cpu, sources, Some(terrain), None);
+            let observer = Vec3::new(
+                0.0,
+                0.0,
+                sky_model.bottom_radius_m + settings.camera.altitude_m,
+            );
+            let shader = firmament::render::Shader::new(&scene, observer)?;
+            shader.air_volume().cloned()
+        } else {
+            None
+        };
+        let uploaded = GpuTerrain::new(&gpu.ctx, sky, terrain, &sources.lights, air.as_ref())
+            .map_err(|e| gpu_failure("uploading the terrain", e));
+        bar.finish_and_clear();
+        uploaded
     }
 
     /// The model the sky's tables hold (lights are built from it).
@@ -371,4 +436,25 @@ impl<'a> RenderSky<'a> {
             RenderSky::Gpu { sky_model, .. } => sky_model,
         }
     }
+}
+
+/// The CPU scene of a frame: the sky's tables, the sources' lights, glow and stars, over the
+/// terrain and the planet's surface when given.
+fn cpu_scene<'s>(
+    sky: &'s Bruneton4d,
+    sources: &SkySources,
+    terrain: Option<&'s Heightfield>,
+    planet: Option<&'s PlanetSurface>,
+) -> Scene<'s> {
+    let mut scene = Scene::clear_sky(sky, Vec3::Z, false);
+    if let Some(t) = terrain {
+        scene.add_terrain(t, t.radius_m);
+    }
+    if let Some(p) = planet {
+        scene.set_ground(p);
+    }
+    scene.lights = sources.lights.clone();
+    scene.background = sources.background.clone();
+    scene.stars = sources.stars.clone();
+    scene
 }

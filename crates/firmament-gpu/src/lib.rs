@@ -34,11 +34,13 @@ mod error;
 pub mod passes;
 pub mod render;
 pub mod shader;
+pub mod terrain;
 
 pub use bruneton4d::{GpuSky, GpuTables, Precomputer};
 pub use device::{test_context, GpuContext};
 pub use error::GpuError;
 pub use render::{GpuRenderer, RenderInputs, RenderTarget, RenderTiming, PIXEL_BYTES};
+pub use terrain::GpuTerrain;
 
 use firmament::atmosphere::Model;
 use firmament::sky::bruneton4d::{TableConfig, Tables};

@@ -4,6 +4,7 @@
 //! Rust twin with the same name and function names (see `docs/architecture.md`).
 
 use firmament::math::quadrature::GL4;
+use firmament::render::air_volume;
 use firmament::sky::bruneton4d::precompute::{
     DENSITY_PHI, DENSITY_THETA, HARMONICS, IRRADIANCE_PHI, IRRADIANCE_THETA, KERNEL_STEPS,
     RAY_INTERVALS, TRANSMITTANCE_SEGMENTS,
@@ -16,6 +17,10 @@ use crate::passes::WORKGROUP;
 use crate::render::frame::{
     CHANNEL_DATA_VEC4, CHANNEL_MIE_RATIO, CHANNEL_SRGB, CHANNEL_STRIDE, LIGHTS_DATA_VEC4,
     LIGHT_DISK, LIGHT_IRRADIANCE, LIGHT_SCALE, LIGHT_STRIDE, MAX_LIGHTS, SLICE_TABLES,
+};
+use crate::terrain::{
+    MAX_PYRAMID_LEVELS, TERRAIN_ALBEDO_VEC4, TERRAIN_CASTS_SHADOWS, TERRAIN_OCCLUSION,
+    TERRAIN_PRESENT, TERRAIN_SHAFTS, TERRAIN_UNIFORM_ALBEDO,
 };
 
 /// A WGSL source file and its path under `shaders/` (for messages).
@@ -96,13 +101,30 @@ pub mod passes {
     pub const ORDER_TAIL: Module = module!("bruneton4d/precompute/order_tail.wgsl");
 }
 
-/// The sky method's render-time module (the view of one observer and one light).
-pub const BRUNETON4D_VIEW: Module = module!("bruneton4d/view.wgsl");
+/// The sky method's render-time modules (the view of one observer and one light; its
+/// questions towards any point and over lit intervals).
+pub const BRUNETON4D_VIEW: [Module; 2] = [
+    module!("bruneton4d/view.wgsl"),
+    module!("bruneton4d/view_point.wgsl"),
+];
 
-/// The renderer's modules: lights, cameras, the frame.
-pub const RENDER: [Module; 3] = [
+/// The terrain: its bindings, the grid and its walk, the surface, the materials, the shadow
+/// fields.
+pub const TERRAIN: [Module; 5] = [
+    module!("terrain/terrain.wgsl"),
+    module!("terrain/grid.wgsl"),
+    module!("terrain/heightfield.wgsl"),
+    module!("terrain/materials.wgsl"),
+    module!("terrain/shadow.wgsl"),
+];
+
+/// The renderer's modules: lights, cameras, the air volume, the scene over the terrain, the
+/// frame.
+pub const RENDER: [Module; 5] = [
     module!("render/light.wgsl"),
     module!("render/camera.wgsl"),
+    module!("render/air_volume.wgsl"),
+    module!("render/scene.wgsl"),
     module!("render/render.wgsl"),
 ];
 
@@ -146,6 +168,16 @@ pub fn prelude() -> String {
         ("LIGHT_IRRADIANCE", LIGHT_IRRADIANCE),
         ("LIGHTS_DATA_VEC4", LIGHTS_DATA_VEC4),
         ("SLICE_TABLES", SLICE_TABLES),
+        ("MAX_PYRAMID_LEVELS", MAX_PYRAMID_LEVELS),
+        ("TERRAIN_ALBEDO_VEC4", TERRAIN_ALBEDO_VEC4),
+        ("TERRAIN_PRESENT", TERRAIN_PRESENT as usize),
+        ("TERRAIN_CASTS_SHADOWS", TERRAIN_CASTS_SHADOWS as usize),
+        ("TERRAIN_SHAFTS", TERRAIN_SHAFTS as usize),
+        ("TERRAIN_OCCLUSION", TERRAIN_OCCLUSION as usize),
+        ("TERRAIN_UNIFORM_ALBEDO", TERRAIN_UNIFORM_ALBEDO as usize),
+        ("AIR_AZIMUTHS", air_volume::AZIMUTHS),
+        ("AIR_ELEVATIONS", air_volume::ELEVATIONS),
+        ("AIR_STEPS", air_volume::STEPS),
     ] {
         s += &u(name, v);
     }
@@ -186,15 +218,17 @@ pub fn precompute_source(pass: Module) -> String {
 
 /// The sky method's WGSL for an engine's own shader: the prelude, the common modules, the 4D
 /// tables' lookups and the view functions (`sky_ray`/`sky_radiance`, `ground_ray`/
-/// `sky_radiance_to_point`, `ground_light`/`sun_and_sky_irradiance`, `camera_slice`). The
+/// `sky_radiance_to_point`, `ground_light`/`sun_and_sky_irradiance`, `camera_slice`; towards
+/// any point and over lit intervals: `point_ray`, `piece_at`, `lit_single`,
+/// `whole_multiple`, `point_light`/`point_irradiance`). The
 /// bindings it declares are documented in `shaders/bruneton4d/view.wgsl` and on
 /// [`crate::GpuSky`].
 pub fn sky_module() -> String {
     let modules: Vec<Module> = COMMON
         .iter()
         .chain(&BRUNETON4D)
+        .chain(&BRUNETON4D_VIEW)
         .copied()
-        .chain([BRUNETON4D_VIEW])
         .collect();
     compose(&modules, None)
 }
@@ -210,9 +244,10 @@ pub fn render_source(output_format: Option<&str>) -> String {
     let modules: Vec<Module> = COMMON
         .iter()
         .chain(&BRUNETON4D)
+        .chain(&BRUNETON4D_VIEW)
+        .chain(&TERRAIN)
+        .chain(&RENDER)
         .copied()
-        .chain([BRUNETON4D_VIEW])
-        .chain(RENDER)
         .chain([output])
         .collect();
     compose(&modules, output_format)
@@ -235,7 +270,9 @@ mod tests {
             .chain(&BRUNETON4D)
             .chain(&PRECOMPUTE)
             .chain(&RENDER)
-            .chain(&[BRUNETON4D_VIEW, OUTPUT_BUFFER, OUTPUT_TEXTURE])
+            .chain(&BRUNETON4D_VIEW)
+            .chain(&TERRAIN)
+            .chain(&[OUTPUT_BUFFER, OUTPUT_TEXTURE])
         {
             for line in p.lines().filter(|l| l.starts_with("const ")) {
                 let name = line.split([':', ' ']).nth(1).unwrap();
@@ -244,6 +281,47 @@ mod tests {
                     "{} redefines {name}",
                     m.path
                 );
+            }
+        }
+    }
+
+    /// Every composed source parses and validates as WGSL (naga, the front end wgpu uses),
+    /// so a shader error fails without a GPU adapter.
+    #[test]
+    fn every_composed_source_validates() {
+        use crate::shader::passes::*;
+        let mut sources = vec![
+            ("render (buffer)".to_string(), render_source(None)),
+            (
+                "render (rgba16float)".to_string(),
+                render_source(Some("rgba16float")),
+            ),
+            ("sky module".to_string(), sky_module()),
+        ];
+        for pass in [
+            TRANSMITTANCE,
+            DIRECT_IRRADIANCE,
+            SINGLE_SCATTERING,
+            PHASE_KERNELS,
+            SCATTERING_DENSITY_FIELD,
+            SCATTERING_DENSITY,
+            INDIRECT_IRRADIANCE,
+            MULTIPLE_SCATTERING,
+            ORDER_SUMS,
+            ORDER_TAIL_FACTORS,
+            ORDER_TAIL,
+        ] {
+            sources.push((pass.path.to_string(), precompute_source(pass)));
+        }
+        for (name, source) in sources {
+            let module = naga::front::wgsl::parse_str(&source)
+                .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
+            let mut validator = naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::all(),
+            );
+            if let Err(e) = validator.validate(&module) {
+                panic!("{name}: {}", e.emit_to_string(&source));
             }
         }
     }

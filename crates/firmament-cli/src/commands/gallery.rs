@@ -53,7 +53,7 @@ struct View {
     when: Option<(&'static str, f64, f64)>,
     /// A time-lapse strip: this many frames side by side, this many minutes apart.
     strip: Option<(usize, i64)>,
-    /// Over the default scene's terrain (CPU only so far).
+    /// Over the default scene's terrain.
     terrain: bool,
     /// With the planet's procedural surface map (`[surface]`, CPU only so far).
     surface: bool,
@@ -141,10 +141,11 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
     if !args.quiet {
         eprintln!("tables ready in {:.2} s", t.elapsed().as_secs_f64());
     }
-    // The terrain views run on the CPU only so far, with tables of their own whose ground
-    // albedo is the terrain's (as `render` computes them), unless --tables are given.
-    let (terrain, terrain_sky) = match (&sky, terrain_config.clone()) {
-        (RenderSky::Cpu(_), Some(config)) => {
+    // The terrain views have tables of their own whose ground albedo is the terrain's and
+    // whose ground is lifted to its floor (as `render` computes them), unless --tables are
+    // given.
+    let (terrain, terrain_sky) = match terrain_config.clone() {
+        Some(config) => {
             let with = Scene {
                 terrain: Some(config),
                 ..base.clone()
@@ -157,12 +158,7 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
             };
             (terrain, terrain_sky)
         }
-        _ => {
-            if !args.quiet {
-                eprintln!("note: the terrain views are skipped on the GPU (CPU only so far)");
-            }
-            (None, None)
-        }
+        None => (None, None),
     };
     let mut html = String::from(
         "<!doctype html><meta charset=utf-8><title>firmament gallery</title>\n<style>body{background:#111;color:#ddd;font-family:sans-serif}figure{display:inline-block;margin:8px;vertical-align:top;max-width:480px}img{max-width:480px}figcaption{font-size:13px}</style>\n<h1>firmament gallery</h1>\n",

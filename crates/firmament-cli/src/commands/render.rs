@@ -567,14 +567,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 "the planet's surface map ([surface]) renders on the CPU only so far: `--backend cpu` or `auto` render it"
             )
         }
-        Backend::Gpu(_) if scene.terrain.is_some() && args.backend == BackendChoice::Gpu => {
-            anyhow::bail!(
-                "the terrain renders on the CPU only so far: `--backend gpu` needs `--no-terrain` (or a scene without [terrain]); `--backend cpu` or `auto` render it"
-            )
-        }
-        Backend::Gpu(_) if scene.terrain.is_some() || scene.surface.is_some() => {
+        Backend::Gpu(_) if scene.surface.is_some() => {
             if !args.quiet {
-                eprintln!("note: the terrain renders on the CPU only so far: using the CPU");
+                eprintln!(
+                    "note: the planet's surface map renders on the CPU only so far: using the CPU"
+                );
             }
             Backend::Cpu
         }

@@ -75,8 +75,9 @@ struct ViewStart {
     mu_s: f32,
     // r²μ² − ρ², the discriminant of the ground sphere along the ray (≥ 0: the line meets it).
     disc_ground_km2: f32,
-    // Whether the ray starts at the observer (so the slice applies).
+    // Whether the ray starts at the observer (so the slice applies), and how far from it.
     at_observer: bool,
+    offset_km: f32,
 }
 
 fn view_start(o: Observer, light: ViewLight, dir: vec3<f32>, nu: f32) -> ViewStart {
@@ -90,6 +91,7 @@ fn view_start(o: Observer, light: ViewLight, dir: vec3<f32>, nu: f32) -> ViewSta
         s.mu_s = clamp_cosine(light.direction.z);
         s.disc_ground_km2 = s.r_km * s.r_km * s.mu * s.mu - s.rho_km * s.rho_km;
         s.at_observer = true;
+        s.offset_km = 0.0;
         return s;
     }
     // The nearer root of d² + 2 r_c μ d + r_c² − R_t² = 0, positive iff μ < 0; with the
@@ -113,6 +115,7 @@ fn view_start(o: Observer, light: ViewLight, dir: vec3<f32>, nu: f32) -> ViewSta
     s.mu_s = clamp_cosine((rc_km * light.direction.z + d_km * nu) / atm.top_radius_km);
     s.disc_ground_km2 = (atm.bottom_radius_km - p_km) * (atm.bottom_radius_km + p_km);
     s.at_observer = false;
+    s.offset_km = d_km;
     return s;
 }
 

@@ -120,7 +120,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         if (frame.shadow_input != 0u) {
             shadow_km = textureLoad(shadow_lengths, vec2<u32>(x, y), 0).x * 1e-3;
         }
-        out = vec4<f32>(shade(ray.dir, shadow_km) * frame.balance.xyz, 1.0);
+        var rgb: vec3<f32>;
+        if ((terrain.flags & TERRAIN_PRESENT) != 0u) {
+            rgb = shade_scene(ray.dir);
+        } else {
+            rgb = shade(ray.dir, shadow_km);
+        }
+        out = vec4<f32>(rgb * frame.balance.xyz, 1.0);
     }
     write_pixel(i, x, y, out);
 }

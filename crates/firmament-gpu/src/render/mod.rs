@@ -59,6 +59,7 @@ use crate::bruneton4d::atmosphere::groups;
 use crate::device::{f32s, read_back, scoped, staging_buffer};
 use crate::passes::{init, workgroups, Pass, Slot, WORKGROUP};
 use crate::shader::render_source;
+use crate::terrain::{no_terrain_words, GpuTerrain};
 use crate::{GpuContext, GpuError, GpuSky};
 use frame::{light_words, slice_words, FrameConstants, MAX_LIGHTS};
 
@@ -67,8 +68,8 @@ pub const PIXEL_BYTES: u64 = 16;
 /// Rows of a band are a multiple of this, so that every band's offset in the output buffer
 /// (rows × width × 16 bytes) is a multiple of 256, the largest storage-offset alignment.
 const BAND_ROW_ALIGN: usize = 16;
-/// Storage buffers the render pass binds: data, five tables, output, slice.
-const STORAGE_BUFFERS_NEEDED: u32 = 8;
+/// Storage buffers the render pass binds: data, five tables, output, slice, terrain.
+const STORAGE_BUFFERS_NEEDED: u32 = 9;
 
 /// Where a frame goes.
 #[derive(Clone, Copy, Debug)]
@@ -91,6 +92,11 @@ pub struct RenderInputs<'a> {
     pub shadow_lengths: Option<&'a wgpu::TextureView>,
     /// A glow from beyond the atmosphere (the night sky's), seen through the air.
     pub background: Option<&'a firmament::scene::sky_lights::Background>,
+    /// A terrain on the planet (uploaded for the frame's lights): the frame then renders
+    /// `firmament::render::render` of a scene with that terrain (its shadows, light shafts,
+    /// ambient occlusion and the change of the air's light it was given), and ignores
+    /// `shadow_lengths`.
+    pub terrain: Option<&'a GpuTerrain>,
 }
 
 /// A render pipeline (for one output) and its `camera_slice` entry point.
@@ -108,6 +114,8 @@ pub struct GpuRenderer {
     unused_params: wgpu::Buffer,
     /// Binding 16 when no shadowed lengths are given (1×1).
     no_shadow_lengths: wgpu::TextureView,
+    /// Binding 17 when no terrain is given (one word).
+    no_terrain: wgpu::Buffer,
     /// Cap on the output bytes one dispatch writes (None: the device's binding limit).
     max_band_bytes: Option<u64>,
 }
@@ -142,6 +150,8 @@ fn compile(ctx: &GpuContext, output: Slot, format: Option<&str>) -> Pipelines {
             (14, Uniform),
             (15, Uniform),
             (16, Texture),
+            (17, Read),
+            (18, Uniform),
         ],
     );
     Pipelines {
@@ -185,6 +195,7 @@ impl GpuRenderer {
                 rgba16: OnceLock::new(),
                 unused_params: init(device, "unused", &[0; 16], wgpu::BufferUsages::UNIFORM),
                 no_shadow_lengths: texture.create_view(&Default::default()),
+                no_terrain: init(device, "no terrain", &[0; 16], wgpu::BufferUsages::STORAGE),
                 max_band_bytes: None,
             })
         })
@@ -445,6 +456,10 @@ impl GpuRenderer {
             ));
         }
         let pipelines = self.pipelines(ctx, &target)?;
+        let terrain_words = match inputs.terrain {
+            Some(t) => t.uniform_words(sky, lights, settings)?,
+            None => no_terrain_words(),
+        };
         let constants =
             FrameConstants::new(sky, lights.len(), inputs.shadow_lengths.is_some(), settings);
         let device = ctx.device();
@@ -458,6 +473,8 @@ impl GpuRenderer {
                 )
             };
             let light_uniform = uniform("lights", &light_words(sky, lights, inputs.background));
+            let terrain_uniform = uniform("terrain", &terrain_words);
+            let terrain_data = inputs.terrain.map_or(&self.no_terrain, |t| t.data());
             let slice_uniform = uniform("slice coordinates", &slice_words(sky, lights, settings));
             let shadow = inputs.shadow_lengths.unwrap_or(&self.no_shadow_lengths);
             let tables = sky.tables();
@@ -493,6 +510,8 @@ impl GpuRenderer {
                     (14, light_uniform.as_entire_binding()),
                     (15, slice_uniform.as_entire_binding()),
                     (16, wgpu::BindingResource::TextureView(shadow)),
+                    (17, terrain_data.as_entire_binding()),
+                    (18, terrain_uniform.as_entire_binding()),
                 ];
                 let entries: Vec<wgpu::BindGroupEntry> = entries
                     .into_iter()

@@ -28,6 +28,7 @@ pub const STEPS: usize = 32;
 pub const MAX_DISTANCE_M: f64 = 120_000.0;
 
 /// ΔS for one observer.
+#[derive(Clone)]
 pub struct AirVolume {
     observer: Vec3,
     /// The local frame at the observer: east, north, up.
@@ -146,6 +147,17 @@ impl AirVolume {
                 out[k] += w * ((1.0 - f) * a + f * b);
             }
         }
+    }
+
+    /// D per direction (m), `row·AZIMUTHS + column` (for a GPU copy of the volume).
+    pub fn reach_m(&self) -> &[f64] {
+        &self.reach
+    }
+
+    /// ΔS at d_0 … d_J per direction, channel-minor: `(direction·(STEPS + 1) + j)·channels
+    /// + channel` (W·m⁻²·sr⁻¹·nm⁻¹).
+    pub fn values(&self) -> &[f32] {
+        &self.values
     }
 
     /// The observer (m).

@@ -101,6 +101,12 @@ impl<'s> Shader<'s> {
         Ok(shader)
     }
 
+    /// The terrain's change of the air's light along this observer's views, when a surface
+    /// reshapes the planet (what a GPU frame of the same scene adds, `firmament_gpu`).
+    pub fn air_volume(&self) -> Option<&air_volume::AirVolume> {
+        self.air.as_ref()
+    }
+
     /// The lights' disks left out of the sky.
     pub fn without_disks(mut self) -> Shader<'s> {
         self.disks.clear();

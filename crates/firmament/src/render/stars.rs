@@ -9,7 +9,7 @@ use crate::io::ImageRgbF32;
 use crate::math::sphere::ray_intersects_ground;
 use crate::math::Vec3;
 use crate::scene::sky_lights::PointSource;
-use crate::scene::{PreparedCamera, Ray, Scene};
+use crate::scene::{PreparedCamera, Ray, Scene, Surface};
 use crate::sky::{Shadow, SkyView};
 use crate::spectrum::ColourMatrix;
 
@@ -160,19 +160,33 @@ pub fn transmittance_to_space(model: &Model, observer: Vec3, dir: Vec3, out: &mu
 }
 
 /// Adds `points` to `frame`, rendered elsewhere (the GPU) with `settings` for `model`, seen
-/// through the model's own transmittance ([`transmittance_to_space`]).
+/// through the model's own transmittance ([`transmittance_to_space`]), hidden where one of
+/// `occluders` (the terrain) is in the way.
 pub fn draw_points_into(
     frame: &mut super::Frame,
     points: &[PointSource],
     model: &Model,
     settings: &super::RenderSettings,
+    occluders: &[&dyn Surface],
 ) {
     let (w, h) = (settings.width, settings.height);
     let camera = settings.camera.prepare(model.bottom_radius_m, w, h);
     let observer = Vec3::new(0.0, 0.0, model.bottom_radius_m + settings.camera.altitude_m);
     let colour = ColourMatrix::new(model.wavelengths.nm());
-    let transmittance =
-        |dir: Vec3, out: &mut [f64]| transmittance_to_space(model, observer, dir, out);
+    let transmittance = |dir: Vec3, out: &mut [f64]| {
+        let ray = Ray {
+            origin: observer,
+            dir,
+        };
+        if occluders
+            .iter()
+            .any(|s| s.intersect(&ray, f64::INFINITY).is_some())
+        {
+            out.iter_mut().for_each(|v| *v = 0.0);
+            return;
+        }
+        transmittance_to_space(model, observer, dir, out)
+    };
     let view = PointView {
         transmittance: &transmittance,
         camera: &camera,

@@ -1,0 +1,191 @@
+//! CPU–GPU parity over the terrain: the valley scenes rendered by `firmament::render::render`
+//! and by `firmament_gpu::GpuRenderer` with a `GpuTerrain` (the same heightfield, its shadow
+//! fields and the CPU's air volume), compared pixel by pixel in luminance as
+//! `render_parity.rs` does, with the tables' ground lifted to the terrain's floor as `render`
+//! computes them. The GPU walks the same max-mip pyramid and shadow fields in f32; where a
+//! pixel's ray grazes a ridge or crosses a shaft's edge within f32 rounding the two may take
+//! different sides, so the criterion is the mean (≤ 1 %) and the share of pixels over 5 %
+//! (≤ 0.5 %), with the largest difference reported.
+
+mod common;
+
+use firmament::atmosphere::Atmosphere;
+use firmament::math::Vec3;
+use firmament::render::{render, Frame, RenderSettings, Shader};
+use firmament::scene::terrain::{Heightfield, TerrainConfig};
+use firmament::scene::{sun_direction, Projection, Scene};
+use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, TableSizes, Tables};
+use firmament::spectrum::Wavelengths;
+use firmament_gpu::{GpuSky, GpuTerrain, RenderInputs};
+
+use common::*;
+
+/// The default valley at a coarser resolution, and the earth's air with its ground lifted to
+/// the valley's floor (small tables).
+fn valley(config: TerrainConfig) -> (Heightfield, Bruneton4d) {
+    let wavelengths = Wavelengths::rgb();
+    let earth = Atmosphere::earth();
+    let radius = earth.resolve(&wavelengths).unwrap().bottom_radius_m;
+    let terrain = config.build(radius, wavelengths.nm()).unwrap();
+    let lifted = earth.lifted(terrain.floor_m(), &wavelengths).unwrap();
+    let model = lifted.resolve(&wavelengths).unwrap();
+    let config = TableConfig {
+        sizes: TableSizes::small(),
+        ..TableConfig::default()
+    };
+    let tables = Tables::compute(&model, &config).unwrap();
+    (terrain, Bruneton4d::new(model, tables).unwrap())
+}
+
+struct Shot {
+    altitude_m: f64,
+    heading_deg: f64,
+    pitch_deg: f64,
+    fov_deg: f64,
+    sun_zenith_deg: f64,
+    sun_azimuth_deg: f64,
+}
+
+/// Both frames of `shot` over `terrain`; None without an adapter.
+fn frames(
+    name: &str,
+    terrain: &Heightfield,
+    sky: &Bruneton4d,
+    shot: &Shot,
+) -> Option<(Frame, Frame, f64)> {
+    let gpu = gpu(name)?;
+    let _guard = serial();
+    let bottom = sky.model.bottom_radius_m;
+    // SceneFile::camera_over: the altitude above the terrain under the observer.
+    let altitude = shot.altitude_m + terrain.height_at(0.0, 0.0) - (bottom - terrain.radius_m);
+    let camera = camera(
+        Projection::Perspective,
+        altitude,
+        shot.heading_deg,
+        shot.pitch_deg,
+        shot.fov_deg,
+    );
+    let settings = RenderSettings {
+        camera: &camera,
+        width: 192,
+        height: 108,
+        white_balance: false,
+    };
+    let sun = sun_direction(shot.sun_zenith_deg, shot.sun_azimuth_deg);
+    let mut scene = Scene::clear_sky(sky, sun, true);
+    scene.add_terrain(terrain, terrain.radius_m);
+    let cpu = render(&scene, &settings, &|_| {}, None).unwrap();
+    let observer = Vec3::new(0.0, 0.0, bottom + altitude);
+    let shader = Shader::new(&scene, observer).unwrap();
+    let gpu_sky = GpuSky::from_sky(&gpu.ctx, sky).unwrap();
+    let gpu_terrain = GpuTerrain::new(
+        &gpu.ctx,
+        &gpu_sky,
+        terrain,
+        &scene.lights,
+        shader.air_volume(),
+    )
+    .unwrap();
+    let inputs = RenderInputs {
+        terrain: Some(&gpu_terrain),
+        ..RenderInputs::default()
+    };
+    let start = std::time::Instant::now();
+    let frame = gpu
+        .renderer
+        .render_with(&gpu.ctx, &gpu_sky, &scene.lights, &settings, inputs)
+        .unwrap();
+    Some((cpu, frame, start.elapsed().as_secs_f64()))
+}
+
+/// Mean relative difference, share of pixels over 5 %, largest difference and where.
+fn differences(name: &str, cpu: &Frame, gpu: &Frame, seconds: f64) -> (f64, f64, f64) {
+    let (w, h) = (cpu.image.width, cpu.image.height);
+    let (mut sum, mut over, mut worst, mut at) = (0.0, 0usize, 0.0f64, 0usize);
+    for i in 0..w * h {
+        let (c, g) = (luminance(&cpu.image.data[i]), luminance(&gpu.image.data[i]));
+        assert!(g.is_finite(), "{name}: pixel {i} is {g} on the GPU");
+        let rel = (g - c).abs() / c.max(1e-9);
+        sum += rel;
+        if rel > 0.05 {
+            over += 1;
+        }
+        if rel > worst {
+            (worst, at) = (rel, i);
+        }
+    }
+    let n = (w * h) as f64;
+    let (mean, share) = (sum / n, over as f64 / n);
+    eprintln!(
+        "{name}: {w}×{h} mean rel {mean:.2e}, {over} pixels over 5 % ({:.2} %), max {worst:.2e} at ({}, {}) cpu {:.4e} gpu {:.4e}; GPU frame {:.0} ms",
+        share * 100.0,
+        at % w,
+        at / w,
+        luminance(&cpu.image.data[at]),
+        luminance(&gpu.image.data[at]),
+        seconds * 1e3
+    );
+    (mean, share, worst)
+}
+
+fn check(name: &str, terrain: &Heightfield, sky: &Bruneton4d, shot: &Shot) {
+    let Some((cpu, gpu, seconds)) = frames(name, terrain, sky, shot) else {
+        return;
+    };
+    let (mean, share, _) = differences(name, &cpu, &gpu, seconds);
+    assert!(
+        mean <= 0.01,
+        "{name}: mean relative difference {mean:.3e} > 1 %"
+    );
+    assert!(
+        share <= 0.005,
+        "{name}: {:.2} % of the pixels differ by more than 5 %",
+        share * 100.0
+    );
+}
+
+fn coarse_valley() -> TerrainConfig {
+    TerrainConfig {
+        resolution: 257,
+        ..TerrainConfig::default()
+    }
+}
+
+#[test]
+fn golden_hour_valley_with_light_shafts() {
+    let (terrain, sky) = valley(coarse_valley());
+    check(
+        "golden hour",
+        &terrain,
+        &sky,
+        &Shot {
+            altitude_m: 25.0,
+            heading_deg: 250.0,
+            pitch_deg: 6.0,
+            fov_deg: 55.0,
+            sun_zenith_deg: 84.5,
+            sun_azimuth_deg: 237.0,
+        },
+    );
+}
+
+#[test]
+fn noon_valley_from_above_without_shafts() {
+    let (terrain, sky) = valley(TerrainConfig {
+        light_shafts: false,
+        ..coarse_valley()
+    });
+    check(
+        "noon from 3 km, no shafts",
+        &terrain,
+        &sky,
+        &Shot {
+            altitude_m: 3000.0,
+            heading_deg: 20.0,
+            pitch_deg: -20.0,
+            fov_deg: 70.0,
+            sun_zenith_deg: 28.0,
+            sun_azimuth_deg: 175.0,
+        },
+    );
+}
