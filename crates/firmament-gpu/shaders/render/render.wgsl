@@ -120,13 +120,25 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         if (frame.shadow_input != 0u) {
             shadow_km = textureLoad(shadow_lengths, vec2<u32>(x, y), 0).x * 1e-3;
         }
-        var rgb: vec3<f32>;
-        if ((terrain.flags & TERRAIN_PRESENT) != 0u) {
-            rgb = shade_scene(ray.dir);
-        } else {
-            rgb = shade(ray.dir, shadow_km);
-        }
-        out = vec4<f32>(rgb * frame.balance.xyz, 1.0);
+        out = vec4<f32>(shade(ray.dir, shadow_km) * frame.balance.xyz, 1.0);
+    }
+    write_pixel(i, x, y, out);
+}
+
+// The frame over a terrain (render/scene.wgsl): an entry point of its own, so that frames
+// without one carry none of its code.
+@compute @workgroup_size(64)
+fn main_terrain(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = invocation_index(gid, nwg);
+    if (i >= frame.rows * frame.width) {
+        return;
+    }
+    let x = i % frame.width;
+    let y = frame.first_row + i / frame.width;
+    let ray = camera_ray(f32(x) + 0.5, f32(y) + 0.5);
+    var out = vec4<f32>(0.0);
+    if (ray.valid) {
+        out = vec4<f32>(shade_scene(ray.dir) * frame.balance.xyz, 1.0);
     }
     write_pixel(i, x, y, out);
 }

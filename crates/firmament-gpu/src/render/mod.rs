@@ -99,10 +99,12 @@ pub struct RenderInputs<'a> {
     pub terrain: Option<&'a GpuTerrain>,
 }
 
-/// A render pipeline (for one output) and its `camera_slice` entry point.
+/// A render pipeline (for one output), its `camera_slice` entry point, and its
+/// `main_terrain` entry point (compiled on first use).
 struct Pipelines {
     pass: Pass,
     slice: wgpu::ComputePipeline,
+    terrain: OnceLock<wgpu::ComputePipeline>,
 }
 
 /// The render pipelines, compiled once per context (the texture outputs on first use).
@@ -123,6 +125,8 @@ pub struct GpuRenderer {
 /// Everything one frame's dispatches need, built and checked before any work is recorded.
 pub(crate) struct Job<'p> {
     pipelines: &'p Pipelines,
+    /// The pipeline drawing the pixels: `main`, or `main_terrain` over a terrain.
+    main: &'p wgpu::ComputePipeline,
     bind_groups: Vec<wgpu::BindGroup>,
     /// Workgroups (x, y) per band.
     dispatches: Vec<(u32, u32)>,
@@ -157,6 +161,7 @@ fn compile(ctx: &GpuContext, output: Slot, format: Option<&str>) -> Pipelines {
     Pipelines {
         slice: pass.entry_point(device, "camera_slice"),
         pass,
+        terrain: OnceLock::new(),
     }
 }
 
@@ -327,7 +332,7 @@ impl GpuRenderer {
             cpass.set_bind_group(0, bg, &[]);
             cpass.dispatch_workgroups(x, y, z);
         }
-        cpass.set_pipeline(&job.pipelines.pass.pipeline);
+        cpass.set_pipeline(job.main);
         for (bg, &(x, y)) in job.bind_groups.iter().zip(&job.dispatches) {
             cpass.set_bind_group(0, bg, &[]);
             cpass.dispatch_workgroups(x, y, 1);
@@ -456,6 +461,18 @@ impl GpuRenderer {
             ));
         }
         let pipelines = self.pipelines(ctx, &target)?;
+        let main = match inputs.terrain {
+            None => &pipelines.pass.pipeline,
+            Some(_) => match pipelines.terrain.get() {
+                Some(p) => p,
+                None => {
+                    let p = scoped(ctx, "render shader compilation (terrain)", || {
+                        Ok(pipelines.pass.entry_point(ctx.device(), "main_terrain"))
+                    })?;
+                    pipelines.terrain.get_or_init(|| p)
+                }
+            },
+        };
         let terrain_words = match inputs.terrain {
             Some(t) => t.uniform_words(sky, lights, settings)?,
             None => no_terrain_words(),
@@ -532,6 +549,7 @@ impl GpuRenderer {
             });
             Ok(Job {
                 pipelines,
+                main,
                 bind_groups,
                 dispatches,
                 slice,

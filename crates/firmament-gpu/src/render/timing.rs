@@ -34,11 +34,24 @@ impl GpuRenderer {
         settings: &RenderSettings,
         frames: usize,
     ) -> Result<RenderTiming, GpuError> {
+        self.time_render_with(ctx, sky, lights, settings, RenderInputs::default(), frames)
+    }
+
+    /// [`GpuRenderer::time_render`] with extra inputs (a terrain, shadowed lengths).
+    pub fn time_render_with(
+        &self,
+        ctx: &GpuContext,
+        sky: &GpuSky,
+        lights: &[Light],
+        settings: &RenderSettings,
+        inputs: RenderInputs,
+        frames: usize,
+    ) -> Result<RenderTiming, GpuError> {
         let frames = frames.max(1);
         self.check_frame_buffer(ctx, settings)?;
         let output = self.frame_buffer(ctx, settings);
         let target = RenderTarget::Buffer(&output);
-        let job = self.prepare(ctx, sky, lights, settings, target, RenderInputs::default())?;
+        let job = self.prepare(ctx, sky, lights, settings, target, inputs)?;
         let device = ctx.device();
         let timestamps = ctx.supports_timestamps();
         let wait = |during: &str| {

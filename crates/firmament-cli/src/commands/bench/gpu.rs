@@ -5,11 +5,13 @@ use std::time::Instant;
 
 use anyhow::Result;
 use firmament::atmosphere::Model;
-use firmament::render::ToneCurve;
-use firmament::scene::Light;
-use firmament::sky::bruneton4d::TableConfig;
+use firmament::math::Vec3;
+use firmament::render::{RenderSettings, Shader, ToneCurve};
+use firmament::scene::terrain::Heightfield;
+use firmament::scene::{sun_direction, Light, Scene};
+use firmament::sky::bruneton4d::{Bruneton4d, TableConfig};
 use firmament_gpu::Precomputer;
-use firmament_gpu::{GpuRenderer, GpuSky};
+use firmament_gpu::{GpuRenderer, GpuSky, GpuTerrain, RenderInputs};
 
 use super::report::GpuTimings;
 use super::scenes;
@@ -107,5 +109,73 @@ pub fn timings(
         Ok(())
     })?;
     timings.gpu_frame_1080p_perspective_with_readback_s = Some(median(seconds));
+
+    step("1920×1080 terrain frame (the default scene)");
+    let (dispatch, whole) = terrain_timings(gpu, &renderer, &sky, model, config, runs)?;
+    timings.gpu_frame_1080p_terrain_s = Some(dispatch);
+    timings.gpu_frame_1080p_terrain_with_cpu_parts_s = Some(whole);
     Ok(timings)
+}
+
+/// The default scene's frame on the GPU (`cpu_frame_1080p_terrain_s`'s): the dispatch alone
+/// (median of `runs` after a warm-up), and the whole frame with the parts the CPU computes
+/// for it each time (the sun's shadow field, the air volume from the tables read back,
+/// the upload), the readback and the tone mapping.
+fn terrain_timings(
+    gpu: &Gpu,
+    renderer: &GpuRenderer,
+    sky: &GpuSky,
+    model: &Model,
+    config: &TableConfig,
+    runs: usize,
+) -> Result<(f64, f64)> {
+    let ctx = &gpu.ctx;
+    let default = firmament::scene::SceneFile::default();
+    let terrain = default
+        .build_terrain(model)?
+        .expect("the default scene has a terrain");
+    let tables = sky
+        .tables()
+        .read_back(ctx, model, config)
+        .map_err(|e| gpu_failure("reading the tables back", e))?;
+    let cpu_sky = Bruneton4d::new(model.clone(), tables)?;
+    let camera = default.camera_over(Some(&terrain), model.bottom_radius_m);
+    let settings = RenderSettings {
+        camera: &camera,
+        width: 1920,
+        height: 1080,
+        white_balance: false,
+    };
+    let sun = sun_direction(default.sun.zenith_deg, default.sun.azimuth_deg);
+    let lights = [Light::sun(model, sun, true)];
+    let observer = Vec3::new(0.0, 0.0, model.bottom_radius_m + camera.altitude_m);
+    let upload = |terrain: &Heightfield| -> Result<GpuTerrain> {
+        let mut scene = Scene::clear_sky(&cpu_sky, sun, true);
+        scene.add_terrain(terrain, terrain.radius_m);
+        let shader = Shader::new(&scene, observer)?;
+        GpuTerrain::new(ctx, sky, terrain, &lights, shader.air_volume())
+            .map_err(|e| gpu_failure("uploading the terrain", e))
+    };
+    let uploaded = upload(&terrain)?;
+    let inputs = RenderInputs {
+        terrain: Some(&uploaded),
+        ..RenderInputs::default()
+    };
+    let dispatch = renderer
+        .time_render_with(ctx, sky, &lights, &settings, inputs, runs)
+        .map_err(|e| gpu_failure("timing frames", e))?;
+    let seconds = time_runs(runs.clamp(1, 3), || {
+        let terrain = terrain.clone_without_shadows();
+        let uploaded = upload(&terrain)?;
+        let inputs = RenderInputs {
+            terrain: Some(&uploaded),
+            ..RenderInputs::default()
+        };
+        let image = renderer
+            .render_with(ctx, sky, &lights, &settings, inputs)
+            .map_err(|e| gpu_failure("rendering", e))?;
+        let _ = image.to_srgb8(1e-4, ToneCurve::Aces);
+        Ok(())
+    })?;
+    Ok((dispatch.seconds, median(seconds)))
 }

@@ -85,6 +85,13 @@ pub struct GpuTimings {
     pub gpu_frame_1080p_perspective_s: Option<f64>,
     pub gpu_frame_timing_method: Option<String>,
     pub gpu_frame_1080p_perspective_with_readback_s: Option<f64>,
+    /// The default scene (the valley at golden hour, light shafts) at 1920×1080: the render
+    /// dispatch alone, as `gpu_frame_timing_method` says.
+    pub gpu_frame_1080p_terrain_s: Option<f64>,
+    /// The same frame whole: the sun's shadow field and the terrain's change of the air's
+    /// light on the CPU, the upload, the dispatch, the readback and the tone mapping (the
+    /// terrain built and the tables read back once beforehand).
+    pub gpu_frame_1080p_terrain_with_cpu_parts_s: Option<f64>,
 }
 
 impl Machine {
