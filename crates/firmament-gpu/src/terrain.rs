@@ -19,6 +19,7 @@ use firmament::math::Vec3;
 use firmament::render::air_volume::{self, AirVolume};
 use firmament::render::RenderSettings;
 use firmament::scene::terrain::grid::{Grid, MaxPyramid};
+use firmament::scene::terrain::shadow::EDGE_MARGIN;
 use firmament::scene::terrain::{Heightfield, Materials};
 use firmament::scene::Light;
 use firmament::spectrum::MAX_CHANNELS;
@@ -136,6 +137,7 @@ impl GpuTerrain {
         data.extend_from_slice(&vis.values);
         let shafts = terrain.casts_shadows && terrain.shafts;
         let mut shadow = [[NONE; 4]; MAX_LIGHTS];
+        let mut clearance = [[NONE; 4]; MAX_LIGHTS];
         if shafts {
             for (l, light) in lights.iter().enumerate() {
                 let field = terrain.shadow_field(light.direction);
@@ -147,6 +149,8 @@ impl GpuTerrain {
                     push_pyramid(&mut data, p);
                 }
                 shadow[l] = at;
+                clearance[l][0] = data.len() as u32;
+                data.extend_from_slice(&field.clearance.values);
             }
         }
         let air_at = match air {
@@ -222,9 +226,9 @@ impl GpuTerrain {
             bits(zones[0]),
             bits(zones[1]),
             bits(lift_m),
-            0,
+            bits(EDGE_MARGIN),
         ];
-        for at in shadow {
+        for at in shadow.into_iter().chain(clearance) {
             words.extend(at);
         }
         for l in 0..MAX_PYRAMID_LEVELS {

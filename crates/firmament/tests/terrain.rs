@@ -229,6 +229,45 @@ fn lit_segments_match_shadow_rays_along_the_view() {
     );
 }
 
+/// The shadow at the surface from the shadow field where its corners agree (and exact
+/// rays on its edge) against exact shadow rays everywhere, at the ends of random rays on
+/// the rough relief under a low and a high sun.
+#[test]
+fn surface_shadows_from_the_field_match_exact_rays() {
+    let hf = rough(false);
+    let mut rng = Rng::for_key(5, 6, 7, 8);
+    for (zenith, azimuth) in [(84.0, 250.0), (60.0, 120.0)] {
+        let light = sun_direction(zenith, azimuth);
+        let field = hf.shadow_field(light);
+        let (mut ends, mut disagree, mut shadowed) = (0, 0, 0);
+        while ends < 2000 {
+            let ray = random_ray(&mut rng, 900.0);
+            if ray.origin.length() - R <= hf.height_below(ray.origin) + 5.0 {
+                continue;
+            }
+            let Some(hit) = hf.intersect(&ray, 8000.0) else {
+                continue;
+            };
+            let gr = firmament::scene::terrain::grid::GridRay {
+                origin: ray.origin,
+                dir: ray.dir,
+                radius_m: R,
+            };
+            let exact = hf.end_in_shadow(&gr, light, hit.distance_m);
+            let fielded = field.end_in_shadow(&hf, &gr, hit.distance_m);
+            assert!(exact.is_some() && fielded.is_some());
+            ends += 1;
+            shadowed += usize::from(exact == Some(true));
+            disagree += usize::from(exact != fielded);
+        }
+        eprintln!(
+            "sun at {zenith}°: {disagree} of {ends} surface points disagree ({shadowed} in shadow)"
+        );
+        assert!(shadowed > 100, "{shadowed} of {ends} in shadow");
+        assert!(disagree * 200 <= ends, "{disagree} of {ends} disagree");
+    }
+}
+
 /// A wall of rock between the valley and a low sun: the ground behind it gets no direct
 /// light and the air in front of it no single scattering, only the sky's light.
 #[test]

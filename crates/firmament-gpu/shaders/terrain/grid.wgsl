@@ -359,11 +359,21 @@ fn walk_start(ray: GridRay, pyramid: u32, nonzero: u32, floors: u32, t0: f32, t1
     let g0 = ray_grid_xy(ray, clipped.x);
     let g1 = ray_grid_xy(ray, clipped.y);
     w.step = vec2<i32>(sign_of(g1.x - g0.x), sign_of(g1.y - g0.y));
-    w.level = i32(terrain.level_count) - 1;
-    w.i = 0;
-    w.j = 0;
-    w.exits = vec2<f32>(walk_face(&w, 0, 0u), walk_face(&w, 0, 1u));
+    // Start in the cell holding the clipped start (on a line, the one ahead).
+    w.level = 0;
+    w.i = walk_leaf(g0.x, w.step.x, terrain.nx - 1u);
+    w.j = walk_leaf(g0.y, w.step.y, terrain.ny - 1u);
+    w.exits = vec2<f32>(walk_face(&w, w.i, 0u), walk_face(&w, w.j, 1u));
     return w;
+}
+
+// The cell index of grid coordinate g on an axis of `cells` cells, the one ahead on a line.
+fn walk_leaf(g: f32, step: i32, cells: u32) -> i32 {
+    var i = floor(g);
+    if (step < 0 && g == i) {
+        i -= 1.0;
+    }
+    return i32(clamp(i, 0.0, f32(cells - 1u)));
 }
 
 // Walk::half: whether the child holding the point at the walk's parameter is the upper one

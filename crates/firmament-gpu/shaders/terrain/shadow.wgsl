@@ -16,6 +16,7 @@ fn merge_tolerance(t: f32) -> f32 {
 struct LitWalk {
     ray: GridRay,
     light: vec3<f32>,
+    light_index: u32,
     // The shadow field's S offset, and the ray's end (m; ≥ 3e38 for a sky ray).
     field: u32,
     end: f32,
@@ -49,6 +50,7 @@ fn lit_start(ray: GridRay, light_index: u32, light: vec3<f32>, end: f32) -> LitW
     let f = terrain.shadow[light_index];
     lw.ray = ray;
     lw.light = light;
+    lw.light_index = light_index;
     lw.field = f.x;
     lw.end = end;
     lw.lit_from = 0.0;
@@ -73,6 +75,36 @@ fn lit_shadow(lw: ptr<function, LitWalk>, a: f32, b: f32) {
     (*lw).shadowed = true;
 }
 
+// ShadowField::end_in_shadow: at a surface the ray ends on, the field's verdict where the
+// signed clearance at the four corners of the end's cell agrees by the margin, an exact
+// shadow ray (heightfield.wgsl) near the shadow's edge and off the grid; −1 when the ray
+// does not end on a surface.
+fn field_end_in_shadow(lw: ptr<function, LitWalk>, light_index: u32) -> i32 {
+    let end = (*lw).end;
+    if (end >= 3.0e38) {
+        return -1;
+    }
+    let ray = (*lw).ray;
+    let g = ray_grid_xy(ray, end);
+    if (grid_contains(g)) {
+        let i = min(u32(floor(g.x)), terrain.nx - 2u);
+        let j = min(u32(floor(g.y)), terrain.ny - 2u);
+        let hc = corners(terrain.heights, i, j);
+        let ab = fractions(g, i, j);
+        if (ray_height(ray, end) <= bilinear(hc, ab.x, ab.y) + 0.5) {
+            let margin = terrain.zones.w * terrain.spacing_m;
+            let c = corners(terrain.clearance[light_index].x, i, j);
+            if (all(c < vec4<f32>(-margin))) {
+                return 0;
+            }
+            if (all(c > vec4<f32>(margin))) {
+                return 1;
+            }
+        }
+    }
+    return end_in_shadow(ray, (*lw).light, end);
+}
+
 // ShadowField::shadowed_intervals's ending: the shadow at a surface the ray ends on comes
 // from an exact shadow ray (cut where the field's interpolated edge reaches a lit surface,
 // added where the exact ray hides an end the field lit); then the last lit run.
@@ -80,7 +112,7 @@ fn lit_finish(lw: ptr<function, LitWalk>) {
     let end = (*lw).end;
     let near_end = end - merge_tolerance(end);
     let touches = (*lw).shadowed && (*lw).lit_from >= near_end;
-    let exact = end_in_shadow((*lw).ray, (*lw).light, end);
+    let exact = field_end_in_shadow(lw, (*lw).light_index);
     if (exact == 0 && touches) {
         var cut = (*lw).piece.x;
         if ((*lw).whole) {

@@ -30,11 +30,14 @@ struct Terrain {
     visibility_ny: u32,
     visibility_spacing_m: f32,
     air: u32,
-    // Materials: snow line, tree line (m); the tables' ground above the sphere (m).
+    // Materials: snow line, tree line (m); the tables' ground above the sphere (m); the
+    // shadow fields' edge margin (in cells' spacing, shadow::EDGE_MARGIN).
     zones: vec4<f32>,
     // Per light: offsets of its shadow heights S, their pyramid, the pyramid of the raise
     // S − H and of −S (NONE where the light has no field).
     shadow: array<vec4<u32>, MAX_LIGHTS>,
+    // Per light: the offset of its signed clearance (ShadowField::clearance) in x.
+    clearance: array<vec4<u32>, MAX_LIGHTS>,
     // Per pyramid level: cells along x′, along y′, offset from a pyramid's start.
     levels: array<vec4<u32>, MAX_PYRAMID_LEVELS>,
     // Per channel group: the albedo of snow, rock, grass, forest (the uniform albedo in the

@@ -99,6 +99,13 @@ impl Grid {
         bilinear(self.corners(i, j), a, b)
     }
 
+    /// Bilinear interpolation at grid coordinates (clamped) of `f` of the corner values.
+    pub fn bilinear_of(&self, gx: f64, gy: f64, f: impl Fn(f64) -> f64) -> f64 {
+        let (i, a) = split(gx, self.nx);
+        let (j, b) = split(gy, self.ny);
+        bilinear(self.corners(i, j).map(f), a, b)
+    }
+
     /// The gradient (∂/∂x′, ∂/∂y′ per metre) at grid coordinates: central differences at the
     /// vertices, interpolated bilinearly (a smooth normal for shading).
     pub fn gradient(&self, gx: f64, gy: f64) -> (f64, f64) {
@@ -419,22 +426,32 @@ impl<'a> Walk<'a> {
             let (a1, b1) = ray.line(grid, 1.0, along_y);
             [a0, a1 - a0, b0, b1 - b0]
         };
+        let step = [sign(x1 - x0), sign(y1 - y0)];
+        // Start in the cell holding the clipped start (on a line, the one ahead): the
+        // ancestors of that cell are where a walk from the top would descend first.
+        let leaf = |g: f64, step: i64, cells: usize| {
+            let mut i = g.floor();
+            if step < 0 && g == i {
+                i -= 1.0;
+            }
+            i.clamp(0.0, (cells - 1) as f64) as i64
+        };
         let mut walk = Walk {
             pyramid,
             nonzero,
             floors,
             ray,
             lines: [line(false), line(true)],
-            level: pyramid.levels.len() - 1,
-            i: 0,
-            j: 0,
+            level: 0,
+            i: leaf(x0, step[0], grid.nx - 1),
+            j: leaf(y0, step[1], grid.ny - 1),
             t: a,
             exits: [f64::INFINITY; 2],
             end: b,
-            step: [sign(x1 - x0), sign(y1 - y0)],
+            step,
             done: clipped.is_none(),
         };
-        walk.exits = [walk.face(0, 0), walk.face(0, 1)];
+        walk.exits = [walk.face(walk.i, 0), walk.face(walk.j, 1)];
         walk
     }
 

@@ -43,6 +43,10 @@ pub struct ShadowField {
     raised: MaxPyramid,
     /// The pyramid of −S: a node the ray crosses below its lowest S is in shadow whole.
     floors: MaxPyramid,
+    /// The signed height (m) of the sweep's shadow line above the terrain at each vertex:
+    /// positive in shadow (the raise), negative in light (how far below the terrain the
+    /// shadow line passes), on the terrain's grid.
+    pub clearance: Grid,
     light: Vec3,
 }
 
@@ -51,18 +55,32 @@ impl ShadowField {
     pub fn new(terrain: &Heightfield, light: Vec3) -> ShadowField {
         let grid = &terrain.heights;
         let mut heights = grid.clone();
+        // Far below any shadow: a vertex of a vertical light, or one the sweep leaves lit
+        // with no terrain towards the light.
+        let mut clearance = Grid {
+            values: vec![-CLEARANCE_CAP_M as f32; grid.values.len()],
+            ..grid.clone()
+        };
         let horizontal = (light.x * light.x + light.y * light.y).sqrt();
         if horizontal > VERTICAL_LIGHT_RAD {
             let raise = sweep(terrain, [light.x / horizontal, light.y / horizontal], light);
             heights
                 .values
                 .par_chunks_mut(grid.nx)
+                .zip(clearance.values.par_chunks_mut(grid.nx))
                 .enumerate()
-                .for_each(|(j, row)| {
-                    for (i, s) in row.iter_mut().enumerate() {
+                .for_each(|(j, (row, clear))| {
+                    for (i, (s, c)) in row.iter_mut().zip(clear.iter_mut()).enumerate() {
                         let (u, v) = grid.plane_coords(i as f64, j as f64);
-                        if let Some(d) = raise.value_at(u, v) {
-                            *s += d.max(0.0) as f32;
+                        let (gx, gy) = raise.cell_coords(u, v);
+                        if raise.contains(gx, gy) {
+                            // The raise interpolated from the sweep's non-negative values
+                            // (S ≥ H exactly where the sweep found light), the signed
+                            // clearance from its signed ones.
+                            let d = raise.bilinear(gx, gy);
+                            let up = raise.bilinear_of(gx, gy, |v| v.max(0.0));
+                            *s += up as f32;
+                            *c = d as f32;
                         }
                     }
                 });
@@ -78,6 +96,7 @@ impl ShadowField {
             raised: MaxPyramid::new(&raise),
             floors: MaxPyramid::new(&negated),
             heights,
+            clearance,
             pyramid,
             light,
         }
@@ -142,7 +161,7 @@ impl ShadowField {
             last_piece = (cell.t0, cell.t1);
             last_whole = false;
         }
-        let Some(shadowed) = terrain.end_in_shadow(ray, self.light, max_distance_m) else {
+        let Some(shadowed) = self.end_in_shadow(terrain, ray, max_distance_m) else {
             return;
         };
         let touches = out.len() > first && out.last().unwrap().1 >= max_distance_m * (1.0 - 1e-9);
@@ -176,6 +195,55 @@ impl ShadowField {
     }
 }
 
+impl ShadowField {
+    /// When `ray` ends at `max_distance_m` on a surface, whether the light is hidden there:
+    /// from the field where the four corners of the end's cell agree by a margin (the
+    /// shadow line passes more than [`EDGE_MARGIN`] cells' spacing above the terrain at all
+    /// of them: in shadow; as far below at all of them: lit), from an exact shadow ray
+    /// ([`Heightfield::end_in_shadow`]) near the shadow's edge and off the grid. The margin
+    /// covers the sweep's error on the shadow line (its samples at 1/[`SWEEP_REFINE`] of a
+    /// cell); what it cannot see is a shadow (or a gap of light) narrower than a cell
+    /// passing between all four vertices (`tests/terrain.rs` counts the disagreements
+    /// with exact rays).
+    pub fn end_in_shadow(
+        &self,
+        terrain: &Heightfield,
+        ray: &GridRay,
+        max_distance_m: f64,
+    ) -> Option<bool> {
+        if !max_distance_m.is_finite() {
+            return None;
+        }
+        let grid = &self.clearance;
+        let (gx, gy, h) = ray.grid_point(grid, max_distance_m);
+        if grid.contains(gx, gy) {
+            let (i, j) = (
+                (gx.floor() as usize).min(grid.nx - 2),
+                (gy.floor() as usize).min(grid.ny - 2),
+            );
+            let hc = terrain.heights.corners(i, j);
+            let (a, b) = super::grid::fractions(gx, gy, i, j);
+            if h <= super::grid::bilinear(hc, a, b) + 0.5 {
+                let margin = EDGE_MARGIN * grid.spacing_m;
+                let c = grid.corners(i, j);
+                if c.iter().all(|&d| d < -margin) {
+                    return Some(false);
+                }
+                if c.iter().all(|&d| d > margin) {
+                    return Some(true);
+                }
+            }
+        }
+        terrain.end_in_shadow(ray, self.light, max_distance_m)
+    }
+}
+
+/// The margin of [`ShadowField::end_in_shadow`], in cells' spacing (of height).
+pub const EDGE_MARGIN: f64 = 0.2;
+
+/// The sweep's signed raise stops this far (m) below the terrain.
+const CLEARANCE_CAP_M: f64 = 1.0e4;
+
 /// Append [a, b] to `out[first..]`, merging it with the last interval when they touch.
 fn push_merged(out: &mut Vec<(f64, f64)>, first: usize, a: f64, b: f64) {
     if out.len() > first {
@@ -188,8 +256,9 @@ fn push_merged(out: &mut Vec<(f64, f64)>, first: usize, a: f64, b: f64) {
     out.push((a, b));
 }
 
-/// The raise D = S − H on a grid rotated so that x′ points along `azimuth` (unit, in the
-/// tangent plane) and covering the terrain's rectangle.
+/// The signed raise D = S − H on a grid rotated so that x′ points along `azimuth` (unit, in
+/// the tangent plane) and covering the terrain's rectangle: where negative, how far below
+/// the terrain the shadow line from the light's side passes (down to −[`CLEARANCE_CAP_M`]).
 fn sweep(terrain: &Heightfield, azimuth: [f64; 2], light: Vec3) -> Grid {
     let grid = &terrain.heights;
     let r = terrain.radius_m;
@@ -239,7 +308,7 @@ fn sweep(terrain: &Heightfield, azimuth: [f64; 2], light: Vec3) -> Grid {
                     f64::NEG_INFINITY
                 };
                 let s_here = h.max(carried);
-                row[i] = (s_here - h) as f32;
+                row[i] = (carried - h).max(-CLEARANCE_CAP_M) as f32;
                 s_next = s_here;
             }
         });
