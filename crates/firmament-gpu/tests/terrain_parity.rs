@@ -189,3 +189,94 @@ fn noon_valley_from_above_without_shafts() {
         },
     );
 }
+
+/// The views `tools/terrain_accuracy.py` measures against the reference (the golden-hour
+/// valley's sky through the shafts, the terrain near and far), each rendered on the GPU as a
+/// 1×1 frame aimed at it and compared with the CPU's shading of the same ray (what
+/// `query --scene` answers): the GPU path's error against the reference is the CPU path's
+/// within these differences.
+#[test]
+fn accuracy_views_match_the_cpu_shading() {
+    let name = "accuracy views";
+    let Some(gpu) = gpu(name) else {
+        return;
+    };
+    let (terrain, sky) = valley(coarse_valley());
+    let _guard = serial();
+    let bottom = sky.model.bottom_radius_m;
+    let altitude = 25.0 + terrain.height_at(0.0, 0.0) - (bottom - terrain.radius_m);
+    let (sun_zenith, sun_azimuth) = (84.5, 237.0);
+    let sun = sun_direction(sun_zenith, sun_azimuth);
+    let mut scene = Scene::clear_sky(&sky, sun, false);
+    scene.add_terrain(&terrain, terrain.radius_m);
+    let observer = Vec3::new(0.0, 0.0, bottom + altitude);
+    let shader = Shader::new(&scene, observer).unwrap();
+    let gpu_sky = GpuSky::from_sky(&gpu.ctx, &sky).unwrap();
+    let gpu_terrain = GpuTerrain::new(
+        &gpu.ctx,
+        &gpu_sky,
+        &terrain,
+        &scene.lights,
+        shader.air_volume(),
+    )
+    .unwrap();
+    let colour = firmament::spectrum::ColourMatrix::new(sky.model.wavelengths.nm());
+    let mut scratch = firmament::render::ShadeScratch::default();
+    let (mut worst, mut sum, mut count) = (0.0f64, 0.0, 0);
+    for zenith in [60.0, 75.0, 82.0, 86.0, 88.5, 90.2, 92.0, 95.0, 100.0] {
+        for azimuth in [205.0, 225.0, 245.0, 260.0, 290.0, 330.0] {
+            let dir = firmament::math::direction_from_zenith_azimuth(
+                f64::to_radians(zenith),
+                f64::to_radians(azimuth),
+            );
+            if dir.dot(sun).acos().to_degrees() < 3.0 {
+                continue;
+            }
+            let mut l = [0.0; 3];
+            shader.shade(
+                &firmament::scene::Ray {
+                    origin: observer,
+                    dir,
+                },
+                &mut scratch,
+                &mut l,
+            );
+            let cpu = colour.to_srgb(&l);
+            let camera = camera(
+                Projection::Perspective,
+                altitude,
+                azimuth,
+                90.0 - zenith,
+                0.01,
+            );
+            let settings = RenderSettings {
+                camera: &camera,
+                width: 1,
+                height: 1,
+                white_balance: false,
+            };
+            let inputs = RenderInputs {
+                terrain: Some(&gpu_terrain),
+                ..RenderInputs::default()
+            };
+            let frame = gpu
+                .renderer
+                .render_with(&gpu.ctx, &gpu_sky, &scene.lights, &settings, inputs)
+                .unwrap();
+            let (c, g) = (
+                luminance(&[cpu[0] as f32, cpu[1] as f32, cpu[2] as f32]),
+                luminance(&frame.image.data[0]),
+            );
+            let rel = (g - c).abs() / c;
+            worst = worst.max(rel);
+            sum += rel;
+            count += 1;
+        }
+    }
+    eprintln!(
+        "{name}: {count} views, mean relative luminance difference {:.2e}, largest {worst:.2e}",
+        sum / count as f64
+    );
+    assert!(count >= 50);
+    assert!(worst <= 0.01, "a view differs by {worst:.3e}");
+}
