@@ -76,6 +76,14 @@ pub trait Relief: Send + Sync {
     fn top_m(&self) -> f64;
     /// The height (m above the sphere) at plane coordinates (u, v).
     fn height_m(&self, u: f64, v: f64) -> f64;
+    /// The lowest height (m above the sphere) over (u, v) at which a light in direction
+    /// `light` (unit) is seen past the relief, as its shafts in the air are drawn: the
+    /// height of the relief itself where it is lit (and where its shadows in the air are
+    /// not drawn, as the air there is lit).
+    fn shadow_height_m(&self, light: Vec3, u: f64, v: f64) -> f64 {
+        let _ = light;
+        self.height_m(u, v)
+    }
 }
 
 /// A borrowed surface is a surface (a scene can hold a terrain built once for many frames).

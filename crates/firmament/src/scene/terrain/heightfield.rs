@@ -340,4 +340,12 @@ impl Relief for Heightfield {
     fn height_m(&self, u: f64, v: f64) -> f64 {
         self.height_at(u, v)
     }
+
+    fn shadow_height_m(&self, light: Vec3, u: f64, v: f64) -> f64 {
+        let ground = self.height_at(u, v);
+        if !(self.casts_shadows && self.shafts) {
+            return ground;
+        }
+        (self.shadow_field(light).heights.value_at(u, v)).map_or(ground, |s| s.max(ground))
+    }
 }
