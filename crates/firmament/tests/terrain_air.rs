@@ -99,7 +99,7 @@ fn the_field_matches_the_integral_done_point_by_point() {
     let (scene, observer) = golden_hour(sky, &terrain);
     let (with, plain) = (
         Shader::new(&scene, observer).unwrap(),
-        Shader::plain(&scene, observer).unwrap(),
+        Shader::plain(&scene, observer).unwrap().with_sky_domes(),
     );
     // As the field's ceiling (the relief's top and twice its highest level).
     let ceiling = terrain.radius_m + terrain.max_height_m() + 7200.0;
@@ -169,7 +169,7 @@ fn the_valley_at_golden_hour_matches_the_reference() {
     let sun = scene.lights[0].direction;
     let (with, plain) = (
         Shader::new(&scene, observer).unwrap(),
-        Shader::plain(&scene, observer).unwrap(),
+        Shader::plain(&scene, observer).unwrap().with_sky_domes(),
     );
     let surfaces: Vec<Box<dyn Surface + '_>> = vec![Box::new(&terrain)];
     let settings = ReferenceSettings {

@@ -38,7 +38,9 @@ use crate::scene::{Ray, Relief, Scene};
 use crate::spectrum::MAX_CHANNELS;
 use crate::Result;
 
+use super::sky_dome::SkyDome;
 use super::{ShadeScratch, Shader};
+use std::sync::Arc;
 
 /// Columns of the field along each side of the relief's rectangle.
 pub const COLUMNS: usize = 13;
@@ -134,7 +136,7 @@ pub fn scattering_change(
     let model = scene.sky.model();
     let n = model.channels();
     let smooth = smooth_scene(scene);
-    let with = Shader::plain(scene, x)?.without_disks();
+    let with = Shader::plain(scene, x)?.without_disks().with_sky_domes();
     let without = Shader::plain(&smooth, x)?;
     let directions: Vec<Vec3> = dirs.iter().map(|d| d.0).collect();
     let mut dl = vec![0.0; directions.len() * n];
@@ -184,8 +186,9 @@ pub struct AirField<'a> {
 
 impl<'a> AirField<'a> {
     /// The field of `scene`'s first surface with a relief, under its lights; None when no
-    /// surface has one.
-    pub fn new(scene: &'a Scene) -> Result<Option<AirField<'a>>> {
+    /// surface has one. `domes`: the sky's radiance per light for the terrain's shading
+    /// ([`Shader::with_domes`]).
+    pub fn new(scene: &'a Scene, domes: Option<Arc<Vec<SkyDome>>>) -> Result<Option<AirField<'a>>> {
         let Some(relief) = scene.surfaces.iter().find_map(|s| s.relief()) else {
             return Ok(None);
         };
@@ -213,7 +216,9 @@ impl<'a> AirField<'a> {
                 let (column, level) = (p / LEVELS_M.len(), p % LEVELS_M.len());
                 let (u, v) = column_plane(bounds, column % COLUMNS, column / COLUMNS);
                 let x = plane_point(radius, u, v, ground[column] + LEVELS_M[level]);
-                let with = Shader::plain(scene, x)?.without_disks();
+                let with = Shader::plain(scene, x)?
+                    .without_disks()
+                    .with_domes(domes.clone());
                 let without = Shader::plain(&smooth, x)?;
                 let mut dl = vec![0.0; per_point];
                 radiance_change(&with, &without, x, &directions, &mut dl);
