@@ -27,12 +27,37 @@ use crate::spectrum::MAX_CHANNELS;
 /// Azimuths sampled per sector.
 const SUBSECTORS: usize = 12;
 
-/// Elevation nodes (degrees, 0 to 90): close near the horizon and the low sun.
+/// Elevation nodes (degrees): uniform pieces [start, end) with their steps, closest near
+/// the horizon and the low sun; the last node is 90°.
+const PIECES: [(f64, f64, f64); 3] = [(0.0, 20.0, 0.5), (20.0, 50.0, 1.5), (50.0, 90.0, 2.5)];
+
+/// Nodes in each piece.
+fn piece_len(p: (f64, f64, f64)) -> usize {
+    ((p.1 - p.0) / p.2).round() as usize
+}
+
+/// Elevation nodes (degrees, 0 to 90).
 fn nodes_deg() -> Vec<f64> {
-    let mut e: Vec<f64> = (0..40).map(|i| 0.5 * i as f64).collect();
-    e.extend((0..20).map(|i| 20.0 + 1.5 * i as f64));
-    e.extend((0..=15).map(|i| 50.0 + 40.0 * i as f64 / 15.0));
+    let mut e: Vec<f64> = (PIECES.iter())
+        .flat_map(|&p| (0..piece_len(p)).map(move |i| p.0 + p.2 * i as f64))
+        .collect();
+    e.push(90.0);
     e
+}
+
+/// The node below elevation `b` (rad, in [0, 90°)) and the fraction towards the next.
+fn node_of(b: f64) -> (usize, f64) {
+    let d = b.to_degrees();
+    let mut first = 0;
+    for p in PIECES {
+        if d < p.1 {
+            let x = (d - p.0).max(0.0) / p.2;
+            let i = (x as usize).min(piece_len(p) - 1);
+            return (first + i, x - i as f64);
+        }
+        first += piece_len(p);
+    }
+    (first - 1, 1.0)
 }
 
 /// The sky's radiance moments per sector (module doc) for one light.
@@ -45,6 +70,8 @@ pub struct SkyDome {
     moments: Vec<f64>,
     /// Σ_k M_k,up(0): the open plane's irradiance per channel.
     open: [f64; MAX_CHANNELS],
+    /// (cos θ_k, sin θ_k) of each sector's centre.
+    centres: [(f64, f64); HORIZON_AZIMUTHS],
 }
 
 impl SkyDome {
@@ -98,6 +125,10 @@ impl SkyDome {
             nodes,
             moments,
             open,
+            centres: std::array::from_fn(|k| {
+                let (s, c) = (width * k as f64).sin_cos();
+                (c, s)
+            }),
         }
     }
 
@@ -113,33 +144,31 @@ impl SkyDome {
     ) {
         let n = self.channels;
         let m = self.nodes.len();
-        let width = std::f64::consts::TAU / HORIZON_AZIMUTHS as f64;
         // The normal in the local frame: east and north as the world's x and y, made
         // perpendicular to `up`.
         let east = (Vec3::X - up * up.x).normalize_or_zero();
         let north = up.cross(east);
         let (ne, nn, nu) = (normal.dot(east), normal.dot(north), normal.dot(up));
         let mut sum = [0.0; MAX_CHANNELS];
-        for (k, &beta) in horizon.iter().enumerate() {
-            let theta = width * k as f64;
-            // Where the surface's plane cuts the sky at the sector's centre: n·ω = 0.
-            let a = ne * theta.cos() + nn * theta.sin();
-            let e0 = (-a).atan2(nu).max(0.0);
-            let b = beta.max(e0);
-            if b >= self.nodes[m - 1] {
+        for (k, (&beta, &(cos_t, sin_t))) in horizon.iter().zip(&self.centres).enumerate() {
+            // Where the surface's plane cuts the sky at the sector's centre: n·ω = 0, at
+            // e₀ = atan(−a/n_up) (below the horizon when a ≥ 0).
+            let a = ne * cos_t + nn * sin_t;
+            let b = if a < 0.0 {
+                beta.max((-a).atan2(nu))
+            } else {
+                beta
+            };
+            if b >= std::f64::consts::FRAC_PI_2 {
                 continue;
             }
-            let j = self.nodes.partition_point(|&e| e <= b).clamp(1, m - 1) - 1;
-            let f = (b - self.nodes[j]) / (self.nodes[j + 1] - self.nodes[j]);
-            let at = |node: usize, axis: usize, c: usize| {
-                self.moments[((k * m + node) * 3 + axis) * n + c]
-            };
+            let (j, f) = node_of(b);
+            let lo = &self.moments[(k * m + j) * 3 * n..][..3 * n];
+            let hi = &self.moments[(k * m + j + 1) * 3 * n..][..3 * n];
             for c in 0..n {
-                let v: f64 = [ne, nn, nu]
-                    .iter()
-                    .enumerate()
-                    .map(|(axis, w)| w * ((1.0 - f) * at(j, axis, c) + f * at(j + 1, axis, c)))
-                    .sum();
+                let v = ne * (lo[c] + f * (hi[c] - lo[c]))
+                    + nn * (lo[n + c] + f * (hi[n + c] - lo[n + c]))
+                    + nu * (lo[2 * n + c] + f * (hi[2 * n + c] - lo[2 * n + c]));
                 sum[c] += v.max(0.0);
             }
         }

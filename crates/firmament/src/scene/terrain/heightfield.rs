@@ -313,16 +313,10 @@ impl Surface for Heightfield {
     }
 
     fn horizon(&self, hit: &SurfaceHit, out: &mut [f64; HORIZON_AZIMUTHS]) -> bool {
-        let (Some(ao), Some((u, v))) = (&self.occlusion, self.plane_of(hit.position)) else {
-            return false;
-        };
-        for (o, h) in out.iter_mut().zip(&ao.horizons) {
-            match h.value_at(u, v) {
-                Some(b) => *o = b,
-                None => return false,
-            }
+        match (&self.occlusion, self.plane_of(hit.position)) {
+            (Some(ao), Some((u, v))) => ao.horizons_at(u, v, out),
+            _ => false,
         }
-        true
     }
 
     fn relief(&self) -> Option<&dyn Relief> {

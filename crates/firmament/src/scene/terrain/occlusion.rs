@@ -34,8 +34,38 @@ pub struct Occlusion {
     /// The visibility of the sky (0 to 1) relative to an open plane of the same tilt.
     pub visibility: Grid,
     /// The horizon's elevation (rad, ≥ 0) towards azimuth k, the direction
-    /// (cos 2πk/K, sin 2πk/K) in (east, north), K = [`AZIMUTHS`].
-    pub horizons: Vec<Grid>,
+    /// (cos 2πk/K, sin 2πk/K) in (east, north), K = [`AZIMUTHS`], at each of the
+    /// visibility grid's vertices (`(j·nx + i)·K + k`: one vertex's together).
+    pub horizons: Vec<f32>,
+}
+
+impl Occlusion {
+    /// The horizons at plane coordinates (u, v), interpolated bilinearly, into `out`; false
+    /// off the grid.
+    pub fn horizons_at(&self, u: f64, v: f64, out: &mut [f64; AZIMUTHS]) -> bool {
+        let g = &self.visibility;
+        let (gx, gy) = g.cell_coords(u, v);
+        if !g.contains(gx, gy) {
+            return false;
+        }
+        let (i, a) = split(gx, g.nx);
+        let (j, b) = split(gy, g.ny);
+        let at = |i: usize, j: usize| &self.horizons[(j * g.nx + i) * AZIMUTHS..][..AZIMUTHS];
+        let (c00, c10, c01, c11) = (at(i, j), at(i + 1, j), at(i, j + 1), at(i + 1, j + 1));
+        for k in 0..AZIMUTHS {
+            let low = c00[k] as f64 + (c10[k] - c00[k]) as f64 * a;
+            let high = c01[k] as f64 + (c11[k] - c01[k]) as f64 * a;
+            out[k] = low + (high - low) * b;
+        }
+        true
+    }
+}
+
+/// Cell index and fraction of grid coordinate `g` on `n` vertices (clamped).
+fn split(g: f64, n: usize) -> (usize, f64) {
+    let g = g.clamp(0.0, (n - 1) as f64);
+    let i = (g.floor() as usize).min(n - 2);
+    (i, g - i as f64)
 }
 
 /// The [`Occlusion`] at every `stride`-th vertex of `heights` (both ways) on a planet of
@@ -111,19 +141,9 @@ pub fn occlusion(heights: &Grid, radius_m: f64, stride: usize) -> Occlusion {
                 };
             }
         });
-    let horizons = (0..AZIMUTHS)
-        .map(|k| {
-            let mut g = coarse(0.0);
-            g.values
-                .iter_mut()
-                .zip(betas.chunks(AZIMUTHS))
-                .for_each(|(v, b)| *v = b[k]);
-            g
-        })
-        .collect();
     Occlusion {
         visibility: out,
-        horizons,
+        horizons: betas,
     }
 }
 
@@ -169,8 +189,11 @@ mod tests {
         let v = pit.visibility.at(20, 20);
         assert!((0.49..0.67).contains(&v), "{v}");
         // The horizons: the wall's top seen from the centre, 35.5° to 45° every way.
-        for h in &pit.horizons {
-            let b = h.at(20, 20).to_degrees();
+        let mut h = [0.0; AZIMUTHS];
+        let (u, v) = pit.visibility.plane_coords(20.0, 20.0);
+        assert!(pit.horizons_at(u, v, &mut h));
+        for b in h {
+            let b = b.to_degrees();
             assert!((35.0..45.1).contains(&b), "{b}");
         }
     }
