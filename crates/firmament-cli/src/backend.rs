@@ -378,9 +378,10 @@ impl<'a> RenderSky<'a> {
         }
     }
 
-    /// `terrain` on the device for a GPU frame: its shadow fields for the frame's lights and,
-    /// when it changes the air's light, the observer's air volume, both computed on the CPU
-    /// (the tables read back from the device for it, once).
+    /// `terrain` on the device for a GPU frame: its shadow fields for the frame's lights,
+    /// the sky's radiance under its horizons and, when it changes the air's light, the
+    /// observer's air volume, all computed on the CPU (the tables read back from the device
+    /// for them, once).
     fn gpu_terrain(
         &self,
         terrain: &Heightfield,
@@ -399,31 +400,26 @@ impl<'a> RenderSky<'a> {
         else {
             unreachable!("gpu_terrain is called for GPU skies")
         };
-        let bar = spinner("the terrain's shadows and air light (CPU)", quiet);
-        let air = if terrain.air_light && !sources.lights.is_empty() {
-            let cpu = match cpu_sky.get() {
-                Some(c) => c,
-                None => {
-                    let tables = sky
-                        .tables()
-                        .read_back(&gpu.ctx, sky_model, config)
-                        .map_err(|e| gpu_failure("reading the tables back", e))?;
-                    let _ = cpu_sky.set(Bruneton4d::new(sky_model.as_ref().clone(), tables)?);
-                    cpu_sky.get().expect("just set")
-                }
-            };
-            let scene = cpu_scene(cpu, sources, Some(terrain), None);
-            let observer = Vec3::new(
-                0.0,
-                0.0,
-                sky_model.bottom_radius_m + settings.camera.altitude_m,
-            );
-            let shader = firmament::render::Shader::new(&scene, observer)?;
-            shader.air_volume().cloned()
-        } else {
-            None
+        let bar = spinner("the terrain's shadows, sky and air light (CPU)", quiet);
+        let cpu = match cpu_sky.get() {
+            Some(c) => c,
+            None => {
+                let tables = sky
+                    .tables()
+                    .read_back(&gpu.ctx, sky_model, config)
+                    .map_err(|e| gpu_failure("reading the tables back", e))?;
+                let _ = cpu_sky.set(Bruneton4d::new(sky_model.as_ref().clone(), tables)?);
+                cpu_sky.get().expect("just set")
+            }
         };
-        let uploaded = GpuTerrain::new(&gpu.ctx, sky, terrain, &sources.lights, air.as_ref())
+        let scene = cpu_scene(cpu, sources, Some(terrain), None);
+        let observer = Vec3::new(
+            0.0,
+            0.0,
+            sky_model.bottom_radius_m + settings.camera.altitude_m,
+        );
+        let shader = firmament::render::Shader::new(&scene, observer)?;
+        let uploaded = GpuTerrain::new(&gpu.ctx, sky, terrain, &shader)
             .map_err(|e| gpu_failure("uploading the terrain", e));
         bar.finish_and_clear();
         uploaded

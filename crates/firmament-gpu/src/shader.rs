@@ -4,7 +4,8 @@
 //! Rust twin with the same name and function names (see `docs/architecture.md`).
 
 use firmament::math::quadrature::GL4;
-use firmament::render::air_volume;
+use firmament::render::{air_volume, sky_dome};
+use firmament::scene::surface::HORIZON_AZIMUTHS;
 use firmament::sky::bruneton4d::precompute::{
     DENSITY_PHI, DENSITY_THETA, HARMONICS, IRRADIANCE_PHI, IRRADIANCE_THETA, KERNEL_STEPS,
     RAY_INTERVALS, TRANSMITTANCE_SEGMENTS,
@@ -108,22 +109,24 @@ pub const BRUNETON4D_VIEW: [Module; 2] = [
     module!("bruneton4d/view_point.wgsl"),
 ];
 
-/// The terrain: its bindings, the grid and its walk, the surface, the materials, the shadow
-/// fields.
-pub const TERRAIN: [Module; 5] = [
+/// The terrain: its bindings, the grid and its walk, the surface, the materials, the
+/// horizons, the shadow fields.
+pub const TERRAIN: [Module; 6] = [
     module!("terrain/terrain.wgsl"),
     module!("terrain/grid.wgsl"),
     module!("terrain/heightfield.wgsl"),
     module!("terrain/materials.wgsl"),
+    module!("terrain/occlusion.wgsl"),
     module!("terrain/shadow.wgsl"),
 ];
 
 /// The renderer's modules: lights, cameras, the air volume, the scene over the terrain, the
 /// frame.
-pub const RENDER: [Module; 5] = [
+pub const RENDER: [Module; 6] = [
     module!("render/light.wgsl"),
     module!("render/camera.wgsl"),
     module!("render/air_volume.wgsl"),
+    module!("render/sky_dome.wgsl"),
     module!("render/scene.wgsl"),
     module!("render/render.wgsl"),
 ];
@@ -178,9 +181,21 @@ pub fn prelude() -> String {
         ("AIR_AZIMUTHS", air_volume::AZIMUTHS),
         ("AIR_ELEVATIONS", air_volume::ELEVATIONS),
         ("AIR_STEPS", air_volume::STEPS),
+        ("HORIZON_AZIMUTHS", HORIZON_AZIMUTHS),
     ] {
         s += &u(name, v);
     }
+    s += &format!(
+        "const DOME_PIECES = array<vec3<f32>, {}>({});\n",
+        sky_dome::PIECES.len(),
+        (sky_dome::PIECES.iter())
+            .map(|p| format!(
+                "vec3<f32>({:?}, {:?}, {:?})",
+                p.0 as f32, p.1 as f32, p.2 as f32
+            ))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
     let n = GL4.nodes.len();
     s += &format!(
         "const GL4_NODES = array<f32, {n}>({});\nconst GL4_WEIGHTS = array<f32, {n}>({});\n",

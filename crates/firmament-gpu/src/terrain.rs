@@ -1,7 +1,8 @@
-//! The terrain on the GPU: a [`Heightfield`] with its max-mip pyramid, its sky visibility,
-//! each light's shadow-height field with its three pyramids (computed on the CPU by the
-//! sweep, `scene::terrain::shadow`) and the observer's air volume
-//! (`render::air_volume`, computed on the CPU) packed into one storage buffer, and the
+//! The terrain on the GPU: a [`Heightfield`] with its max-mip pyramid, its sky visibility
+//! and horizons, each light's shadow-height field with its three pyramids and clearance
+//! (computed on the CPU by the sweep, `scene::terrain::shadow`), each light's sky dome
+//! (`render::sky_dome`) and the observer's air volume (`render::air_volume`), both from the
+//! CPU's [`Shader`], packed into one storage buffer, and the
 //! uniform that says where each part lies (`shaders/terrain/terrain.wgsl`). The render pass
 //! walks them as the CPU does (`shaders/terrain/`: grid, heightfield, shadow, materials) in
 //! f32, in metres relative to the observer's foot.
@@ -9,15 +10,16 @@
 //! ```no_run
 //! # fn demo(ctx: &firmament_gpu::GpuContext, sky: &firmament_gpu::GpuSky,
 //! #         terrain: &firmament::scene::terrain::Heightfield,
-//! #         lights: &[firmament::scene::Light]) -> Result<(), firmament_gpu::GpuError> {
-//! let gpu_terrain = firmament_gpu::GpuTerrain::new(ctx, sky, terrain, lights, None)?;
+//! #         shader: &firmament::render::Shader) -> Result<(), firmament_gpu::GpuError> {
+//! // `shader`: Shader::new of the CPU scene with the terrain, from the frame's observer.
+//! let gpu_terrain = firmament_gpu::GpuTerrain::new(ctx, sky, terrain, shader)?;
 //! let inputs = firmament_gpu::RenderInputs { terrain: Some(&gpu_terrain), ..Default::default() };
 //! # let _ = inputs; Ok(()) }
 //! ```
 
 use firmament::math::Vec3;
-use firmament::render::air_volume::{self, AirVolume};
-use firmament::render::RenderSettings;
+use firmament::render::air_volume;
+use firmament::render::{RenderSettings, Shader};
 use firmament::scene::terrain::grid::{Grid, MaxPyramid};
 use firmament::scene::terrain::shadow::EDGE_MARGIN;
 use firmament::scene::terrain::{Heightfield, Materials};
@@ -46,9 +48,10 @@ pub const TERRAIN_OCCLUSION: u32 = 8;
 pub const TERRAIN_UNIFORM_ALBEDO: u32 = 16;
 /// "No field here" (`NONE` in WGSL).
 const NONE: u32 = u32::MAX;
-/// Bytes of the `Terrain` uniform.
+/// Words of the `Terrain` uniform: seven vec4 rows, two per light, the pyramid's levels and
+/// the albedo rows.
 pub(crate) const UNIFORM_WORDS: usize =
-    4 * (6 + MAX_LIGHTS + MAX_PYRAMID_LEVELS) + 4 * TERRAIN_ALBEDO_VEC4;
+    4 * (7 + 2 * MAX_LIGHTS + MAX_PYRAMID_LEVELS) + 4 * TERRAIN_ALBEDO_VEC4;
 
 /// A terrain, its lights' shadow fields and the observer's air volume, on the device.
 pub struct GpuTerrain {
@@ -90,17 +93,18 @@ fn bits(x: f64) -> u32 {
 }
 
 impl GpuTerrain {
-    /// Upload `terrain` for frames lit by `lights` (their shadow fields computed here on the
-    /// CPU when the terrain casts light shafts), with the observer's `air` volume (the
-    /// terrain's change of the air's light, `Shader::air_volume`) when given, for the
-    /// tables of `sky`.
+    /// Upload `terrain` for frames prepared by `shader` (the CPU's [`Shader`] of the same
+    /// scene from the frame's observer, over the tables of `sky`): its lights' shadow
+    /// fields (computed here on the CPU when the terrain casts light shafts), its air volume
+    /// (the terrain's change of the air's light) and its sky domes (the sky's radiance under
+    /// the terrain's horizons), those it has.
     pub fn new(
         ctx: &GpuContext,
         sky: &GpuSky,
         terrain: &Heightfield,
-        lights: &[Light],
-        air: Option<&AirVolume>,
+        shader: &Shader,
     ) -> Result<GpuTerrain, GpuError> {
+        let lights: Vec<&Light> = shader.lights().collect();
         if lights.len() > MAX_LIGHTS {
             return Err(firmament::Error::invalid(
                 "lights",
@@ -128,18 +132,31 @@ impl GpuTerrain {
         let pyramid = data.len() as u32;
         let levels = push_pyramid(&mut data, terrain.pyramid());
         let visibility = data.len() as u32;
-        let vis = terrain.visibility.clone().unwrap_or(Grid {
-            values: vec![1.0; 4],
-            nx: 2,
-            ny: 2,
-            ..grid.clone()
-        });
+        let occlusion = terrain.occlusion.as_ref();
+        let vis = occlusion.map_or(
+            Grid {
+                values: vec![1.0; 4],
+                nx: 2,
+                ny: 2,
+                ..grid.clone()
+            },
+            |o| o.visibility.clone(),
+        );
         data.extend_from_slice(&vis.values);
+        let horizons = match occlusion {
+            Some(o) => {
+                let at = data.len() as u32;
+                data.extend_from_slice(&o.horizons);
+                at
+            }
+            None => NONE,
+        };
         let shafts = terrain.casts_shadows && terrain.shafts;
         let mut shadow = [[NONE; 4]; MAX_LIGHTS];
-        let mut clearance = [[NONE; 4]; MAX_LIGHTS];
-        if shafts {
-            for (l, light) in lights.iter().enumerate() {
+        // Per light: the clearance's offset, the sky dome's.
+        let mut per_light = [[NONE; 4]; MAX_LIGHTS];
+        for (l, light) in lights.iter().enumerate() {
+            if shafts {
                 let field = terrain.shadow_field(light.direction);
                 let s = data.len() as u32;
                 data.extend_from_slice(&field.heights.values);
@@ -149,11 +166,20 @@ impl GpuTerrain {
                     push_pyramid(&mut data, p);
                 }
                 shadow[l] = at;
-                clearance[l][0] = data.len() as u32;
+                per_light[l][0] = data.len() as u32;
                 data.extend_from_slice(&field.clearance.values);
             }
+            if let (Some(dome), Some(_)) = (shader.sky_domes().and_then(|d| d.get(l)), occlusion) {
+                per_light[l][1] = data.len() as u32;
+                data.extend(dome.moments().iter().map(|&v| v as f32));
+                data.extend(dome.open().iter().map(|&v| v as f32));
+            }
         }
-        let air_at = match air {
+        let dome_nodes = shader
+            .sky_domes()
+            .and_then(|d| d.first())
+            .map_or(0, |d| d.node_count() as u32);
+        let air_at = match shader.air_volume() {
             Some(a) => {
                 let at = data.len() as u32;
                 data.extend(a.reach_m().iter().map(|&d| d as f32));
@@ -176,7 +202,7 @@ impl GpuTerrain {
         if shafts {
             flags |= TERRAIN_SHAFTS;
         }
-        if terrain.visibility.is_some() {
+        if occlusion.is_some() {
             flags |= TERRAIN_OCCLUSION;
         }
         let mut albedo = vec![0.0f32; 4 * TERRAIN_ALBEDO_VEC4];
@@ -227,8 +253,12 @@ impl GpuTerrain {
             bits(zones[1]),
             bits(lift_m),
             bits(EDGE_MARGIN),
+            horizons,
+            dome_nodes,
+            0,
+            0,
         ];
-        for at in shadow.into_iter().chain(clearance) {
+        for at in shadow.into_iter().chain(per_light) {
             words.extend(at);
         }
         for l in 0..MAX_PYRAMID_LEVELS {
@@ -236,7 +266,7 @@ impl GpuTerrain {
             words.extend([w, h, o, 0]);
         }
         words.extend(albedo.iter().map(|v| v.to_bits()));
-        debug_assert_eq!(words.len(), UNIFORM_WORDS);
+        assert_eq!(words.len(), UNIFORM_WORDS, "the Terrain uniform's layout");
         let data = scoped(ctx, "uploading the terrain", || {
             Ok(init(
                 ctx.device(),

@@ -78,14 +78,7 @@ fn frames(
     let observer = Vec3::new(0.0, 0.0, bottom + altitude);
     let shader = Shader::new(&scene, observer).unwrap();
     let gpu_sky = GpuSky::from_sky(&gpu.ctx, sky).unwrap();
-    let gpu_terrain = GpuTerrain::new(
-        &gpu.ctx,
-        &gpu_sky,
-        terrain,
-        &scene.lights,
-        shader.air_volume(),
-    )
-    .unwrap();
+    let gpu_terrain = GpuTerrain::new(&gpu.ctx, &gpu_sky, terrain, &shader).unwrap();
     let inputs = RenderInputs {
         terrain: Some(&gpu_terrain),
         ..RenderInputs::default()
@@ -212,14 +205,7 @@ fn accuracy_views_match_the_cpu_shading() {
     let observer = Vec3::new(0.0, 0.0, bottom + altitude);
     let shader = Shader::new(&scene, observer).unwrap();
     let gpu_sky = GpuSky::from_sky(&gpu.ctx, &sky).unwrap();
-    let gpu_terrain = GpuTerrain::new(
-        &gpu.ctx,
-        &gpu_sky,
-        &terrain,
-        &scene.lights,
-        shader.air_volume(),
-    )
-    .unwrap();
+    let gpu_terrain = GpuTerrain::new(&gpu.ctx, &gpu_sky, &terrain, &shader).unwrap();
     let colour = firmament::spectrum::ColourMatrix::new(sky.model.wavelengths.nm());
     let mut scratch = firmament::render::ShadeScratch::default();
     let (mut worst, mut sum, mut count) = (0.0f64, 0.0, 0);

@@ -142,13 +142,21 @@ fn shade_scene(dir: vec3<f32>) -> vec3<f32> {
     var weights: MaterialWeights;
     var visible_sky = 1.0;
     var altitude_km = 0.0;
+    // The terrain's horizons at the hit, for the sky's light weighted by its radiance
+    // (render/sky_dome.wgsl) in place of the uniform sky's visibility.
+    var horizons: Horizons;
+    var domes = false;
     if (hit.hit) {
         let height_m = ray_height(ray, hit.t_m);
         altitude_km = (height_m - terrain.zones.z) * 1e-3;
         if (hit.terrain) {
             let slope = degrees(acos(clamp(dot(hit.normal, hit.up), -1.0, 1.0)));
             weights = material_weights(hit.q.xy, height_m, slope);
-            visible_sky = sky_visibility(hit.q);
+            horizons = horizons_at(hit.q);
+            domes = horizons.valid && terrain.per_light[0].y != NONE;
+            if (!domes) {
+                visible_sky = sky_visibility(hit.q);
+            }
         }
     }
     var acc: array<vec4<f32>, MAX_CHANNEL_GROUPS>;
@@ -175,7 +183,16 @@ fn shade_scene(dir: vec3<f32>) -> vec3<f32> {
                 if (hit.terrain) {
                     albedo = terrain_albedo(weights, k);
                 }
-                let e = point_irradiance(g, k);
+                var e = point_irradiance(g, k);
+                if (domes) {
+                    // The sky's light under the horizon, weighted by its radiance, in place of
+                    // the open plane's (1 + n·up)/2.
+                    var f = vec4<f32>(0.0);
+                    if (g.occlusion > 0.0) {
+                        f = dome_share(light, hit.up, hit.normal, horizons, k) / g.occlusion;
+                    }
+                    e.sky *= f;
+                }
                 let direct = select(vec4<f32>(0.0), e.direct * light_irradiance(light, k), lit_at_end);
                 let t = point_transmittance(pray, endp, k);
                 let l = acc[k] * scale + albedo / PI * (direct + visible_sky * e.sky * scale) * t;

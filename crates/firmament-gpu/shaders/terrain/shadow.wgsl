@@ -93,7 +93,7 @@ fn field_end_in_shadow(lw: ptr<function, LitWalk>, light_index: u32) -> i32 {
         let ab = fractions(g, i, j);
         if (ray_height(ray, end) <= bilinear(hc, ab.x, ab.y) + 0.5) {
             let margin = terrain.zones.w * terrain.spacing_m;
-            let c = corners(terrain.clearance[light_index].x, i, j);
+            let c = corners(terrain.per_light[light_index].x, i, j);
             if (all(c < vec4<f32>(-margin))) {
                 return 0;
             }

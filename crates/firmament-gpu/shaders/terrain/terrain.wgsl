@@ -33,11 +33,18 @@ struct Terrain {
     // Materials: snow line, tree line (m); the tables' ground above the sphere (m); the
     // shadow fields' edge margin (in cells' spacing, shadow::EDGE_MARGIN).
     zones: vec4<f32>,
+    // The horizons' offset (HORIZON_AZIMUTHS per visibility vertex, rad; NONE without) and
+    // the sky domes' elevation nodes.
+    horizons: u32,
+    dome_nodes: u32,
+    pad0: u32,
+    pad1: u32,
     // Per light: offsets of its shadow heights S, their pyramid, the pyramid of the raise
     // S − H and of −S (NONE where the light has no field).
     shadow: array<vec4<u32>, MAX_LIGHTS>,
-    // Per light: the offset of its signed clearance (ShadowField::clearance) in x.
-    clearance: array<vec4<u32>, MAX_LIGHTS>,
+    // Per light: the offsets of its signed clearance (ShadowField::clearance) and of its sky
+    // dome (render::sky_dome::SkyDome: the moments, then the open plane's irradiance).
+    per_light: array<vec4<u32>, MAX_LIGHTS>,
     // Per pyramid level: cells along x′, along y′, offset from a pyramid's start.
     levels: array<vec4<u32>, MAX_PYRAMID_LEVELS>,
     // Per channel group: the albedo of snow, rock, grass, forest (the uniform albedo in the

@@ -9,6 +9,7 @@
 
 pub mod air_volume;
 pub mod frame;
+pub mod sky_dome;
 pub mod stars;
 pub mod terrain_air;
 pub mod tonemap;
@@ -16,6 +17,7 @@ mod volumes;
 
 use std::f64::consts::PI;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Arc;
 
 use rayon::prelude::*;
 
@@ -23,7 +25,7 @@ pub use frame::Frame;
 pub use tonemap::ToneCurve;
 
 use crate::io::ImageRgbF32;
-use crate::scene::surface::lit_intervals;
+use crate::scene::surface::{lit_intervals, HORIZON_AZIMUTHS};
 use crate::scene::{Camera, Projection, Ray, Scene};
 use crate::sky::{Shadow, SkyView};
 use crate::spectrum::{with_channel_buffers, ColourMatrix, MAX_CHANNELS};
@@ -76,6 +78,9 @@ pub struct Shader<'s> {
     /// The terrain's change of the air's light along this observer's views, when a surface
     /// reshapes the planet ([`terrain_air`]).
     air: Option<air_volume::AirVolume>,
+    /// The sky's radiance per light for the irradiance of surfaces under a horizon
+    /// ([`sky_dome`]); none: their [`crate::scene::Surface::sky_visibility`] alone.
+    domes: Option<Arc<Vec<sky_dome::SkyDome>>>,
 }
 
 /// Per-thread scratch space of [`Shader::shade`] (no allocation per pixel).
@@ -89,10 +94,10 @@ impl<'s> Shader<'s> {
     /// The views of `scene`'s sky method from `observer`, one per light, and the terrain's
     /// change of the air's light ([`terrain_air`]) when a surface has a relief.
     pub fn new(scene: &'s Scene<'s>, observer: crate::math::Vec3) -> Result<Shader<'s>> {
-        let mut shader = Shader::plain(scene, observer)?;
+        let mut shader = Shader::plain(scene, observer)?.with_sky_domes();
         // (A scene without lights has no air light to change.)
         if let Some(view) = shader.views.first() {
-            if let Some(field) = terrain_air::AirField::new(scene)? {
+            if let Some(field) = terrain_air::AirField::new(scene, shader.domes.clone())? {
                 let model = scene.sky.model();
                 let volume = air_volume::AirVolume::new(&field, view.as_ref(), model, observer);
                 shader.air = Some(volume);
@@ -105,6 +110,32 @@ impl<'s> Shader<'s> {
     /// reshapes the planet (what a GPU frame of the same scene adds, `firmament_gpu`).
     pub fn air_volume(&self) -> Option<&air_volume::AirVolume> {
         self.air.as_ref()
+    }
+
+    /// The sky domes, one per light, when the shader has them ([`Shader::with_sky_domes`]).
+    pub fn sky_domes(&self) -> Option<&[sky_dome::SkyDome]> {
+        self.domes.as_deref().map(Vec::as_slice)
+    }
+
+    /// The lights, in the order of the scene's (the views').
+    pub fn lights(&self) -> impl Iterator<Item = &crate::scene::Light> {
+        self.views.iter().map(|v| v.light())
+    }
+
+    /// With the sky's radiance per light from this shader's observer ([`sky_dome`]), for
+    /// the irradiance of surfaces under a horizon.
+    pub fn with_sky_domes(self) -> Shader<'s> {
+        let domes = (self.views.iter())
+            .map(|v| sky_dome::SkyDome::new(v.as_ref(), self.channels))
+            .collect();
+        self.with_domes(Some(Arc::new(domes)))
+    }
+
+    /// With the sky domes `domes` (one per light, from [`Shader::with_sky_domes`] of a
+    /// shader nearby: the sky's shape changes little over a terrain).
+    pub fn with_domes(mut self, domes: Option<Arc<Vec<sky_dome::SkyDome>>>) -> Shader<'s> {
+        self.domes = domes;
+        self
     }
 
     /// The lights' disks left out of the sky.
@@ -133,6 +164,7 @@ impl<'s> Shader<'s> {
             disks,
             channels,
             air: None,
+            domes: None,
         })
     }
 
@@ -147,14 +179,30 @@ impl<'s> Shader<'s> {
         let hit = scene.nearest_hit(ray, f64::INFINITY);
         let end = hit.map_or(f64::INFINITY, |(_, h)| h.distance_m);
         match hit {
-            Some((i, hit)) => with_channel_buffers(n, |[l, t, albedo, direct, sky]| {
-                scene.surfaces[i].albedo(&hit, albedo);
-                let visible_sky = scene.surfaces[i].sky_visibility(&hit);
-                for view in &self.views {
+            Some((i, hit)) => with_channel_buffers(n, |[l, t, albedo, direct, sky, share]| {
+                let surface = &scene.surfaces[i];
+                surface.albedo(&hit, albedo);
+                let mut horizon = [0.0; HORIZON_AZIMUTHS];
+                let domes = (self.domes.as_ref()).filter(|_| surface.horizon(&hit, &mut horizon));
+                let visible_sky = match domes {
+                    Some(_) => 1.0,
+                    None => surface.sky_visibility(&hit),
+                };
+                let up = hit.position.normalize();
+                for (j, view) in self.views.iter().enumerate() {
                     let (shadow, lit_at_end) = self.shadow(ray, view.light(), end, scratch);
                     view.sun_and_sky_irradiance(hit.position, hit.normal, direct, sky);
                     if !lit_at_end {
                         direct.iter_mut().for_each(|v| *v = 0.0);
+                    }
+                    if let Some(domes) = domes {
+                        // The sky's light under the horizon, weighted by its radiance, in
+                        // place of the open plane's (1 + n·up)/2 that the sky method applied.
+                        domes[j].share(up, hit.normal, &horizon, share);
+                        let open = 0.5 * (1.0 + hit.normal.dot(up));
+                        for k in 0..n {
+                            sky[k] *= if open > 0.0 { share[k] / open } else { 0.0 };
+                        }
                     }
                     view.sky_radiance_to_point(hit.position, shadow, l, t);
                     // A specular lobe (the sea's glint) on the direct beam.

@@ -34,11 +34,13 @@ use rayon::prelude::*;
 use crate::atmosphere::groups::{AEROSOLS, MOLECULES};
 use crate::math::lattice::band_directions;
 use crate::math::Vec3;
-use crate::scene::{Ray, Scene};
+use crate::scene::{Ray, Relief, Scene};
 use crate::spectrum::MAX_CHANNELS;
 use crate::Result;
 
+use super::sky_dome::SkyDome;
 use super::{ShadeScratch, Shader};
+use std::sync::Arc;
 
 /// Columns of the field along each side of the relief's rectangle.
 pub const COLUMNS: usize = 13;
@@ -134,7 +136,7 @@ pub fn scattering_change(
     let model = scene.sky.model();
     let n = model.channels();
     let smooth = smooth_scene(scene);
-    let with = Shader::plain(scene, x)?.without_disks();
+    let with = Shader::plain(scene, x)?.without_disks().with_sky_domes();
     let without = Shader::plain(&smooth, x)?;
     let directions: Vec<Vec3> = dirs.iter().map(|d| d.0).collect();
     let mut dl = vec![0.0; directions.len() * n];
@@ -162,13 +164,18 @@ pub fn scattering_change(
 
 /// ΔL on a grid over a relief (module doc): at each point, for each direction of
 /// [`quadrature`], per channel.
-pub struct AirField {
+pub struct AirField<'a> {
+    relief: &'a dyn Relief,
+    /// The first light's direction (unit), whose shadow the field's heights follow.
+    light: Option<Vec3>,
     /// The planet's radius (m).
     radius_m: f64,
     /// The relief's rectangle [u_min, v_min, u_max, v_max] in the plane (m).
     bounds: [f64; 4],
     /// The ground's height (m) at each column, row-major.
     ground: Vec<f64>,
+    /// The first light's shadow height (m, [`Relief::shadow_height_m`]) at each column.
+    shadow: Vec<f64>,
     channels: usize,
     /// The directions and their solid angles (sr).
     dirs: Vec<(Vec3, f64)>,
@@ -177,10 +184,11 @@ pub struct AirField {
     radiance: Vec<f32>,
 }
 
-impl AirField {
+impl<'a> AirField<'a> {
     /// The field of `scene`'s first surface with a relief, under its lights; None when no
-    /// surface has one.
-    pub fn new(scene: &Scene) -> Result<Option<AirField>> {
+    /// surface has one. `domes`: the sky's radiance per light for the terrain's shading
+    /// ([`Shader::with_domes`]).
+    pub fn new(scene: &'a Scene, domes: Option<Arc<Vec<SkyDome>>>) -> Result<Option<AirField<'a>>> {
         let Some(relief) = scene.surfaces.iter().find_map(|s| s.relief()) else {
             return Ok(None);
         };
@@ -208,7 +216,9 @@ impl AirField {
                 let (column, level) = (p / LEVELS_M.len(), p % LEVELS_M.len());
                 let (u, v) = column_plane(bounds, column % COLUMNS, column / COLUMNS);
                 let x = plane_point(radius, u, v, ground[column] + LEVELS_M[level]);
-                let with = Shader::plain(scene, x)?.without_disks();
+                let with = Shader::plain(scene, x)?
+                    .without_disks()
+                    .with_domes(domes.clone());
                 let without = Shader::plain(&smooth, x)?;
                 let mut dl = vec![0.0; per_point];
                 radiance_change(&with, &without, x, &directions, &mut dl);
@@ -217,10 +227,20 @@ impl AirField {
                 }
                 Ok(())
             })?;
+        let light = lights.first().copied();
+        let shadow = (0..COLUMNS * COLUMNS)
+            .map(|c| {
+                let (u, v) = column_plane(bounds, c % COLUMNS, c / COLUMNS);
+                light.map_or(ground[c], |l| relief.shadow_height_m(l, u, v))
+            })
+            .collect();
         Ok(Some(AirField {
+            relief,
+            light,
             radius_m: radius,
             bounds,
             ground,
+            shadow,
             channels: n,
             dirs,
             radiance,
@@ -248,10 +268,20 @@ impl AirField {
             .collect()
     }
 
-    /// ΔJ(x, v) into `out` (per channel): the field interpolated trilinearly at x (zero
-    /// off the relief's rectangle, fading to zero over as much again above the highest
-    /// level), scattered with `weights` (from [`Self::phase_weights`] for v) and `sigma`,
-    /// the molecules' and the aerosols' scattering coefficients at x (m⁻¹).
+    /// ΔJ(x, v) into `out` (per channel): the field interpolated at x (zero off the
+    /// relief's rectangle, fading to zero over as much again above the highest level),
+    /// scattered with `weights` (from [`Self::phase_weights`] for v) and `sigma`, the
+    /// molecules' and the aerosols' scattering coefficients at x (m⁻¹).
+    ///
+    /// Bilinear between the four columns around x; in each column, linear between the
+    /// levels at the height over the column's shadow height S (the first light's,
+    /// [`Relief::shadow_height_m`]; the ground where it is lit) that x has over its own.
+    /// ΔL jumps at the shadow's edge, far more sharply than the columns resolve: a point in
+    /// the shadow loses the aureole the ridge hides round the light, and its rays towards
+    /// the light run through shadowed air before they reach the lit air; a point above the
+    /// edge keeps both. So each column is read on the same side of its shadow's edge, as
+    /// far from it, as x. Where the light reaches the ground, S is the ground and this is
+    /// the height above it.
     pub fn scattering_change_at(
         &self,
         x: Vec3,
@@ -277,8 +307,9 @@ impl AirField {
         );
         let (fx, fy) = (gx - i as f64, gy - j as f64);
         let height = x.length() - self.radius_m;
+        let above_shadow = height - self.shadow_height_m(u, v);
         let per_point = self.dirs.len() * n;
-        // The phase-weighted sums Σ_q w_q p_g ΔL_q at the eight corners, interpolated.
+        // The phase-weighted sums Σ_q w_q p_g ΔL_q at the points, interpolated.
         let mut sums = [[0.0; MAX_CHANNELS]; 2];
         for (di, dj, w) in [
             (0, 0, (1.0 - fx) * (1.0 - fy)),
@@ -287,9 +318,13 @@ impl AirField {
             (1, 1, fx * fy),
         ] {
             let column = (j + dj) * COLUMNS + i + di;
-            let (l, f, fade) = level_of(height - self.ground[column]);
-            for (level, wl) in [(l, 1.0 - f), (l + 1, f)] {
-                let w = w * fade * wl;
+            let w = w * fade(height - self.ground[column]);
+            if w == 0.0 {
+                continue;
+            }
+            let h = self.shadow[column] + above_shadow - self.ground[column];
+            for (level, wl) in level_of(h) {
+                let w = w * wl;
                 if w == 0.0 {
                     continue;
                 }
@@ -308,21 +343,36 @@ impl AirField {
             out[k] = sigma[0][k] * sums[0][k] + sigma[1][k] * sums[1][k];
         }
     }
+
+    /// The first light's shadow height at (u, v) (m above the sphere).
+    fn shadow_height_m(&self, u: f64, v: f64) -> f64 {
+        match self.light {
+            Some(l) => self.relief.shadow_height_m(l, u, v),
+            None => self.relief.height_m(u, v),
+        }
+    }
 }
 
-/// The lower level, the fraction towards the next, and a fade (1 up to the highest level,
-/// then down to 0 over as much again) for a height (m) above the ground.
-fn level_of(h: f64) -> (usize, f64, f64) {
+/// The two levels that bracket a height `h` (m above the ground) and their weights: linear
+/// between them, the nearest alone beyond the lowest or the highest.
+fn level_of(h: f64) -> [(usize, f64); 2] {
     let top = LEVELS_M.len() - 1;
     if h <= LEVELS_M[0] {
-        return (0, 0.0, 1.0);
+        return [(0, 1.0), (0, 0.0)];
     }
     if h >= LEVELS_M[top] {
-        let fade = (2.0 - h / LEVELS_M[top]).clamp(0.0, 1.0);
-        return (top - 1, 1.0, fade);
+        return [(top, 1.0), (top, 0.0)];
     }
     let l = LEVELS_M.partition_point(|&a| a <= h) - 1;
-    (l, (h - LEVELS_M[l]) / (LEVELS_M[l + 1] - LEVELS_M[l]), 1.0)
+    let f = (h - LEVELS_M[l]) / (LEVELS_M[l + 1] - LEVELS_M[l]);
+    [(l, 1.0 - f), (l + 1, f)]
+}
+
+/// 1 up to the field's highest level (m above the ground), then down to 0 over as much
+/// again.
+fn fade(h: f64) -> f64 {
+    let top = LEVELS_M[LEVELS_M.len() - 1];
+    (2.0 - h / top).clamp(0.0, 1.0)
 }
 
 /// Plane coordinates of column (i, j) of a rectangle.

@@ -18,6 +18,9 @@ pub struct SurfaceHit {
     pub normal: Vec3,
 }
 
+/// Azimuths of [`Surface::horizon`] (the terrain's, `scene::terrain::occlusion`).
+pub const HORIZON_AZIMUTHS: usize = crate::scene::terrain::occlusion::AZIMUTHS;
+
 /// A surface in the scene.
 pub trait Surface: Send + Sync {
     /// The nearest hit of `ray` at a distance in (0, `max_distance_m`).
@@ -49,6 +52,16 @@ pub trait Surface: Send + Sync {
         1.0
     }
 
+    /// The horizon's elevation (rad, ≥ 0) that the rest of this surface makes around `hit`
+    /// towards azimuth k, the direction (cos 2πk/K, sin 2πk/K) in (east, north), K =
+    /// [`HORIZON_AZIMUTHS`], into `out`: the sky below it is hidden (a renderer weights it
+    /// by the sky's radiance, `render::sky_dome`). False by default: no horizon but the
+    /// surface's own plane, or [`Surface::sky_visibility`] alone.
+    fn horizon(&self, hit: &SurfaceHit, out: &mut [f64; HORIZON_AZIMUTHS]) -> bool {
+        let _ = (hit, out);
+        false
+    }
+
     /// The relief this surface gives the planet, when it reshapes it enough to change the
     /// light of the air around it (`render::terrain_air`); None by default.
     fn relief(&self) -> Option<&dyn Relief> {
@@ -76,6 +89,14 @@ pub trait Relief: Send + Sync {
     fn top_m(&self) -> f64;
     /// The height (m above the sphere) at plane coordinates (u, v).
     fn height_m(&self, u: f64, v: f64) -> f64;
+    /// The lowest height (m above the sphere) over (u, v) at which a light in direction
+    /// `light` (unit) is seen past the relief, as its shafts in the air are drawn: the
+    /// height of the relief itself where it is lit (and where its shadows in the air are
+    /// not drawn, as the air there is lit).
+    fn shadow_height_m(&self, light: Vec3, u: f64, v: f64) -> f64 {
+        let _ = light;
+        self.height_m(u, v)
+    }
 }
 
 /// A borrowed surface is a surface (a scene can hold a terrain built once for many frames).
@@ -97,6 +118,9 @@ impl<T: Surface + ?Sized> Surface for &T {
     }
     fn sky_visibility(&self, hit: &SurfaceHit) -> f64 {
         (**self).sky_visibility(hit)
+    }
+    fn horizon(&self, hit: &SurfaceHit, out: &mut [f64; HORIZON_AZIMUTHS]) -> bool {
+        (**self).horizon(hit, out)
     }
     fn relief(&self) -> Option<&dyn Relief> {
         (**self).relief()

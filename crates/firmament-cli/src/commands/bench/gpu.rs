@@ -153,7 +153,7 @@ fn terrain_timings(
         let mut scene = Scene::clear_sky(&cpu_sky, sun, true);
         scene.add_terrain(terrain, terrain.radius_m);
         let shader = Shader::new(&scene, observer)?;
-        GpuTerrain::new(ctx, sky, terrain, &lights, shader.air_volume())
+        GpuTerrain::new(ctx, sky, terrain, &shader)
             .map_err(|e| gpu_failure("uploading the terrain", e))
     };
     let uploaded = upload(&terrain)?;

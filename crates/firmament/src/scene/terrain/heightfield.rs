@@ -8,10 +8,11 @@ use std::sync::{Arc, RwLock};
 
 use super::grid::{bilinear, first_descent, fractions, CellSpan, Grid, GridRay, MaxPyramid, Walk};
 use super::materials::Materials;
+use super::occlusion::Occlusion;
 use super::shadow::ShadowField;
 use crate::math::Vec3;
 use crate::scene::camera::Ray;
-use crate::scene::surface::{Relief, Surface, SurfaceHit};
+use crate::scene::surface::{Relief, Surface, SurfaceHit, HORIZON_AZIMUTHS};
 
 /// The radius (m, one standard deviation) of the terrain around the observer whose albedo
 /// the tables take for the planet's ground ([`Heightfield::mean_albedo`]).
@@ -35,8 +36,8 @@ pub struct Heightfield {
     /// surface's shadows are (exact shadow rays at the view rays' ends).
     pub shafts: bool,
     /// The fraction of the sky the terrain leaves visible, relative to an open plane of the
-    /// same tilt ([`super::occlusion`]), on the heights' grid; none: 1 everywhere.
-    pub visibility: Option<Grid>,
+    /// same tilt, and its horizons ([`super::occlusion`]); none: the whole sky everywhere.
+    pub occlusion: Option<Occlusion>,
     /// Whether it changes the air's light around it ([`Surface::relief`] is None without).
     pub air_light: bool,
     shadows: RwLock<Vec<(Vec3, Arc<ShadowField>)>>,
@@ -54,7 +55,7 @@ impl Heightfield {
             materials,
             casts_shadows: true,
             shafts: true,
-            visibility: None,
+            occlusion: None,
             air_light: true,
             shadows: RwLock::new(Vec::new()),
         }
@@ -69,7 +70,7 @@ impl Heightfield {
             materials: self.materials.clone(),
             casts_shadows: self.casts_shadows,
             shafts: self.shafts,
-            visibility: self.visibility.clone(),
+            occlusion: self.occlusion.clone(),
             air_light: self.air_light,
             shadows: RwLock::new(Vec::new()),
         }
@@ -306,9 +307,16 @@ impl Surface for Heightfield {
     }
 
     fn sky_visibility(&self, hit: &SurfaceHit) -> f64 {
-        match (&self.visibility, self.plane_of(hit.position)) {
-            (Some(ao), Some((u, v))) => ao.value_at(u, v).unwrap_or(1.0),
+        match (&self.occlusion, self.plane_of(hit.position)) {
+            (Some(ao), Some((u, v))) => ao.visibility.value_at(u, v).unwrap_or(1.0),
             _ => 1.0,
+        }
+    }
+
+    fn horizon(&self, hit: &SurfaceHit, out: &mut [f64; HORIZON_AZIMUTHS]) -> bool {
+        match (&self.occlusion, self.plane_of(hit.position)) {
+            (Some(ao), Some((u, v))) => ao.horizons_at(u, v, out),
+            _ => false,
         }
     }
 
@@ -340,5 +348,13 @@ impl Relief for Heightfield {
 
     fn height_m(&self, u: f64, v: f64) -> f64 {
         self.height_at(u, v)
+    }
+
+    fn shadow_height_m(&self, light: Vec3, u: f64, v: f64) -> f64 {
+        let ground = self.height_at(u, v);
+        if !(self.casts_shadows && self.shafts) {
+            return ground;
+        }
+        (self.shadow_field(light).heights.value_at(u, v)).map_or(ground, |s| s.max(ground))
     }
 }

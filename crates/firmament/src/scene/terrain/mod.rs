@@ -210,14 +210,14 @@ impl TerrainConfig {
                 wavelengths_nm,
             )),
         };
-        let visibility = self
+        let occlusion = self
             .occlusion
-            .then(|| occlusion::sky_visibility(&heights, radius_m, occlusion::STRIDE));
+            .then(|| occlusion::occlusion(&heights, radius_m, occlusion::STRIDE));
         let mut field = Heightfield::new(heights, radius_m, materials);
         field.casts_shadows = self.shadows;
         field.shafts = self.light_shafts;
         field.air_light = self.air_light;
-        field.visibility = visibility;
+        field.occlusion = occlusion;
         Ok(field)
     }
 }

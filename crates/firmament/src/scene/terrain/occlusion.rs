@@ -6,8 +6,10 @@
 //! per azimuth is the closed form of ∫ max(0, n·ω) cos e de from max(β, e₀) to π/2, with e₀
 //! where the surface's own plane cuts the sky (Dozier & Frew 1990, "Rapid calculation of
 //! terrain parameters for radiation modeling from digital elevation data", IEEE TGRS 28,
-//! the sky-view factor). The sky is taken as uniform in azimuth for this ratio; light
-//! reflected by the surrounding slopes is not added.
+//! the sky-view factor). The sky is taken as uniform in azimuth for this share; the
+//! horizons themselves are kept too, so a renderer can weight the sky they hide by its
+//! radiance (`render::sky_dome`: at golden hour the hidden sky is the bright part round
+//! the sun). Light reflected by the surrounding slopes is not added.
 
 use rayon::prelude::*;
 
@@ -18,13 +20,57 @@ pub const AZIMUTHS: usize = 8;
 /// The occlusion is computed at every STRIDE-th vertex each way (it varies over the
 /// horizon's scale, hundreds of metres, not a cell's) and interpolated between.
 pub const STRIDE: usize = 2;
-/// How far the horizon is searched (m).
-pub const HORIZON_RANGE_M: f64 = 4000.0;
+/// How far the horizon is searched (m): the peaks that hide a low sun from the default
+/// valley stand up to 25 km away (searched to 4 km, the valley's shadowed floor near the
+/// observer kept the sun's aureole and read +7 % against the reference at golden hour,
+/// +5 % to 25 km, as the brute-force irradiance; docs/accuracy.md).
+pub const HORIZON_RANGE_M: f64 = 25_000.0;
 
-/// The visibility of the sky (0 to 1) at every `stride`-th vertex of `heights` (both ways)
-/// on a planet of radius `radius_m`: a grid `stride` times coarser over the same rectangle
-/// (the horizons searched on the full one), read by bilinear interpolation.
-pub fn sky_visibility(heights: &Grid, radius_m: f64, stride: usize) -> Grid {
+/// The sky's visibility and the horizons of a terrain, on a grid `stride` times coarser
+/// than its heights (the horizons searched on the full one), read by bilinear
+/// interpolation.
+#[derive(Clone, Debug)]
+pub struct Occlusion {
+    /// The visibility of the sky (0 to 1) relative to an open plane of the same tilt.
+    pub visibility: Grid,
+    /// The horizon's elevation (rad, ≥ 0) towards azimuth k, the direction
+    /// (cos 2πk/K, sin 2πk/K) in (east, north), K = [`AZIMUTHS`], at each of the
+    /// visibility grid's vertices (`(j·nx + i)·K + k`: one vertex's together).
+    pub horizons: Vec<f32>,
+}
+
+impl Occlusion {
+    /// The horizons at plane coordinates (u, v), interpolated bilinearly, into `out`; false
+    /// off the grid.
+    pub fn horizons_at(&self, u: f64, v: f64, out: &mut [f64; AZIMUTHS]) -> bool {
+        let g = &self.visibility;
+        let (gx, gy) = g.cell_coords(u, v);
+        if !g.contains(gx, gy) {
+            return false;
+        }
+        let (i, a) = split(gx, g.nx);
+        let (j, b) = split(gy, g.ny);
+        let at = |i: usize, j: usize| &self.horizons[(j * g.nx + i) * AZIMUTHS..][..AZIMUTHS];
+        let (c00, c10, c01, c11) = (at(i, j), at(i + 1, j), at(i, j + 1), at(i + 1, j + 1));
+        for k in 0..AZIMUTHS {
+            let low = c00[k] as f64 + (c10[k] - c00[k]) as f64 * a;
+            let high = c01[k] as f64 + (c11[k] - c01[k]) as f64 * a;
+            out[k] = low + (high - low) * b;
+        }
+        true
+    }
+}
+
+/// Cell index and fraction of grid coordinate `g` on `n` vertices (clamped).
+fn split(g: f64, n: usize) -> (usize, f64) {
+    let g = g.clamp(0.0, (n - 1) as f64);
+    let i = (g.floor() as usize).min(n - 2);
+    (i, g - i as f64)
+}
+
+/// The [`Occlusion`] at every `stride`-th vertex of `heights` (both ways) on a planet of
+/// radius `radius_m`.
+pub fn occlusion(heights: &Grid, radius_m: f64, stride: usize) -> Occlusion {
     let stride = stride.max(1);
     let dx = heights.spacing_m;
     let mut steps = Vec::new();
@@ -41,20 +87,28 @@ pub fn sky_visibility(heights: &Grid, radius_m: f64, stride: usize) -> Grid {
         (heights.nx - 1).div_ceil(stride) + 1,
         (heights.ny - 1).div_ceil(stride) + 1,
     );
-    let mut out = Grid {
+    let coarse = |value: f32| Grid {
         nx,
         ny,
         origin: heights.origin,
         spacing_m: dx * stride as f64,
         axis: heights.axis,
-        values: vec![1.0; nx * ny],
+        values: vec![value; nx * ny],
     };
+    let mut out = coarse(1.0);
+    // The horizons vertex-major while they are searched ([vertex][azimuth]).
+    let mut betas = vec![0.0f32; nx * ny * AZIMUTHS];
     let (last_x, last_y) = ((heights.nx - 1) as f64, (heights.ny - 1) as f64);
     out.values
         .par_chunks_mut(nx)
+        .zip(betas.par_chunks_mut(nx * AZIMUTHS))
         .enumerate()
-        .for_each(|(j, row)| {
-            for (i, v) in row.iter_mut().enumerate() {
+        .for_each(|(j, (row, row_betas))| {
+            for (i, (v, beta)) in row
+                .iter_mut()
+                .zip(row_betas.chunks_mut(AZIMUTHS))
+                .enumerate()
+            {
                 // The coarse vertex on the fine grid (the last row and column clamped: the
                 // coarse grid may reach a little beyond the fine one's edge).
                 let gx = ((i * stride) as f64).min(last_x);
@@ -64,7 +118,7 @@ pub fn sky_visibility(heights: &Grid, radius_m: f64, stride: usize) -> Grid {
                 let norm = (1.0 + hu * hu + hv * hv).sqrt();
                 let (nx, ny, nz) = (-hu / norm, -hv / norm, 1.0 / norm);
                 let (mut seen, mut open) = (0.0, 0.0);
-                for &(c, s) in &dirs {
+                for (&(c, s), beta) in dirs.iter().zip(beta.iter_mut()) {
                     let mut tan_b: f64 = 0.0;
                     for &d in &steps {
                         let (x, y) = (gx + c * d / dx, gy + s * d / dx);
@@ -74,6 +128,7 @@ pub fn sky_visibility(heights: &Grid, radius_m: f64, stride: usize) -> Grid {
                         let rise = heights.bilinear(x, y) - h0 - d * d / (2.0 * radius_m);
                         tan_b = tan_b.max(rise / d);
                     }
+                    *beta = tan_b.atan() as f32;
                     let a = nx * c + ny * s;
                     let e0 = (-a).atan2(nz);
                     seen += share(a, nz, tan_b.atan().max(e0));
@@ -86,7 +141,10 @@ pub fn sky_visibility(heights: &Grid, radius_m: f64, stride: usize) -> Grid {
                 };
             }
         });
-    out
+    Occlusion {
+        visibility: out,
+        horizons: betas,
+    }
 }
 
 /// ∫ from `low` to π/2 of (a cos e + c sin e) cos e de.
@@ -113,7 +171,7 @@ mod tests {
             axis: [1.0, 0.0],
             values: vec![0.0; 41 * 41],
         };
-        let flat = sky_visibility(&g, 6.36e6, 1);
+        let flat = occlusion(&g, 6.36e6, 1).visibility;
         assert!((flat.at(20, 20) - 1.0).abs() < 1e-6);
         // A ring wall 500 m high from 500 m: a horizon at 45° seen from the centre, so the
         // open share ∫ sin e cos e de from β to 90° is cos²β of the plain's: 1/2. The
@@ -127,8 +185,16 @@ mod tests {
                 }
             }
         }
-        let pit = sky_visibility(&g, 1e12, 1);
-        let v = pit.at(20, 20);
+        let pit = occlusion(&g, 1e12, 1);
+        let v = pit.visibility.at(20, 20);
         assert!((0.49..0.67).contains(&v), "{v}");
+        // The horizons: the wall's top seen from the centre, 35.5° to 45° every way.
+        let mut h = [0.0; AZIMUTHS];
+        let (u, v) = pit.visibility.plane_coords(20.0, 20.0);
+        assert!(pit.horizons_at(u, v, &mut h));
+        for b in h {
+            let b = b.to_degrees();
+            assert!((35.0..45.1).contains(&b), "{b}");
+        }
     }
 }
