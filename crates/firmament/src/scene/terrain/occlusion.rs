@@ -13,7 +13,7 @@
 
 use rayon::prelude::*;
 
-use super::grid::Grid;
+use super::grid::{split, Grid};
 
 /// Azimuths searched for the horizon.
 pub const AZIMUTHS: usize = 8;
@@ -59,13 +59,6 @@ impl Occlusion {
         }
         true
     }
-}
-
-/// Cell index and fraction of grid coordinate `g` on `n` vertices (clamped).
-fn split(g: f64, n: usize) -> (usize, f64) {
-    let g = g.clamp(0.0, (n - 1) as f64);
-    let i = (g.floor() as usize).min(n - 2);
-    (i, g - i as f64)
 }
 
 /// The [`Occlusion`] at every `stride`-th vertex of `heights` (both ways) on a planet of

@@ -218,8 +218,8 @@ impl ShadowField {
         let (gx, gy, h) = ray.grid_point(grid, max_distance_m);
         if grid.contains(gx, gy) {
             let (i, j) = (
-                (gx.floor() as usize).min(grid.nx - 2),
-                (gy.floor() as usize).min(grid.ny - 2),
+                (gx as usize).min(grid.nx - 2),
+                (gy as usize).min(grid.ny - 2),
             );
             let hc = terrain.heights.corners(i, j);
             let (a, b) = super::grid::fractions(gx, gy, i, j);
@@ -289,19 +289,38 @@ fn sweep(terrain: &Heightfield, azimuth: [f64; 2], light: Vec3) -> Grid {
     };
     // cos(e + φ)/cos e = cos φ − tan e · sin φ.
     let (sin_phi, cos_phi) = (dx / r).sin_cos();
-    let frame = raise.clone();
+    let (origin, heights) = (raise.origin, &terrain.heights);
     raise
         .values
         .par_chunks_mut(nx)
         .enumerate()
         .for_each(|(j, row)| {
+            // Along the row everything is linear in i: the plane coordinates, the terrain
+            // grid's coordinates and L·(u, v, R).
+            let y = origin[1] + j as f64 * dx;
+            let (u0, v0) = (c * origin[0] - s * y, s * origin[0] + c * y);
+            let (du, dv) = (c * dx, s * dx);
+            let (gx0, gy0) = heights.cell_coords(u0, v0);
+            let (gx1, gy1) = heights.cell_coords(u0 + du, v0 + dv);
+            let (dgx, dgy) = (gx1 - gx0, gy1 - gy0);
+            let dot0 = light.x * u0 + light.y * v0 + light.z * r;
+            let ddot = light.x * du + light.y * dv;
             // From the light's side (high x′) towards the shadows.
             let mut s_next = f64::NEG_INFINITY;
             for i in (0..nx).rev() {
-                let (u, v) = frame.plane_coords(i as f64, j as f64);
-                let h = terrain.height_at(u, v);
-                let sin_e = light.dot(Vec3::new(u, v, r)) / (u * u + v * v + r * r).sqrt();
-                let tan_e = sin_e / (1.0 - sin_e * sin_e).max(1e-12).sqrt();
+                let k = i as f64;
+                let (u, v) = (u0 + k * du, v0 + k * dv);
+                let (gx, gy) = (gx0 + k * dgx, gy0 + k * dgy);
+                // Off the terrain: the sphere.
+                let h = if heights.contains(gx, gy) {
+                    heights.bilinear(gx, gy)
+                } else {
+                    0.0
+                };
+                // The light's elevation e at the point: sin e = L·p/|p|, so
+                // tan e = L·p / sqrt(|p|² − (L·p)²).
+                let dot = dot0 + k * ddot;
+                let tan_e = dot / (u * u + v * v + r * r - dot * dot).max(1e-12).sqrt();
                 let carried = if s_next.is_finite() {
                     (r + s_next) * (cos_phi - tan_e * sin_phi) - r
                 } else {
