@@ -420,7 +420,13 @@ fn walk_advance(w: ptr<function, Walk>) -> bool {
     (*w).level += k - 1;
     (*w).i = i1 >> u32(k - 1);
     (*w).j = j1 >> u32(k - 1);
-    (*w).exits = vec2<f32>(walk_face(w, (*w).i, 0u), walk_face(w, (*w).j, 1u));
+    // A neighbour at the same level keeps the exit of the axis not stepped along.
+    if (k > 1 || i1 != i0) {
+        (*w).exits.x = walk_face(w, (*w).i, 0u);
+    }
+    if (k > 1 || j1 != j0) {
+        (*w).exits.y = walk_face(w, (*w).j, 1u);
+    }
     return true;
 }
 

@@ -540,7 +540,13 @@ impl<'a> Walk<'a> {
         self.level += k - 1;
         self.i = i1 >> (k - 1);
         self.j = j1 >> (k - 1);
-        self.exits = [self.face(self.i, 0), self.face(self.j, 1)];
+        // A neighbour at the same level keeps the exit of the axis not stepped along.
+        if k > 1 || i1 != i0 {
+            self.exits[0] = self.face(self.i, 0);
+        }
+        if k > 1 || j1 != j0 {
+            self.exits[1] = self.face(self.j, 1);
+        }
         true
     }
 }
