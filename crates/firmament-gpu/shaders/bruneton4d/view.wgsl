@@ -346,19 +346,25 @@ fn combined_scattering(v: View, a: At, k: u32, p_r: f32) -> Combined {
         return c;
     }
     c.scattering = rayleigh_and_multiple(a, k, p_r);
+    c.mie = single_mie(v, a, c.scattering, k);
+    return c;
+}
+
+// Single Mie of channel group k at `a`: the table's (or the slice's), or with red-only
+// storage the ratio rule of MieStorage::RedOnly, scat[k]·red/scat[0]·ratio[k], from
+// `scattering` (the lookup's Rayleigh part, with or without the multiple scattering as the
+// caller's orders are).
+fn single_mie(v: View, a: At, scattering: vec4<f32>, k: u32) -> vec4<f32> {
     if (v.mie_layout == 0u) {
         if (a.sliced) {
-            c.mie = sample_slice(a.slice, a.slice_filter, 2u * atm.groups + k);
-        } else {
-            c.mie = sample_scattering_b(a.table, k);
+            return sample_slice(a.slice, a.slice_filter, 2u * atm.groups + k);
         }
-    } else if (a.scat0 > 0.0) {
-        // The ratio rule of MieStorage::RedOnly: scat[k]·red/scat[0]·ratio[k].
-        c.mie = c.scattering * a.red / a.scat0 * view_constants[k * CHANNEL_STRIDE + CHANNEL_MIE_RATIO];
-    } else {
-        c.mie = vec4<f32>(0.0);
+        return sample_scattering_b(a.table, k);
     }
-    return c;
+    if (a.scat0 > 0.0) {
+        return scattering * a.red / a.scat0 * view_constants[k * CHANNEL_STRIDE + CHANNEL_MIE_RATIO];
+    }
+    return vec4<f32>(0.0);
 }
 
 // ---------------------------------------------------------------------------------------

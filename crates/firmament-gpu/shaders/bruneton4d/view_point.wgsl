@@ -102,15 +102,7 @@ fn piece_single(v: View, p: Piece, k: u32) -> Combined {
     } else {
         c.scattering = sample_scattering_a(a.table, k);
     }
-    if (v.mie_layout == 0u) {
-        if (a.sliced) {
-            c.mie = sample_slice(a.slice, a.slice_filter, 2u * atm.groups + k);
-        } else {
-            c.mie = sample_scattering_b(a.table, k);
-        }
-    } else if (a.scat0 > 0.0) {
-        c.mie = c.scattering * a.red / a.scat0 * view_constants[k * CHANNEL_STRIDE + CHANNEL_MIE_RATIO];
-    }
+    c.mie = single_mie(v, a, c.scattering, k);
     let t = piece_transmittance(p, k);
     c.scattering *= t;
     c.mie *= t;

@@ -105,40 +105,57 @@ fn shade(dir: vec3<f32>, shadow_length_km: f32) -> vec3<f32> {
     return rgb;
 }
 
+// The pixel of invocation (gid, nwg) and its camera ray (CameraRay.valid false outside
+// the band or the projection).
+struct Pixel {
+    i: u32,
+    x: u32,
+    y: u32,
+    in_band: bool,
+    ray: CameraRay,
+}
+
+fn pixel(gid: vec3<u32>, nwg: vec3<u32>) -> Pixel {
+    var p: Pixel;
+    p.i = invocation_index(gid, nwg);
+    p.in_band = p.i < frame.rows * frame.width;
+    if (!p.in_band) {
+        return p;
+    }
+    p.x = p.i % frame.width;
+    p.y = frame.first_row + p.i / frame.width;
+    p.ray = camera_ray(f32(p.x) + 0.5, f32(p.y) + 0.5);
+    return p;
+}
+
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let i = invocation_index(gid, nwg);
-    if (i >= frame.rows * frame.width) {
+    let p = pixel(gid, nwg);
+    if (!p.in_band) {
         return;
     }
-    let x = i % frame.width;
-    let y = frame.first_row + i / frame.width;
-    let ray = camera_ray(f32(x) + 0.5, f32(y) + 0.5);
     var out = vec4<f32>(0.0);
-    if (ray.valid) {
+    if (p.ray.valid) {
         var shadow_km = 0.0;
         if (frame.shadow_input != 0u) {
-            shadow_km = textureLoad(shadow_lengths, vec2<u32>(x, y), 0).x * 1e-3;
+            shadow_km = textureLoad(shadow_lengths, vec2<u32>(p.x, p.y), 0).x * 1e-3;
         }
-        out = vec4<f32>(shade(ray.dir, shadow_km) * frame.balance.xyz, 1.0);
+        out = vec4<f32>(shade(p.ray.dir, shadow_km) * frame.balance.xyz, 1.0);
     }
-    write_pixel(i, x, y, out);
+    write_pixel(p.i, p.x, p.y, out);
 }
 
 // The frame over a terrain (render/scene.wgsl): an entry point of its own, so that frames
 // without one carry none of its code.
 @compute @workgroup_size(64)
 fn main_terrain(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let i = invocation_index(gid, nwg);
-    if (i >= frame.rows * frame.width) {
+    let p = pixel(gid, nwg);
+    if (!p.in_band) {
         return;
     }
-    let x = i % frame.width;
-    let y = frame.first_row + i / frame.width;
-    let ray = camera_ray(f32(x) + 0.5, f32(y) + 0.5);
     var out = vec4<f32>(0.0);
-    if (ray.valid) {
-        out = vec4<f32>(shade_scene(ray.dir) * frame.balance.xyz, 1.0);
+    if (p.ray.valid) {
+        out = vec4<f32>(shade_scene(p.ray.dir) * frame.balance.xyz, 1.0);
     }
-    write_pixel(i, x, y, out);
+    write_pixel(p.i, p.x, p.y, out);
 }

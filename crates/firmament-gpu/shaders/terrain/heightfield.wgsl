@@ -134,18 +134,11 @@ fn sky_visibility(q: vec3<f32>) -> f32 {
     if ((terrain.flags & TERRAIN_OCCLUSION) == 0u) {
         return 1.0;
     }
-    let r = terrain.radius_m;
-    let uv = r * q.xy / (r + q.z);
-    let c = terrain.axis.x;
-    let s = terrain.axis.y;
-    let g = vec2<f32>((c * uv.x + s * uv.y) - terrain.origin_u, (-s * uv.x + c * uv.y) - terrain.origin_v) / terrain.visibility_spacing_m;
-    let n = vec2<f32>(f32(terrain.visibility_nx - 1u), f32(terrain.visibility_ny - 1u));
-    if (g.x < 0.0 || g.y < 0.0 || g.x > n.x || g.y > n.y) {
+    let cell = visibility_cell(q);
+    if (cell.x < 0.0) {
         return 1.0;
     }
-    let i = min(floor(g), n - 1.0);
-    let f = g - i;
-    let k = terrain.visibility + u32(i.y) * terrain.visibility_nx + u32(i.x);
+    let k = terrain.visibility + u32(cell.y) * terrain.visibility_nx + u32(cell.x);
     let v = vec4<f32>(terrain_data[k], terrain_data[k + 1u], terrain_data[k + terrain.visibility_nx], terrain_data[k + terrain.visibility_nx + 1u]);
-    return bilinear(v, f.x, f.y);
+    return bilinear(v, cell.z, cell.w);
 }
