@@ -14,7 +14,7 @@ use firmament::scene::{Camera, Projection, SceneFile as Scene};
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
 use crate::commands::render::{
-    atmosphere_args, render_scene, terrain_and_atmosphere, write_outputs,
+    atmosphere_args, render_scene, terrain_and_atmosphere, write_outputs, FileOptions,
 };
 
 /// Arguments of `firmament gallery`.
@@ -111,7 +111,7 @@ fn write_strip(
             t.at = at.to_rfc3339();
         }
         let (frame, ev100) = render_scene(sky, &s, None, true)?;
-        let rgb = frame.to_srgb8(
+        let rgb = frame.to_srgb8_dithered(
             firmament::render::tonemap::exposure_from_ev100(ev100),
             s.output.tonemap,
         );
@@ -209,7 +209,12 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
             None => {
                 let (frame, ev100) = render_scene(sky, &scene, terrain, true)?;
                 let ev100 = ev100 + v.ev_offset;
-                write_outputs(&frame, &scene, ev100, false, true)?;
+                let files = FileOptions {
+                    half: false,
+                    gamut: firmament::spectrum::gamut::Gamut::Rec709,
+                    dither: true,
+                };
+                write_outputs(&frame, &scene, ev100, files, true)?;
                 ev100
             }
             Some((frames, minutes)) => {

@@ -13,6 +13,7 @@ use firmament::scene::file::{SceneLocation, SceneTime};
 use firmament::scene::sky_lights::{sources_of, SkySources};
 use firmament::scene::terrain::Heightfield;
 use firmament::scene::{sun_direction, Projection, SceneFile as Scene};
+use firmament::spectrum::gamut::Gamut;
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
 use crate::commands::astro::AstroArgs;
@@ -114,9 +115,18 @@ pub struct RenderArgs {
     /// White-balance to the sun's colour.
     #[arg(long)]
     pub white_balance: bool,
-    /// Write OpenEXR as 16-bit half floats instead of 32-bit.
+    /// Write OpenEXR as 16-bit half floats instead of 32-bit (values above the half range,
+    /// 65 504, such as the sun's disk, are clamped there, with a warning).
     #[arg(long)]
     pub exr_half: bool,
+    /// The colour space of OpenEXR output: rec709 (default; sRGB's primaries), rec2020 or
+    /// acescg, named in the file's `chromaticities`. Colours outside it are mapped into it
+    /// at their luminance: no file holds a negative component.
+    #[arg(long, default_value = "rec709", value_name = "rec709|rec2020|acescg")]
+    pub gamut: String,
+    /// Round PNG output to the nearest code instead of dithering (triangular, ±1 code).
+    #[arg(long)]
+    pub no_dither: bool,
     /// Output file, repeatable; format from the extension (.png, .exr, .hdr).
     #[arg(long = "out", value_name = "FILE")]
     pub outputs: Vec<PathBuf>,
@@ -416,32 +426,75 @@ pub fn render_scene(
     Ok((frame, ev100))
 }
 
+/// How frames become files: EXR precision and colour space, PNG dither.
+#[derive(Clone, Copy, Debug)]
+pub struct FileOptions {
+    /// 16-bit half-float EXR.
+    pub half: bool,
+    /// The EXR's colour space (PNG and Radiance HDR are Rec. 709).
+    pub gamut: Gamut,
+    /// Triangular dither in 8-bit PNG.
+    pub dither: bool,
+}
+
+impl FileOptions {
+    /// From `render`'s flags.
+    pub fn from_args(args: &RenderArgs) -> Result<FileOptions> {
+        let gamut = Gamut::parse(&args.gamut).ok_or_else(|| {
+            anyhow::anyhow!(
+                "invalid value for `--gamut`: {} (accepted: rec709, rec2020, acescg)",
+                args.gamut
+            )
+        })?;
+        Ok(FileOptions {
+            half: args.exr_half,
+            gamut,
+            dither: !args.no_dither,
+        })
+    }
+}
+
 /// Write the frame to every output (each atomically).
 pub fn write_outputs(
     frame: &render::Frame,
     scene: &Scene,
     ev100: f64,
-    half: bool,
+    files: FileOptions,
     quiet: bool,
 ) -> Result<()> {
     for path in &scene.output.files {
         let t = Instant::now();
         match OutputFormat::from_path(path)? {
             OutputFormat::Png => {
-                let rgb8 =
-                    frame.to_srgb8(tonemap::exposure_from_ev100(ev100), scene.output.tonemap);
+                let exposure = tonemap::exposure_from_ev100(ev100);
+                let rgb8 = if files.dither {
+                    frame.to_srgb8_dithered(exposure, scene.output.tonemap)
+                } else {
+                    frame.to_srgb8(exposure, scene.output.tonemap)
+                };
                 io::write_png_srgb8(path, frame.image.width, frame.image.height, &rgb8)?;
             }
-            OutputFormat::Exr => io::write_exr(
-                path,
-                &frame.image,
-                if half {
+            OutputFormat::Exr => {
+                let image = frame.in_gamut(files.gamut);
+                let precision = if files.half {
+                    let half_max = io::HALF_MAX;
+                    let clamped = (image.data.iter())
+                        .filter(|p| p.iter().any(|&v| v > half_max))
+                        .count();
+                    if clamped > 0 && !quiet {
+                        eprintln!(
+                            "warning: {clamped} pixels of {} exceed the half-float range (65 504: the sun's disk?) and are clamped there; a 32-bit EXR (without --exr-half) keeps them, --no-sun-disk leaves the disk out",
+                            path.display()
+                        );
+                    }
                     ExrPrecision::F16
                 } else {
                     ExrPrecision::F32
-                },
-            )?,
-            OutputFormat::Hdr => io::write_hdr(path, &frame.image)?,
+                };
+                let chromaticities = files.gamut.chromaticities();
+                io::write_exr_in(path, &image, precision, &[], Some(&chromaticities))?;
+            }
+            OutputFormat::Hdr => io::write_hdr(path, &frame.in_gamut(Gamut::Rec709))?,
         }
         if !quiet {
             eprintln!(
@@ -505,6 +558,7 @@ fn render_scene_reference(
 /// Run `firmament render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
     let scene = scene_from_args(args)?;
+    let files = FileOptions::from_args(args)?;
     let times = match (&args.until, &args.every, &scene.time) {
         (Some(until), Some(every), Some(t)) => {
             for f in &scene.output.files {
@@ -557,7 +611,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                     ev100
                 );
             }
-            return write_outputs(&frame, &scene, ev100, args.exr_half, args.quiet);
+            return write_outputs(&frame, &scene, ev100, files, args.quiet);
         }
         other => anyhow::bail!("invalid value for `--method`: {other} (accepted: lut, reference)"),
     }
@@ -603,7 +657,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             terrain.as_ref(),
             &times,
             args.resume,
-            args.exr_half,
+            files,
             args.quiet,
         )?;
         if !args.quiet && rendered > 0 {
@@ -632,5 +686,5 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             }
         );
     }
-    write_outputs(&frame, &scene, ev100, args.exr_half, args.quiet)
+    write_outputs(&frame, &scene, ev100, files, args.quiet)
 }

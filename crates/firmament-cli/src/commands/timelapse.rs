@@ -12,7 +12,7 @@ use firmament::scene::SceneFile as Scene;
 use serde_json::json;
 
 use crate::backend::RenderSky;
-use crate::commands::render::{render_scene, write_outputs};
+use crate::commands::render::{render_scene, write_outputs, FileOptions};
 use crate::common::{cancel_flag, progress_bar};
 use firmament::scene::terrain::Heightfield;
 
@@ -72,7 +72,7 @@ pub fn run(
     terrain: Option<&Heightfield>,
     times: &[Instant],
     resume: bool,
-    half: bool,
+    options: FileOptions,
     quiet: bool,
 ) -> Result<(usize, usize)> {
     let patterns = scene.output.files.clone();
@@ -115,7 +115,7 @@ pub fn run(
         }
         frame_scene.output.files = files;
         let (frame, ev100) = render_scene(sky, &frame_scene, terrain, true)?;
-        write_outputs(&frame, &frame_scene, ev100, half, true)?;
+        write_outputs(&frame, &frame_scene, ev100, options, true)?;
         rendered += 1;
         bar.inc(1);
     }

@@ -2,7 +2,8 @@
 // forest spectra (the uniform's `albedo` rows, from data/terrain_albedo.csv at the model's
 // wavelengths) mixed by height and slope with patchy edges, or one albedo everywhere.
 
-// materials::hash32: Wellons's lowbias32 chained over the salt and the coordinates.
+// math::hash::hash32 (the twin of math/hash.rs): Wellons's lowbias32 chained over the salt
+// and the coordinates.
 fn lowbias32(v_in: u32) -> u32 {
     var v = v_in;
     v ^= v >> 16u;

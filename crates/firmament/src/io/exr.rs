@@ -5,7 +5,12 @@ use std::path::Path;
 
 use super::atomic::write_atomic;
 use super::{file_error, io_error, ExrPrecision, ImageRgbF32};
+use crate::spectrum::gamut::Chromaticities;
 use crate::{Error, Result};
+
+/// The largest finite half float (IEEE 754 binary16): brighter samples of a 16-bit file are
+/// clamped to it.
+pub const HALF_MAX: f32 = 65504.0;
 
 fn exr_error(path: &Path, e: exr::error::Error, writing: bool) -> Error {
     use exr::error::Error as E;
@@ -41,6 +46,19 @@ pub fn write_exr_with_attributes(
     precision: ExrPrecision,
     attributes: &[(&str, &str)],
 ) -> Result<()> {
+    write_exr_in(path, image, precision, attributes, None)
+}
+
+/// As [`write_exr_with_attributes`], with the image's primaries and white in the header's
+/// standard `chromaticities` attribute when given (the colour space of the samples:
+/// Rec. 2020, ACEScg; readers take Rec. 709 without it).
+pub fn write_exr_in(
+    path: impl AsRef<Path>,
+    image: &ImageRgbF32,
+    precision: ExrPrecision,
+    attributes: &[(&str, &str)],
+    chromaticities: Option<&Chromaticities>,
+) -> Result<()> {
     use exr::prelude::*;
     let path = path.as_ref();
     image.check(path)?;
@@ -63,6 +81,16 @@ pub fn write_exr_with_attributes(
     let size = (image.width, image.height);
     let w = image.width;
     let px = |p: Vec2<usize>| image.data[p.y() * w + p.x()];
+    let mut image_attributes = ImageAttributes::new(IntegerBounds::from_dimensions(size));
+    image_attributes.chromaticities = chromaticities.map(|c| {
+        let v = |[x, y]: [f64; 2]| Vec2(x as f32, y as f32);
+        exr::meta::attribute::Chromaticities {
+            red: v(c.red),
+            green: v(c.green),
+            blue: v(c.blue),
+            white: v(c.white),
+        }
+    });
     write_atomic(path, |out| {
         let result = match precision {
             ExrPrecision::F32 => {
@@ -70,29 +98,35 @@ pub fn write_exr_with_attributes(
                     let [r, g, b] = px(p);
                     (r, g, b)
                 });
-                Image::from_layer(Layer::new(
-                    size,
-                    layer_attributes,
-                    Encoding::SMALL_LOSSLESS,
-                    channels,
-                ))
+                Image::new(
+                    image_attributes.clone(),
+                    Layer::new(
+                        size,
+                        layer_attributes.clone(),
+                        Encoding::SMALL_LOSSLESS,
+                        channels,
+                    ),
+                )
                 .write()
                 .to_buffered(out)
             }
             ExrPrecision::F16 => {
                 // Half floats end at 65504: brighter samples (the sun's disk, a star's
                 // pixel) are clamped there rather than written as infinity.
-                let half = |v: f32| f16::from_f32(v.min(f16::MAX.to_f32()));
+                let half = |v: f32| f16::from_f32(v.min(HALF_MAX));
                 let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
                     let [r, g, b] = px(p);
                     (half(r), half(g), half(b))
                 });
-                Image::from_layer(Layer::new(
-                    size,
-                    layer_attributes,
-                    Encoding::SMALL_LOSSLESS,
-                    channels,
-                ))
+                Image::new(
+                    image_attributes.clone(),
+                    Layer::new(
+                        size,
+                        layer_attributes.clone(),
+                        Encoding::SMALL_LOSSLESS,
+                        channels,
+                    ),
+                )
                 .write()
                 .to_buffered(out)
             }
@@ -118,6 +152,25 @@ pub fn read_exr(path: impl AsRef<Path>) -> Result<ImageRgbF32> {
     )
     .map_err(|e| exr_error(path, e, false))?;
     Ok(image.layer_data.channel_data.pixels)
+}
+
+/// The `chromaticities` attribute of an OpenEXR file's first header, if it has one.
+pub fn read_exr_chromaticities(path: impl AsRef<Path>) -> Result<Option<Chromaticities>> {
+    let path = path.as_ref();
+    File::open(path).map_err(|e| io_error(path, &e, false))?;
+    let meta =
+        exr::meta::MetaData::read_from_file(path, false).map_err(|e| exr_error(path, e, false))?;
+    Ok(meta.headers.first().and_then(|h| {
+        h.shared_attributes.chromaticities.map(|c| {
+            let v = |p: exr::math::Vec2<f32>| [p.0 as f64, p.1 as f64];
+            Chromaticities {
+                red: v(c.red),
+                green: v(c.green),
+                blue: v(c.blue),
+                white: v(c.white),
+            }
+        })
+    }))
 }
 
 /// Reads the string (`text`) attributes of an OpenEXR file's first header (layer and

@@ -13,7 +13,10 @@ pub mod png;
 
 use std::path::{Path, PathBuf};
 
-pub use self::exr::{read_exr, read_exr_text_attributes, write_exr, write_exr_with_attributes};
+pub use self::exr::{
+    read_exr, read_exr_chromaticities, read_exr_text_attributes, write_exr, write_exr_in,
+    write_exr_with_attributes, HALF_MAX,
+};
 pub use self::hdr::{read_hdr, rgbe_decode, rgbe_encode, write_hdr, write_hdr_uncompressed};
 pub use self::png::{read_png_srgb8, write_png_srgb8};
 pub use atomic::write_atomic;

@@ -2,6 +2,7 @@
 //! metres or unit directions), ray geometry in a spherical atmosphere ([`sphere`]) and
 //! quadrature rules ([`quadrature`]).
 
+pub mod hash;
 pub mod lattice;
 pub mod quadrature;
 pub mod sphere;

@@ -85,12 +85,16 @@ pub fn encode_srgb(linear: f32) -> u8 {
     } else {
         linear.clamp(0.0, 1.0)
     } as f64;
-    let v = if c <= 0.0031308 {
+    (linear_to_srgb(c) * 255.0).round().clamp(0.0, 255.0) as u8
+}
+
+/// The sRGB transfer function on [0, 1] (IEC 61966-2-1).
+pub fn linear_to_srgb(c: f64) -> f64 {
+    if c <= 0.0031308 {
         12.92 * c
     } else {
         1.055 * c.powf(1.0 / 2.4) - 0.055
-    };
-    (v * 255.0).round().clamp(0.0, 255.0) as u8
+    }
 }
 
 /// 8-bit sRGB to linear [0, 1] (inverse of [`encode_srgb`] up to quantisation).

@@ -6,6 +6,7 @@
 //! from published PyPI packages; each file's first line names its source.
 
 pub mod colour;
+pub mod gamut;
 mod rayleigh;
 pub(crate) mod table;
 

@@ -3,6 +3,7 @@
 //! PROSAIL's dry soil, and Kokhanovsky & Zege 2004 snow with Warren & Brandt 2008 ice),
 //! mixed by height and slope, or one albedo everywhere.
 
+use crate::math::hash::hash32;
 use crate::math::{smoothstep, Vec3};
 
 const TERRAIN_ALBEDO_CSV: &str = include_str!("../../../data/terrain_albedo.csv");
@@ -116,20 +117,6 @@ pub fn patchiness(p: Vec3, cell_m: f64, salt: u32) -> f64 {
     let low = v(0, 0) + (v(1, 0) - v(0, 0)) * sx;
     let high = v(0, 1) + (v(1, 1) - v(0, 1)) * sx;
     low + (high - low) * sy
-}
-
-/// A 32-bit integer hash of a lattice point (32-bit so that WGSL computes the same):
-/// Wellons's "lowbias32" finaliser (C. Wellons 2018, "Prospecting for hash functions",
-/// bias 0.17), chained over the salt and the two coordinates.
-pub fn hash32(salt: u32, x: i32, y: i32) -> u32 {
-    fn lowbias32(mut v: u32) -> u32 {
-        v ^= v >> 16;
-        v = v.wrapping_mul(0x7feb_352d);
-        v ^= v >> 15;
-        v = v.wrapping_mul(0x846c_a68b);
-        v ^ (v >> 16)
-    }
-    lowbias32(x as u32 ^ lowbias32(y as u32 ^ lowbias32(salt)))
 }
 
 #[cfg(test)]
