@@ -357,22 +357,27 @@ impl<'a> RenderSky<'a> {
                     terrain: gpu_terrain.as_ref(),
                     ..RenderInputs::default()
                 };
+                // Disks smaller than four pixels are points, as on the CPU.
+                let (w, h) = (settings.width, settings.height);
+                let prepared = settings.camera.prepare(sky_model.bottom_radius_m, w, h);
+                let small = stars::small_disks(&sources.lights, &prepared, w, h);
+                let mut lights = sources.lights.clone();
+                for (i, _) in &small {
+                    lights[*i].visible_disk = false;
+                }
                 let mut frame = on_gpu("rendering on the GPU", quiet, || {
                     renderer
-                        .render_with(&gpu.ctx, sky, &sources.lights, settings, inputs)
+                        .render_with(&gpu.ctx, sky, &lights, settings, inputs)
                         .map_err(|e| gpu_failure("rendering", e))
                 })?;
-                // The stars are points: splatted on the CPU into the frame read back, hidden
-                // by the terrain.
+                // The stars and the small disks are points: splatted on the CPU into the
+                // frame read back, hidden by the terrain.
                 let occluders: Vec<&dyn Surface> =
                     terrain.iter().map(|t| *t as &dyn Surface).collect();
-                stars::draw_points_into(
-                    &mut frame,
-                    &sources.stars,
-                    sky_model,
-                    settings,
-                    &occluders,
-                );
+                let points: Vec<_> = (sources.stars.iter().cloned())
+                    .chain(small.into_iter().map(|(_, p)| p))
+                    .collect();
+                stars::draw_points_into(&mut frame, &points, sky_model, settings, &occluders);
                 Ok(frame)
             }
         }

@@ -4,7 +4,7 @@
 //! Rust twin with the same name and function names (see `docs/architecture.md`).
 
 use firmament::math::quadrature::GL4;
-use firmament::render::{air_volume, sky_dome};
+use firmament::render::{air_volume, disk_edges, sky_dome};
 use firmament::scene::surface::HORIZON_AZIMUTHS;
 use firmament::sky::bruneton4d::precompute::{
     DENSITY_PHI, DENSITY_THETA, HARMONICS, IRRADIANCE_PHI, IRRADIANCE_THETA, KERNEL_STEPS,
@@ -122,9 +122,10 @@ pub const TERRAIN: [Module; 6] = [
 
 /// The renderer's modules: lights, cameras, the air volume, the scene over the terrain, the
 /// frame.
-pub const RENDER: [Module; 6] = [
+pub const RENDER: [Module; 7] = [
     module!("render/light.wgsl"),
     module!("render/camera.wgsl"),
+    module!("render/disk_edges.wgsl"),
     module!("render/air_volume.wgsl"),
     module!("render/sky_dome.wgsl"),
     module!("render/scene.wgsl"),
@@ -182,9 +183,14 @@ pub fn prelude() -> String {
         ("AIR_ELEVATIONS", air_volume::ELEVATIONS),
         ("AIR_STEPS", air_volume::STEPS),
         ("HORIZON_AZIMUTHS", HORIZON_AZIMUTHS),
+        ("DISK_SUBSAMPLES", disk_edges::SUBSAMPLES),
     ] {
         s += &u(name, v);
     }
+    s += &format!(
+        "const DISK_EDGE_FOOTPRINTS: f32 = {:?};\n",
+        disk_edges::EDGE_FOOTPRINTS as f32
+    );
     s += &format!(
         "const DOME_PIECES = array<vec3<f32>, {}>({});\n",
         sky_dome::PIECES.len(),

@@ -33,7 +33,8 @@ struct Frame {
     camera_above_top_km: f32,
     inside: u32,
     tan_half_fov: f32,
-    pad0: f32,
+    // An upper bound on the pixels' footprints (rad; disk_edges.wgsl).
+    max_footprint_rad: f32,
     pad1: f32,
     pad2: f32,
 }
@@ -140,7 +141,20 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         if (frame.shadow_input != 0u) {
             shadow_km = textureLoad(shadow_lengths, vec2<u32>(p.x, p.y), 0).x * 1e-3;
         }
-        out = vec4<f32>(shade(p.ray.dir, shadow_km) * frame.balance.xyz, 1.0);
+        var rgb = vec3<f32>(0.0);
+        if (straddles_disk_edge(p.x, p.y, p.ray.dir)) {
+            // A disk's edge: the mean over the pixel's footprint.
+            for (var k = 0u; k < DISK_SUBSAMPLES * DISK_SUBSAMPLES; k++) {
+                let r = camera_ray(f32(p.x) + subpixel(k).x, f32(p.y) + subpixel(k).y);
+                if (r.valid) {
+                    rgb += shade(r.dir, shadow_km);
+                }
+            }
+            rgb /= f32(DISK_SUBSAMPLES * DISK_SUBSAMPLES);
+        } else {
+            rgb = shade(p.ray.dir, shadow_km);
+        }
+        out = vec4<f32>(rgb * frame.balance.xyz, 1.0);
     }
     write_pixel(p.i, p.x, p.y, out);
 }
@@ -155,7 +169,19 @@ fn main_terrain(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     }
     var out = vec4<f32>(0.0);
     if (p.ray.valid) {
-        out = vec4<f32>(shade_scene(p.ray.dir) * frame.balance.xyz, 1.0);
+        var rgb = vec3<f32>(0.0);
+        if (straddles_disk_edge(p.x, p.y, p.ray.dir)) {
+            for (var k = 0u; k < DISK_SUBSAMPLES * DISK_SUBSAMPLES; k++) {
+                let r = camera_ray(f32(p.x) + subpixel(k).x, f32(p.y) + subpixel(k).y);
+                if (r.valid) {
+                    rgb += shade_scene(r.dir);
+                }
+            }
+            rgb /= f32(DISK_SUBSAMPLES * DISK_SUBSAMPLES);
+        } else {
+            rgb = shade_scene(p.ray.dir);
+        }
+        out = vec4<f32>(rgb * frame.balance.xyz, 1.0);
     }
     write_pixel(p.i, p.x, p.y, out);
 }

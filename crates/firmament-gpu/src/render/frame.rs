@@ -62,6 +62,8 @@ pub(crate) struct FrameConstants {
     camera_above_top_km: f64,
     pub(crate) inside: bool,
     tan_half_fov: f64,
+    /// An upper bound on the pixels' footprints (rad; render::disk_edges).
+    max_footprint_rad: f64,
 }
 
 impl FrameConstants {
@@ -102,6 +104,11 @@ impl FrameConstants {
             camera_above_top_km: (r - top) * 1e-3,
             inside: r <= top,
             tan_half_fov: prepared.tan_half_fov(),
+            max_footprint_rad: firmament::render::disk_edges::max_footprint_rad(
+                &prepared,
+                settings.width,
+                settings.height,
+            ),
         }
     }
 
@@ -127,7 +134,7 @@ impl FrameConstants {
             bits(self.camera_above_top_km),
             u32::from(self.inside),
             bits(self.tan_half_fov),
-            0,
+            bits(self.max_footprint_rad),
             0,
             0,
         ]);

@@ -8,6 +8,7 @@
 //! the lights for their disks. A second surface or light needs no change here.
 
 pub mod air_volume;
+pub mod disk_edges;
 pub mod frame;
 pub mod sky_dome;
 pub mod stars;
@@ -294,11 +295,18 @@ pub fn render(
     let observer =
         crate::math::Vec3::new(0.0, 0.0, model.bottom_radius_m + settings.camera.altitude_m);
     let mut shader = Shader::new(scene, observer)?;
-    let points = stars::small_disks(scene, &prepared, w, h);
+    let points = stars::small_disks(&scene.lights, &prepared, w, h);
     shader
         .disks
         .retain(|(i, _)| points.iter().all(|(j, _)| j != i));
     let n = shader.channels;
+    let edges = disk_edges::DiskEdges::new(
+        &scene.lights,
+        shader.disks.iter().map(|d| d.0),
+        &prepared,
+        w,
+        h,
+    );
     let mut image = ImageRgbF32::new(w, h);
     let mut mask = vec![false; w * h];
     let done = AtomicUsize::new(0);
@@ -320,7 +328,22 @@ pub fn render(
                 let Some(ray) = prepared.ray(x as f64 + 0.5, y as f64 + 0.5) else {
                     continue;
                 };
-                shader.shade(&ray, &mut scratch, l);
+                if edges.straddles(&prepared, x, y, ray.dir) {
+                    // A disk's edge: the mean over the pixel's footprint.
+                    l.iter_mut().for_each(|v| *v = 0.0);
+                    let mut sub = [0.0f64; MAX_CHANNELS];
+                    let count = (disk_edges::SUBSAMPLES * disk_edges::SUBSAMPLES) as f64;
+                    for (dx, dy) in disk_edges::subpixels() {
+                        if let Some(r) = prepared.ray(x as f64 + dx, y as f64 + dy) {
+                            shader.shade(&r, &mut scratch, &mut sub[..n]);
+                            for k in 0..n {
+                                l[k] += sub[k] / count;
+                            }
+                        }
+                    }
+                } else {
+                    shader.shade(&ray, &mut scratch, l);
+                }
                 let c = colour.to_srgb(l);
                 row[x] = [
                     (c[0] * balance[0]) as f32,

@@ -9,7 +9,7 @@ use crate::io::ImageRgbF32;
 use crate::math::sphere::ray_intersects_ground;
 use crate::math::Vec3;
 use crate::scene::sky_lights::PointSource;
-use crate::scene::{PreparedCamera, Ray, Scene, Surface};
+use crate::scene::{Light, PreparedCamera, Ray, Scene, Surface};
 use crate::sky::{Shadow, SkyView};
 use crate::spectrum::ColourMatrix;
 
@@ -77,14 +77,14 @@ pub fn draw_points<'p>(
 /// The lights whose drawn disks would cover fewer than four pixels where they stand: their
 /// index and their light as a point (a disk that small, sampled at pixel centres, would
 /// flicker in and out of the image; as a point its energy is kept).
-pub(super) fn small_disks(
-    scene: &Scene,
+pub fn small_disks(
+    lights: &[Light],
     camera: &PreparedCamera,
     width: usize,
     height: usize,
 ) -> Vec<(usize, PointSource)> {
     let mut out = Vec::new();
-    for (i, light) in scene.lights.iter().enumerate() {
+    for (i, light) in lights.iter().enumerate() {
         if !light.visible_disk {
             continue;
         }
