@@ -13,7 +13,7 @@ use std::process::ExitCode;
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 
-use commands::{astro, atmosphere, bake, bench, gallery, query, render, validate};
+use commands::{astro, atmosphere, bake, bench, gallery, query, render, render_args, validate};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -40,7 +40,7 @@ enum Command {
     /// Precompute the tables and write them to a file for `--tables`.
     Bake(bake::BakeArgs),
     /// Render a picture of the sky (with no arguments: a default scene to firmament.png and firmament.exr).
-    Render(Box<render::RenderArgs>),
+    Render(Box<render_args::RenderArgs>),
     /// The canonical views as PNGs with an index.html contact sheet.
     Gallery(gallery::GalleryArgs),
     /// Benchmarks: medians of the precomputation and frame costs.

@@ -13,9 +13,8 @@ use firmament::scene::file::{SceneLocation, SceneTime};
 use firmament::scene::{Camera, Projection, SceneFile as Scene};
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
-use crate::commands::render::{
-    atmosphere_args, render_scene, terrain_and_atmosphere, write_outputs, FileOptions,
-};
+use crate::commands::outputs::{write_outputs, FileOptions};
+use crate::commands::render::{atmosphere_args, render_scene, terrain_and_atmosphere};
 
 /// Arguments of `firmament gallery`.
 #[derive(Args, Debug)]

@@ -12,7 +12,8 @@ use firmament::scene::SceneFile as Scene;
 use serde_json::json;
 
 use crate::backend::RenderSky;
-use crate::commands::render::{render_scene, write_outputs, FileOptions};
+use crate::commands::outputs::{write_outputs, FileOptions};
+use crate::commands::render::render_scene;
 use crate::common::{cancel_flag, progress_bar};
 use firmament::scene::terrain::Heightfield;
 
