@@ -46,7 +46,7 @@ use crate::spectrum::MAX_CHANNELS;
 pub const TRANSMITTANCE_SEGMENTS: usize = 128;
 /// Intervals along view rays for single and multiple scattering (Bruneton 2017 uses 50
 /// trapezoids). We weight them by Simpson's rule (with the transmittance fitted as an
-/// exponential, see [`ray`]): at this spacing a zenith ray takes
+/// exponential, see the private `ray` module): at this spacing a zenith ray takes
 /// 1.2 km steps, one aerosol scale height, where the trapezoid overestimates an
 /// exponential integrand by 8 % and Simpson by 0.5 % (found by the reference path tracer).
 pub const RAY_INTERVALS: usize = 50;
