@@ -128,6 +128,8 @@
 //! sRGB, an EXR of the map in physical units): `cargo run --release -p firmament --example
 //! sky_query`.
 
+#![warn(missing_docs)]
+
 pub mod astro;
 pub mod atmosphere;
 pub mod error;

@@ -116,16 +116,16 @@ pub fn unit_from_texcoord(u: f64, n: usize) -> f64 {
 /// Geometry constants the mappings need (metres).
 #[derive(Clone, Copy, Debug)]
 pub struct Radii {
-    /// Ground radius.
+    /// Ground radius (m).
     pub bottom: f64,
-    /// Top radius.
+    /// Top radius (m).
     pub top: f64,
     /// cos of the largest sun zenith angle covered.
     pub mu_s_min: f64,
 }
 
 impl Radii {
-    /// H = sqrt(R_t² − R_g²): the distance to the top along the horizon from the ground.
+    /// H = sqrt(R_t² − R_g²) (m): the distance to the top along the horizon from the ground.
     #[inline]
     pub fn h(&self) -> f64 {
         (self.top * self.top - self.bottom * self.bottom).sqrt()

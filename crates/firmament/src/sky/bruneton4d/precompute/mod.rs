@@ -58,8 +58,10 @@ pub const DENSITY_PHI: usize = 32;
 pub const HARMONICS: usize = DENSITY_PHI / 2;
 /// Azimuth steps over [0, π] to compute the phase functions' harmonics.
 pub const KERNEL_STEPS: usize = 96;
-/// Hemisphere sampling of the indirect irradiance (Bruneton 2017: 16 × 64).
+/// Hemisphere sampling of the indirect irradiance (Bruneton 2017: 16 × 64): zenith-angle
+/// steps over [0, π/2].
 pub const IRRADIANCE_THETA: usize = 16;
+/// Azimuth steps over [0, 2π] of the same sampling.
 pub const IRRADIANCE_PHI: usize = 64;
 
 /// Progress callback: (stage description, fraction done of the whole precomputation).
