@@ -63,7 +63,7 @@ use crate::terrain::{no_terrain_words, GpuTerrain};
 use crate::{GpuContext, GpuError, GpuSky};
 use frame::{light_words, slice_words, FrameConstants, MAX_LIGHTS};
 
-/// Bytes per pixel of a frame buffer (one vec4<f32>: linear sRGB and the mask).
+/// Bytes per pixel of a frame buffer (one `vec4<f32>`: linear sRGB and the mask).
 pub const PIXEL_BYTES: u64 = 16;
 /// Rows of a band are a multiple of this, so that every band's offset in the output buffer
 /// (rows × width × 16 bytes) is a multiple of 256, the largest storage-offset alignment.
@@ -268,7 +268,7 @@ impl GpuRenderer {
     }
 
     /// Record a frame into `encoder` (one compute pass; nothing is submitted). Refuses what
-    /// the CPU refuses, more than [`MAX_LIGHTS`] lights, and frames the device cannot hold.
+    /// the CPU refuses, more than `MAX_LIGHTS` lights, and frames the device cannot hold.
     pub fn encode(
         &self,
         ctx: &GpuContext,

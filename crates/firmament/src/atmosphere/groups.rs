@@ -78,7 +78,7 @@ impl ScatteringGroups {
         members_scattering(&model.constituents, &self.members[group], altitude_m, out);
     }
 
-    /// The ratio-rule factors (β_R[0]/β_M[0])·(β_M[k]/β_R[k]) at the ground, by which the
+    /// The ratio-rule factors `(β_R[0]/β_M[0])·(β_M[k]/β_R[k])` at the ground, by which the
     /// red-only Mie storage extrapolates the other channels (Bruneton & Neyret 2008 §4;
     /// Bruneton 2017 `GetExtrapolatedSingleMieScattering`); 0 where undefined.
     pub fn mie_ratio(&self) -> Vec<f64> {

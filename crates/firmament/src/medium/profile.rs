@@ -17,7 +17,7 @@ pub struct DensityLayer {
     /// whatever its width.
     #[serde(default)]
     pub width_m: f64,
-    /// Coefficient of the exponential term.
+    /// Coefficient of the exponential term (dimensionless).
     #[serde(default)]
     pub exp_term: f64,
     /// Scale height H (m) of the exponential term; `inf` (or 0 with exp_term 0) for none.
@@ -26,7 +26,7 @@ pub struct DensityLayer {
     /// Coefficient of the linear term (per metre of altitude).
     #[serde(default)]
     pub linear_term_per_m: f64,
-    /// Constant term.
+    /// Constant term (dimensionless).
     #[serde(default)]
     pub constant_term: f64,
 }

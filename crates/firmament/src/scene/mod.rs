@@ -1,6 +1,6 @@
 //! What a picture shows: the atmosphere through a sky method, surfaces, volumes and lights
 //! ([`Scene`]), seen by a camera ([`camera`]); and the scene files that describe it in TOML
-//! ([`file`]).
+//! ([`file`](mod@file)).
 //!
 //! The world is planet-centred (metres); the observer stands above the point of the planet
 //! on the +z axis, whose local frame is x = east, y = north, z = up.

@@ -45,12 +45,21 @@ pub enum SurfaceMap {
     /// Continents from 3D gradient noise over the sphere (`seed`), covering 1 −
     /// `ocean_fraction` of it; ice poleward of about 70°; deserts in the subtropics, forest
     /// in the tropics and mid-latitudes, grass between.
-    Procedural { seed: u64, ocean_fraction: f64 },
+    Procedural {
+        /// Seed of the continents' noise.
+        seed: u64,
+        /// The share of the sphere that is sea, in [0, 1] (Earth: 0.71).
+        ocean_fraction: f64,
+    },
     /// An equirectangular map (`width` × `height` linear sRGB pixels, row 0 at 90° N, column
     /// 0 at 180° W).
     Image {
+        /// Width of the map (pixels, 360° of longitude).
         width: usize,
+        /// Height of the map (pixels, 180° of latitude).
         height: usize,
+        /// The albedo, linear sRGB read as reflectances at 680, 550 and 440 nm (linear
+        /// between them); `width * height` pixels, row-major.
         rgb: Vec<[f32; 3]>,
     },
 }

@@ -51,6 +51,8 @@ pub trait SkyMethod: Send + Sync {
 
     /// The evaluation for views from `observer` (planet-centred, m; anywhere, in space too)
     /// lit by `light`: the method's per-view cache is built here, once per frame and light.
+    /// A light other than the model's sun scales every answer by its irradiance over the
+    /// model's [`Model::solar_irradiance`].
     fn view<'a>(&'a self, observer: Vec3, light: &'a Light) -> Box<dyn SkyView + 'a>;
 }
 
@@ -60,10 +62,11 @@ pub trait SkyView: Send + Sync {
     /// The light.
     fn light(&self) -> &Light;
 
-    /// Radiance scattered towards the observer along the ray in direction `dir` up to the
-    /// atmosphere boundary or the planet's ground (the ground's own radiance and the light's
-    /// disk excluded), and the transmittance along that ray (0 where it meets the ground).
-    /// An empty `transmittance` asks for the radiance only.
+    /// Radiance (W·m⁻²·sr⁻¹·nm⁻¹) scattered towards the observer along the ray in unit
+    /// direction `dir` (world frame) up to the atmosphere boundary or the planet's ground
+    /// (the ground's own radiance and the light's disk excluded), and the transmittance
+    /// (0–1) along that ray (0 where it meets the ground). An empty `transmittance` asks for
+    /// the radiance only.
     fn sky_radiance(
         &self,
         dir: Vec3,
@@ -72,8 +75,9 @@ pub trait SkyView: Send + Sync {
         transmittance: &mut [f64],
     );
 
-    /// Radiance scattered towards the observer between it and `point` (aerial perspective,
-    /// paper eq. 16's S|x − T(x, x_s)·S|x_s) and the transmittance between them.
+    /// Radiance (W·m⁻²·sr⁻¹·nm⁻¹) scattered towards the observer between it and `point`
+    /// (planet-centred, m; aerial perspective, paper eq. 16's S|x − T(x, x_s)·S|x_s) and the
+    /// transmittance (0–1) between them.
     fn sky_radiance_to_point(
         &self,
         point: Vec3,
@@ -82,15 +86,18 @@ pub trait SkyView: Send + Sync {
         transmittance: &mut [f64],
     );
 
-    /// Transmittance of the air between the observer and `point`.
+    /// Transmittance (0–1) of the air between the observer and `point` (planet-centred, m).
     fn transmittance_to_point(&self, point: Vec3, out: &mut [f64]);
 
-    /// Transmittance from `point` to the light, with the planet's occlusion of its disk.
+    /// Transmittance (0–1) from `point` (planet-centred, m) to the light, with the planet's
+    /// occlusion of its disk: times the light's irradiance, the direct beam's irradiance on
+    /// a surface facing it.
     fn transmittance_to_light(&self, point: Vec3, out: &mut [f64]);
 
-    /// The light's direct irradiance and the sky's irradiance on a surface at `point` with
-    /// unit `normal` (the sky term with the (1 + n·n̄)/2 occlusion factor of paper eq. 16;
-    /// above the atmosphere the direct beam only).
+    /// The light's direct irradiance and the sky's irradiance (W·m⁻²·nm⁻¹) on a surface at
+    /// `point` (planet-centred, m) with unit `normal` (the direct term with the cosine of
+    /// the light's incidence, the sky term with the (1 + n·n̄)/2 occlusion factor of paper
+    /// eq. 16; above the atmosphere the direct beam only).
     fn sun_and_sky_irradiance(
         &self,
         point: Vec3,

@@ -16,6 +16,8 @@ use crate::{Error, Result};
 /// one `angle_deg value` pair per line (whitespace or comma separated, `#` starts a comment),
 /// angles strictly increasing in [0, 180]. Values are interpolated linearly in θ; if the
 /// table does not start at 0° or end at 180° the end values are extended as constants.
+///
+/// [`PhaseFunction::prepare`]: super::PhaseFunction::prepare
 #[derive(Clone, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TabulatedPhase {

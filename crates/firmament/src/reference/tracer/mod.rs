@@ -1,8 +1,8 @@
 //! The path tracer proper: one wavelength at a time through a [`Model`]: the channel's
-//! coefficients ([`Channel`]), positions relative to an anchor ([`geometry`]), free paths by
-//! delta tracking ([`free_path`]), deterministic optical depths ([`optical_depth`]), the
-//! scene's volumes ([`volumes`]) and surfaces ([`surfaces`]), and the paths themselves
-//! ([`paths`]).
+//! coefficients (`Channel`), positions relative to an anchor (`geometry`), free paths by
+//! delta tracking (`free_path`), deterministic optical depths (`optical_depth`), the
+//! scene's volumes (`volumes`) and surfaces (`surfaces`), and the paths themselves
+//! (`paths`).
 //!
 //! Geometry. Positions are kept as an offset `o` from an *anchor* `A` on the ground sphere
 //! (|A| = R_g, below the ray's start), so that the quantity that matters, the altitude, is
@@ -29,7 +29,7 @@
 //! Surfaces. Besides the analytic ground sphere (the model's albedo), a flight ends at the
 //! nearest of the scene's surfaces inside the atmosphere, where the path is reflected as
 //! at the ground: Lambertian with the surface's albedo about the hit's normal, NEE with
-//! cos = n·l, a shadow ray that any surface blocks. See [`surfaces`].
+//! cos = n·l, a shadow ray that any surface blocks. See `surfaces`.
 
 mod free_path;
 pub(crate) mod geometry;

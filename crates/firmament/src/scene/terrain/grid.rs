@@ -347,7 +347,7 @@ impl GridRay {
 /// (or, with `below`, a whole node the ray crosses below the lowest value in it).
 #[derive(Clone, Copy, Debug)]
 pub struct CellSpan {
-    /// The span is a whole node the ray crosses below its lowest value ([`walk`]'s
+    /// The span is a whole node the ray crosses below its lowest value ([`Walk`]'s
     /// `floors`); `i` and `j` are then the node's, not a cell's.
     pub below: bool,
     /// Cell index along x′.

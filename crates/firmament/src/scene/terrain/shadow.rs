@@ -201,7 +201,7 @@ impl ShadowField {
     /// shadow line passes more than [`EDGE_MARGIN`] cells' spacing above the terrain at all
     /// of them: in shadow; as far below at all of them: lit), from an exact shadow ray
     /// ([`Heightfield::end_in_shadow`]) near the shadow's edge and off the grid. The margin
-    /// covers the sweep's error on the shadow line (its samples at 1/[`SWEEP_REFINE`] of a
+    /// covers the sweep's error on the shadow line (its samples at 1/`SWEEP_REFINE` of a
     /// cell); what it cannot see is a shadow (or a gap of light) narrower than a cell
     /// passing between all four vertices (`tests/terrain.rs` counts the disagreements
     /// with exact rays).

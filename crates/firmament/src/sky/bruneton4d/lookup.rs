@@ -1,6 +1,10 @@
 //! Lookups shared by the precomputation passes and the evaluation API: transmittance
 //! between points and to the sun from the transmittance table (Bruneton 2017
 //! `GetTransmittance`, `GetTransmittanceToSun`) and irradiance lookups.
+//!
+//! Arguments as in [`crate::math::sphere`]: r the distance from the planet's centre (m), μ
+//! the cosine of the view ray's zenith angle there, μ_s the sun's; outputs per channel,
+//! transmittances in [0, 1], irradiance in W·m⁻²·nm⁻¹.
 
 use super::params::{self, Radii, TableSizes};
 use super::table::{Table2, MAX_OPTICAL_DEPTH};
@@ -111,7 +115,8 @@ impl<'a> Lookup<'a> {
         smoothstep(-e, e, mu_s - cos_theta_h)
     }
 
-    /// Irradiance-table lookup at (r, μ_s).
+    /// Irradiance-table lookup at (r, μ_s): for [`super::Tables::irradiance`], the sky's
+    /// irradiance (W·m⁻²·nm⁻¹) on a horizontal surface at radius r.
     #[inline]
     pub fn irradiance(&self, table: &Table2, r: f64, mu_s: f64, out: &mut [f64]) {
         let (u, v) = params::irradiance_uv(

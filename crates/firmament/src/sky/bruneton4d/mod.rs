@@ -1,7 +1,7 @@
 //! Bruneton & Neyret 2008, *Precomputed Atmospheric Scattering*, as refined in Bruneton
 //! 2017: transmittance, irradiance and 4D scattering tables precomputed for one atmosphere
 //! ([`precompute`]), their parameterisations ([`params`]), storage and filtering
-//! ([`table`]), lookups ([`lookup`]), the versioned file format ([`file`]), and the
+//! ([`table`]), lookups ([`lookup`]), the versioned file format ([`file`](mod@file)), and the
 //! evaluation of the paper's eq. 16 pieces from them ([`view`]).
 
 pub mod file;

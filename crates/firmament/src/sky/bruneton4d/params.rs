@@ -100,7 +100,7 @@ impl TableSizes {
     }
 }
 
-/// Texel-centre-exact mapping of x ∈ [0,1] to a texture coordinate for `n` texels
+/// Texel-centre-exact mapping of x ∈ [0, 1] to a texture coordinate for `n` texels
 /// (Bruneton 2017 `GetTextureCoordFromUnitRange`).
 #[inline]
 pub fn texcoord_from_unit(x: f64, n: usize) -> f64 {
@@ -116,23 +116,23 @@ pub fn unit_from_texcoord(u: f64, n: usize) -> f64 {
 /// Geometry constants the mappings need (metres).
 #[derive(Clone, Copy, Debug)]
 pub struct Radii {
-    /// Ground radius.
+    /// Ground radius (m).
     pub bottom: f64,
-    /// Top radius.
+    /// Top radius (m).
     pub top: f64,
     /// cos of the largest sun zenith angle covered.
     pub mu_s_min: f64,
 }
 
 impl Radii {
-    /// H = sqrt(R_t² − R_g²): the distance to the top along the horizon from the ground.
+    /// H = sqrt(R_t² − R_g²) (m): the distance to the top along the horizon from the ground.
     #[inline]
     pub fn h(&self) -> f64 {
         (self.top * self.top - self.bottom * self.bottom).sqrt()
     }
 }
 
-/// (u, v) ∈ [0,1]² of the transmittance table for (r, μ) (paper §4, Bruneton 2017).
+/// (u, v) ∈ [0, 1]² of the transmittance table for (r, μ) (paper §4, Bruneton 2017).
 #[inline]
 pub fn transmittance_uv(radii: &Radii, r: f64, mu: f64, nmu: usize, nr: usize) -> (f64, f64) {
     let h = radii.h();
@@ -203,7 +203,7 @@ pub fn irradiance_texel(radii: &Radii, sizes: &TableSizes, x: usize, y: usize) -
     )
 }
 
-/// The four coordinates (u_ν, u_μs, u_μ, u_r) ∈ [0,1]⁴ of the scattering table.
+/// The four coordinates (u_ν, u_μs, u_μ, u_r) ∈ [0, 1]⁴ of the scattering table.
 #[inline]
 pub fn scattering_uvwz(
     radii: &Radii,
@@ -340,7 +340,7 @@ pub fn nu_from_u_nu(mu: f64, mu_s: f64, u_nu: f64) -> f64 {
     clamp_cosine(mu * mu_s + s * (1.0 - 2.0 * x * x))
 }
 
-/// The non-linear μ_s coordinate in [0,1] (Bruneton 2017): from the distance to the top
+/// The non-linear μ_s coordinate in [0, 1] (Bruneton 2017): from the distance to the top
 /// along the sun ray from the ground, with the configurable minimum sun elevation.
 #[inline]
 pub fn x_mu_s(radii: &Radii, mu_s: f64) -> f64 {

@@ -82,6 +82,8 @@ pub struct Tables {
     /// τ(r, μ) = −ln T to the top of the atmosphere, capped at
     /// [`table::MAX_OPTICAL_DEPTH`]: what the table files store and the transmittance
     /// lookups interpolate.
+    ///
+    /// [`table::MAX_OPTICAL_DEPTH`]: super::table::MAX_OPTICAL_DEPTH
     pub optical_depth: Table2,
     /// Indirect (sky) ground irradiance E(r, μ_s), W·m⁻²·nm⁻¹.
     pub irradiance: Table2,
@@ -94,7 +96,7 @@ pub struct Tables {
     /// Mean radiance of each scattering order over the table texels, per channel (order 1
     /// first): to see that orders decrease.
     pub order_means: Vec<Vec<f64>>,
-    /// Ratio rule factors (β_R[0]/β_M[0])·(β_M[k]/β_R[k]) for [`MieStorage::RedOnly`].
+    /// Ratio rule factors `(β_R[0]/β_M[0])·(β_M[k]/β_R[k])` for [`MieStorage::RedOnly`].
     pub mie_ratio: Vec<f64>,
     /// Multiple scattering, orders 2 to N summed, as radiance (W·m⁻²·sr⁻¹·nm⁻¹). Bruneton
     /// 2017 folds it into the single Rayleigh table divided by the molecular phase function; kept apart,

@@ -46,7 +46,7 @@ use crate::spectrum::MAX_CHANNELS;
 pub const TRANSMITTANCE_SEGMENTS: usize = 128;
 /// Intervals along view rays for single and multiple scattering (Bruneton 2017 uses 50
 /// trapezoids). We weight them by Simpson's rule (with the transmittance fitted as an
-/// exponential, see [`ray`]): at this spacing a zenith ray takes
+/// exponential, see the private `ray` module): at this spacing a zenith ray takes
 /// 1.2 km steps, one aerosol scale height, where the trapezoid overestimates an
 /// exponential integrand by 8 % and Simpson by 0.5 % (found by the reference path tracer).
 pub const RAY_INTERVALS: usize = 50;
@@ -58,8 +58,10 @@ pub const DENSITY_PHI: usize = 32;
 pub const HARMONICS: usize = DENSITY_PHI / 2;
 /// Azimuth steps over [0, π] to compute the phase functions' harmonics.
 pub const KERNEL_STEPS: usize = 96;
-/// Hemisphere sampling of the indirect irradiance (Bruneton 2017: 16 × 64).
+/// Hemisphere sampling of the indirect irradiance (Bruneton 2017: 16 × 64): zenith-angle
+/// steps over [0, π/2].
 pub const IRRADIANCE_THETA: usize = 16;
+/// Azimuth steps over [0, 2π] of the same sampling.
 pub const IRRADIANCE_PHI: usize = 64;
 
 /// Progress callback: (stage description, fraction done of the whole precomputation).
