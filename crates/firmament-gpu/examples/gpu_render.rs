@@ -20,7 +20,10 @@ fn luminance(p: &[f32; 3]) -> f64 {
 }
 
 fn write_png(frame: &Frame, ev100: f64, path: &std::path::Path) -> firmament::Result<()> {
-    let rgb8 = frame.to_srgb8(tonemap::exposure_from_ev100(ev100), ToneCurve::Aces);
+    let rgb8 = frame.to_srgb8(
+        tonemap::exposure_from_ev100(ev100, ToneCurve::Aces),
+        ToneCurve::Aces,
+    );
     firmament::io::write_png_srgb8(path, frame.image.width, frame.image.height, &rgb8)
 }
 

@@ -179,7 +179,8 @@ fn low_orbit_perspective_at_the_limb() {
 #[test]
 fn spectral_equirect() {
     let sky = sky("earth", Wavelengths::spectral(), 4, MieStorage::Separate);
-    let cam = camera(Projection::Equirect, 100.0, 0.0, 0.0, 60.0);
+    // Turned: the centre column faces 75° (--heading-deg).
+    let cam = camera(Projection::Equirect, 100.0, 75.0, 0.0, 60.0);
     let settings = RenderSettings {
         camera: &cam,
         width: 128,

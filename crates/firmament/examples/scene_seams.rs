@@ -61,7 +61,10 @@ fn main() -> firmament::Result<()> {
     };
     let frame = render::render(&scene, &settings, &|_| {}, None)?;
     let ev100 = tonemap::auto_ev100(frame.log_average_luminance());
-    let rgb8 = frame.to_srgb8(tonemap::exposure_from_ev100(ev100), ToneCurve::Aces);
+    let rgb8 = frame.to_srgb8(
+        tonemap::exposure_from_ev100(ev100, ToneCurve::Aces),
+        ToneCurve::Aces,
+    );
     firmament::io::write_png_srgb8(&out, settings.width, settings.height, &rgb8)?;
     eprintln!("{out}: EV100 {ev100:.1}");
     Ok(())

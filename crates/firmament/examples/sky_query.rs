@@ -165,7 +165,10 @@ fn main() -> firmament::Result<()> {
     // ...and a PNG needs an exposure (here a light meter's, from the log-average luminance)
     // and a tone curve.
     let ev100 = tonemap::auto_ev100(frame.log_average_luminance());
-    let rgb8 = frame.to_srgb8_dithered(tonemap::exposure_from_ev100(ev100), ToneCurve::Aces);
+    let rgb8 = frame.to_srgb8_dithered(
+        tonemap::exposure_from_ev100(ev100, ToneCurve::Aces),
+        ToneCurve::Aces,
+    );
     let png = out_dir.join("sky_query.png");
     write_png_srgb8(&png, settings.width, settings.height, &rgb8)?;
     println!(

@@ -98,7 +98,7 @@
 //! let top = frame.image.get(32, 0); // just below the zenith
 //! assert!(top[2] > top[0], "the sky is blue: {top:?}");
 //! let ev100 = tonemap::auto_ev100(frame.log_average_luminance());
-//! let rgb8 = frame.to_srgb8(tonemap::exposure_from_ev100(ev100), ToneCurve::Aces);
+//! let rgb8 = frame.to_srgb8(tonemap::exposure_from_ev100(ev100, ToneCurve::Aces), ToneCurve::Aces);
 //! let dir = std::env::temp_dir().join(format!("firmament-doc-{}", std::process::id()));
 //! std::fs::create_dir_all(&dir).unwrap();
 //! firmament::io::write_png_srgb8(dir.join("sky.png"), 64, 32, &rgb8)?;

@@ -24,11 +24,15 @@ pub struct AstroArgs {
     /// altitude above the ground is separate).
     #[arg(long, allow_hyphen_values = true)]
     pub elevation_m: Option<f64>,
-    /// Surface pressure for refraction (hPa).
-    #[arg(long)]
+    #[arg(long, help = format!(
+        "Surface pressure for refraction (hPa) [default: {}, ISO 2533 sea level]",
+        Weather::default().pressure_hpa
+    ))]
     pub pressure_hpa: Option<f64>,
-    /// Surface temperature for refraction (°C).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, help = format!(
+        "Surface temperature for refraction (°C) [default: {}]",
+        Weather::default().temperature_c
+    ))]
     pub temperature_c: Option<f64>,
 }
 
@@ -83,10 +87,10 @@ pub struct AstroCommandArgs {
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub elevation_m: f64,
     /// Surface pressure for refraction (hPa).
-    #[arg(long, default_value_t = 1013.25)]
+    #[arg(long, default_value_t = Weather::default().pressure_hpa)]
     pub pressure_hpa: f64,
     /// Surface temperature for refraction (°C).
-    #[arg(long, default_value_t = 15.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = Weather::default().temperature_c, allow_hyphen_values = true)]
     pub temperature_c: f64,
 }
 

@@ -111,7 +111,7 @@ fn write_strip(
         }
         let (frame, ev100) = render_scene(sky, &s, None, true)?;
         let rgb = frame.to_srgb8_dithered(
-            firmament::render::tonemap::exposure_from_ev100(ev100),
+            firmament::render::tonemap::exposure_from_ev100(ev100, s.output.tonemap),
             s.output.tonemap,
         );
         for y in 0..h {

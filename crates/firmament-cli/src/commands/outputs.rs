@@ -51,7 +51,7 @@ pub fn write_outputs(
         let t = Instant::now();
         match OutputFormat::from_path(path)? {
             OutputFormat::Png => {
-                let exposure = tonemap::exposure_from_ev100(ev100);
+                let exposure = tonemap::exposure_from_ev100(ev100, scene.output.tonemap);
                 let rgb8 = if files.dither {
                     frame.to_srgb8_dithered(exposure, scene.output.tonemap)
                 } else {

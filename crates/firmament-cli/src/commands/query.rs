@@ -32,8 +32,10 @@ pub struct QueryArgs {
     /// unless --time is given.
     #[arg(long, allow_hyphen_values = true)]
     pub sun_zenith_deg: Option<f64>,
-    /// Sun azimuth (degrees clockwise from north; default 180).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, help = format!(
+        "Sun azimuth (degrees clockwise from north) [default: {}, as `render`'s]",
+        firmament::scene::file::SceneSun::default().azimuth_deg
+    ))]
     pub sun_azimuth_deg: Option<f64>,
     /// A date and a place instead of the sun's angles (the moon and, at night, the night
     /// sky's glow then add to the views).
@@ -186,7 +188,11 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
     let astro = args.astro.resolve()?;
     let (sun_zenith_deg, sun_azimuth_deg) = match (&astro, args.sun_zenith_deg) {
         (Some(_), _) => (f64::NAN, f64::NAN),
-        (None, Some(z)) => (z, args.sun_azimuth_deg.unwrap_or(180.0)),
+        (None, Some(z)) => (
+            z,
+            (args.sun_azimuth_deg)
+                .unwrap_or(firmament::scene::file::SceneSun::default().azimuth_deg),
+        ),
         (None, None) => anyhow::bail!("the sun's place is needed: --sun-zenith-deg (and --sun-azimuth-deg), or --time with --lat-deg/--lon-deg"),
     };
     if astro.is_none() {

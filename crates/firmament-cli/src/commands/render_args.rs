@@ -19,35 +19,51 @@ pub struct RenderArgs {
     /// Scene file (TOML; see scenes/ for examples).
     #[arg(long, value_name = "FILE")]
     pub scene: Option<PathBuf>,
-    /// Camera: perspective, fisheye, equirect, cubemap, orbit.
-    #[arg(long)]
+    // The help texts name the defaults of the built-in scene (`defaults()`), so that they
+    // are defined once, in `SceneFile::default`.
+    #[arg(long, value_name = "perspective|fisheye|equirect|cubemap|orbit", help = camera_help())]
     pub camera: Option<String>,
-    /// Image width (pixels).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true, value_parser = pixels, help = size_help("width"))]
     pub width: Option<usize>,
-    /// Image height (pixels).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true, value_parser = pixels, help = size_help("height"))]
     pub height: Option<usize>,
-    /// Camera altitude above the ground (m).
-    #[arg(long, allow_hyphen_values = true)]
+    /// A cube map's face edge (pixels): the map is 6·SIZE × SIZE.
+    #[arg(long, allow_hyphen_values = true, value_parser = pixels, conflicts_with_all = ["width", "height"])]
+    pub size: Option<usize>,
+    #[arg(long, allow_hyphen_values = true, help = with_default(
+        "Camera altitude above the ground, or above the terrain below the camera (m)",
+        defaults().camera.altitude_m,
+    ))]
     pub altitude_m: Option<f64>,
-    /// View heading (degrees clockwise from north).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, help = with_default(
+        "View heading (degrees clockwise from north); an equirect map's centre column and a fisheye's top face it (north by default for them)",
+        defaults().camera.heading_deg,
+    ))]
     pub heading_deg: Option<f64>,
-    /// View pitch (degrees above the horizon).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, help = with_default(
+        "View pitch (degrees above the horizon; perspective only)",
+        defaults().camera.pitch_deg,
+    ))]
     pub pitch_deg: Option<f64>,
-    /// Camera roll (degrees).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, help = with_default(
+        "Camera roll (degrees, clockwise; perspective and orbit)",
+        defaults().camera.roll_deg,
+    ))]
     pub roll_deg: Option<f64>,
-    /// Vertical field of view (degrees).
-    #[arg(long)]
+    #[arg(long, help = with_default(
+        "Vertical field of view (degrees; perspective, and orbit where it fits the planet by default)",
+        defaults().camera.fov_deg,
+    ))]
     pub fov_deg: Option<f64>,
-    /// Sun zenith angle (degrees; > 90 below the horizon).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, help = with_default(
+        "Sun zenith angle (degrees; > 90 below the horizon)",
+        defaults().sun.zenith_deg,
+    ))]
     pub sun_zenith_deg: Option<f64>,
-    /// Sun azimuth (degrees clockwise from north).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, help = with_default(
+        "Sun azimuth (degrees clockwise from north)",
+        defaults().sun.azimuth_deg,
+    ))]
     pub sun_azimuth_deg: Option<f64>,
     /// Do not draw the solar disk.
     #[arg(long)]
@@ -78,29 +94,33 @@ pub struct RenderArgs {
     /// Skip the time-lapse's frames whose every output file exists (resume a stopped run).
     #[arg(long, requires = "until")]
     pub resume: bool,
-    /// Embedded preset.
-    #[arg(long, conflicts_with = "atmosphere")]
+    #[arg(long, conflicts_with = "atmosphere", help = with_default(
+        "Embedded preset: earth, bruneton2008, frostbite2016, hazy, mars",
+        defaults().atmosphere.preset,
+    ))]
     pub preset: Option<String>,
     /// Atmosphere TOML file.
     #[arg(long, value_name = "FILE")]
     pub atmosphere: Option<PathBuf>,
-    /// Wavelengths: rgb, spectral or NM,NM,...
-    #[arg(long)]
+    #[arg(long, help = with_default(
+        "Wavelengths: `spectral` (16 samples 365–815 nm), `rgb` (680, 550, 440 nm: fast, colours and luminance a few % off at sunset) or NM,NM,...",
+        defaults().atmosphere.wavelengths,
+    ))]
     pub wavelengths: Option<String>,
     /// Precomputed tables from `firmament bake`.
     #[arg(long, value_name = "FILE")]
     pub tables: Option<PathBuf>,
     /// Table sizes when computing: default or small.
-    #[arg(long, default_value = "default")]
+    #[arg(long, default_value = "default", value_name = "default|small")]
     pub table_size: String,
-    /// Exposure value at ISO 100 (PNG only); automatic when absent.
-    #[arg(long, allow_hyphen_values = true)]
+    /// Exposure value at ISO 100 (PNG only) [default: automatic, as a camera's meter].
+    #[arg(long, allow_hyphen_values = true, conflicts_with = "auto_exposure")]
     pub ev100: Option<f64>,
     /// Automatic exposure from the log-average luminance (overrides the scene's ev100).
     #[arg(long)]
     pub auto_exposure: bool,
-    /// Tone curve for PNG: aces (default), filmic, clamp.
-    #[arg(long)]
+    /// Tone curve for PNG: aces, filmic, clamp [default: the scene's, aces].
+    #[arg(long, value_name = "aces|filmic|clamp")]
     pub tonemap: Option<String>,
     /// White-balance to the sun's colour.
     #[arg(long)]
@@ -117,8 +137,10 @@ pub struct RenderArgs {
     /// Round PNG output to the nearest code instead of dithering (triangular, ±1 code).
     #[arg(long)]
     pub no_dither: bool,
-    /// Output file, repeatable; format from the extension (.png, .exr, .hdr).
-    #[arg(long = "out", value_name = "FILE")]
+    #[arg(long = "out", value_name = "FILE", help = with_default(
+        "Output file, repeatable; format from the extension (.png, .exr, .hdr, .dds)",
+        defaults().output.files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(" and "),
+    ))]
     pub outputs: Vec<PathBuf>,
     /// Print nothing but errors.
     #[arg(long, short)]
@@ -138,6 +160,70 @@ pub struct RenderArgs {
     pub backend: BackendChoice,
 }
 
+/// The built-in scene, whose values are the defaults of the flags.
+fn defaults() -> Scene {
+    Scene::default()
+}
+
+/// `text [default: value]`, as clap writes its own defaults.
+fn with_default(text: &str, value: impl std::fmt::Display) -> String {
+    format!("{text} [default: {value}]")
+}
+
+fn camera_help() -> String {
+    with_default(
+        "Camera: perspective, fisheye, equirect, cubemap, orbit",
+        format!("{:?}", defaults().camera.projection).to_lowercase(),
+    )
+}
+
+fn size_help(which: &str) -> String {
+    let d = defaults();
+    let v = if which == "width" {
+        d.image.width
+    } else {
+        d.image.height
+    };
+    let all_round = [
+        (Projection::Fisheye, "fisheye"),
+        (Projection::Equirect, "equirect"),
+        (Projection::Cubemap, "cubemap"),
+        (Projection::Orbit, "orbit"),
+    ]
+    .iter()
+    .map(|&(p, name)| {
+        let (w, h) = default_size(p);
+        format!("{name} {}", if which == "width" { w } else { h })
+    })
+    .collect::<Vec<_>>()
+    .join(", ");
+    format!(
+        "Image {which} (pixels, 1 to 32768); an equirect map is 2:1 and a cube map 6:1, so either size gives the other [default: {v}; {all_round}]"
+    )
+}
+
+/// The image size a projection chosen by `--camera` gets without sizes.
+fn default_size(p: Projection) -> (usize, usize) {
+    match p {
+        Projection::Fisheye | Projection::Orbit => (1024, 1024),
+        Projection::Equirect => (2048, 1024),
+        Projection::Cubemap => (3072, 512),
+        Projection::Perspective => {
+            let d = defaults();
+            (d.image.width, d.image.height)
+        }
+    }
+}
+
+/// A `--width`/`--height`/`--size` value: our message for anything but a positive integer
+/// (clap's for `-5` would be "unexpected argument").
+fn pixels(s: &str) -> std::result::Result<usize, String> {
+    match s.trim().parse::<i64>() {
+        Ok(v) if (1..=32768).contains(&v) => Ok(v as usize),
+        _ => Err("an image size in pixels, an integer in [1, 32768]".into()),
+    }
+}
+
 fn parse_projection(s: &str) -> Result<Projection> {
     Ok(match s {
         "perspective" => Projection::Perspective,
@@ -149,6 +235,83 @@ fn parse_projection(s: &str) -> Result<Projection> {
     })
 }
 
+/// Refuse the camera flags that `projection` would ignore: the all-round maps have no
+/// pitch, roll or field of view (an equirect map's and a fisheye's heading turns them),
+/// a cube map's faces face the world's axes, an orbit camera looks straight down.
+fn refuse_ignored_flags(args: &RenderArgs, projection: Projection) -> Result<()> {
+    let name = format!("{projection:?}").to_lowercase();
+    if args.size.is_some() && projection != Projection::Cubemap {
+        anyhow::bail!(
+            "--size is a cube map's face edge; the {name} camera takes --width and --height"
+        );
+    }
+    let given = [
+        ("--heading-deg", args.heading_deg.is_some()),
+        ("--pitch-deg", args.pitch_deg.is_some()),
+        ("--roll-deg", args.roll_deg.is_some()),
+        ("--fov-deg", args.fov_deg.is_some()),
+    ];
+    let (ignored, why): (&[&str], &str) = match projection {
+        Projection::Perspective => (&[], ""),
+        Projection::Fisheye | Projection::Equirect => (
+            &["--pitch-deg", "--roll-deg", "--fov-deg"],
+            "it sees the whole sky, level; --heading-deg turns it",
+        ),
+        Projection::Cubemap => (
+            &["--heading-deg", "--pitch-deg", "--roll-deg", "--fov-deg"],
+            "its faces face the world's axes; --layout arranges them",
+        ),
+        Projection::Orbit => (
+            &["--pitch-deg"],
+            "it looks straight down at the planet; --heading-deg turns it",
+        ),
+    };
+    match given
+        .iter()
+        .find(|(flag, set)| *set && ignored.contains(flag))
+    {
+        Some((flag, _)) => anyhow::bail!("{flag} does not apply to the {name} camera: {why}"),
+        None => Ok(()),
+    }
+}
+
+/// The image size from --width, --height and --size: an equirect map is 2:1 and a cube
+/// map 6:1, so one size gives the other and two that disagree are refused.
+fn set_size(args: &RenderArgs, scene: &mut Scene) -> Result<()> {
+    let ratio = match scene.camera.projection {
+        Projection::Equirect => Some((2, "an equirect map is 2:1")),
+        Projection::Cubemap => Some((6, "a cube map is six square faces side by side, 6:1")),
+        _ => None,
+    };
+    let (width, height) = match (args.size, ratio) {
+        (Some(s), Some((k, _))) => (Some(k * s), Some(s)),
+        _ => (args.width, args.height),
+    };
+    match (width, height, ratio) {
+        (Some(w), Some(h), Some((k, why))) if w != k * h => anyhow::bail!(
+            "--width {w} and --height {h} disagree: {why} (--width {} or --height {}, or give one of them)",
+            k * h,
+            w / k
+        ),
+        (Some(w), None, Some((k, why))) => {
+            if w % k != 0 {
+                anyhow::bail!("--width {w} is not a multiple of {k}: {why}");
+            }
+            (scene.image.width, scene.image.height) = (w, w / k);
+        }
+        (None, Some(h), Some((k, _))) => (scene.image.width, scene.image.height) = (k * h, h),
+        _ => {
+            if let Some(w) = width {
+                scene.image.width = w;
+            }
+            if let Some(h) = height {
+                scene.image.height = h;
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The scene after applying flags.
 pub fn scene_from_args(args: &RenderArgs) -> Result<Scene> {
     let mut scene = match &args.scene {
@@ -157,20 +320,22 @@ pub fn scene_from_args(args: &RenderArgs) -> Result<Scene> {
     };
     if let Some(c) = &args.camera {
         scene.camera.projection = parse_projection(c)?;
-        // Sensible shapes for the all-round projections unless sizes are given.
+        // The default scene's framing is a perspective view's: another projection from it
+        // starts level, facing north, at its own size.
         if args.scene.is_none() {
-            match scene.camera.projection {
-                Projection::Fisheye => (scene.image.width, scene.image.height) = (1024, 1024),
-                Projection::Equirect => (scene.image.width, scene.image.height) = (2048, 1024),
-                Projection::Cubemap => (scene.image.width, scene.image.height) = (3072, 512),
-                Projection::Orbit => {
-                    (scene.image.width, scene.image.height) = (1024, 1024);
-                    scene.camera.altitude_m = 20_000_000.0;
-                }
-                Projection::Perspective => {}
+            let p = scene.camera.projection;
+            (scene.image.width, scene.image.height) = default_size(p);
+            if p != Projection::Perspective {
+                (scene.camera.heading_deg, scene.camera.pitch_deg) = (0.0, 0.0);
+                scene.camera.roll_deg = 0.0;
+            }
+            if p == Projection::Orbit {
+                scene.camera.altitude_m = 20_000_000.0;
             }
         }
     }
+    let projection = scene.camera.projection;
+    refuse_ignored_flags(args, projection)?;
     macro_rules! set {
         ($flag:expr, $field:expr) => {
             if let Some(v) = $flag {
@@ -178,23 +343,13 @@ pub fn scene_from_args(args: &RenderArgs) -> Result<Scene> {
             }
         };
     }
-    set!(args.width, scene.image.width);
-    set!(args.height, scene.image.height);
-    if args.width.is_some()
-        && args.height.is_none()
-        && scene.camera.projection == Projection::Cubemap
-    {
-        scene.image.height = scene.image.width / 6;
-    }
+    set_size(args, &mut scene)?;
     set!(args.altitude_m, scene.camera.altitude_m);
     set!(args.heading_deg, scene.camera.heading_deg);
     set!(args.pitch_deg, scene.camera.pitch_deg);
     set!(args.roll_deg, scene.camera.roll_deg);
     set!(args.fov_deg, scene.camera.fov_deg);
-    if scene.camera.projection == Projection::Orbit
-        && args.fov_deg.is_none()
-        && args.scene.is_none()
-    {
+    if projection == Projection::Orbit && args.fov_deg.is_none() && args.scene.is_none() {
         scene.camera.fov_deg = firmament::scene::camera::orbit_fit_fov_deg(
             6_360_000.0 * 1.01,
             6_360_000.0 + scene.camera.altitude_m,

@@ -30,6 +30,12 @@ fn cube_direction(face: u32, u: f32, v: f32) -> vec3<f32> {
     }
 }
 
+// The heading (rad) of the level all-round projections (fisheye, equirect), from the
+// prepared basis: forward = (sin h, cos h, 0). Exactly 0 facing north.
+fn heading() -> f32 {
+    return atan2(frame.forward.x, frame.forward.y);
+}
+
 struct CameraRay {
     dir: vec3<f32>,
     valid: bool,
@@ -65,12 +71,13 @@ fn camera_ray(px: f32, py: f32) -> CameraRay {
                 // atan2(0, 0) is 0 on the CPU; the zenith.
                 d = vec3<f32>(0.0, 0.0, 1.0);
             } else {
-                d = direction_from_zenith_azimuth(rho * PI / 2.0, atan2(-x, y));
+                d = direction_from_zenith_azimuth(rho * PI / 2.0, atan2(-x, y) + heading());
             }
         }
         case 2u: {
-            // Equirect: azimuth u·π, elevation v·π/2 (zenith angle π/2 − elevation).
-            let azimuth = u * PI;
+            // Equirect: azimuth u·π from the heading, elevation v·π/2 (zenith angle
+            // π/2 − elevation).
+            let azimuth = u * PI + heading();
             let elevation = v * PI / 2.0;
             let c = cos(elevation);
             d = vec3<f32>(c * sin(azimuth), c * cos(azimuth), sin(elevation));

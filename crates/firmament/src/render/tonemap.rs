@@ -53,16 +53,53 @@ impl ToneCurve {
     }
 }
 
-/// Scale from luminance (cd/m²) to exposed values for EV100: 1/L_max with
-/// L_max = 1.2·2^EV100 (saturation-based sensitivity, ISO 100, q = 0.65).
-pub fn exposure_from_ev100(ev100: f64) -> f64 {
-    1.0 / (1.2 * 2f64.powf(ev100))
+/// The reflected-light meter calibration constant K (cd·s/m², ISO 2720): a meter at ISO 100
+/// reads EV100 = log2(L·100/K) for luminance L.
+pub const METER_K: f64 = 12.5;
+
+/// Display mid-grey: an 18 % reflectance card, linear (sRGB code 118).
+pub const DISPLAY_MID_GREY: f64 = 0.18;
+
+impl ToneCurve {
+    /// The exposed value that the curve maps to `y` in (0, 1) (bisection; the curves are
+    /// monotonic).
+    pub fn inverse(self, y: f64) -> f64 {
+        let (mut lo, mut hi) = (0.0, 1.0);
+        while self.apply(hi) < y && hi < 1e6 {
+            hi *= 2.0;
+        }
+        for _ in 0..80 {
+            let mid = 0.5 * (lo + hi);
+            if self.apply(mid) < y {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    }
 }
 
-/// EV100 from the average scene luminance with the reflected-light meter calibration
-/// K = 12.5 (ISO 2720): EV100 = log2(L_avg·100/K).
+/// The luminance (cd/m²) a light meter reads as `ev100` (ISO 2720): 2^EV100·K/100.
+pub fn metered_luminance(ev100: f64) -> f64 {
+    2f64.powf(ev100) * METER_K / 100.0
+}
+
+/// Scale from luminance (cd/m²) to exposed values for EV100 and a tone curve, as a camera
+/// renders a photograph: the luminance its meter reads at that EV lands on display
+/// mid-grey after the curve (a camera's JPEG rendering does the same; the saturation-based
+/// scale 1/(1.2·2^EV) of Lagarde & de Rousiers 2014 alone put it at 0.104 before the
+/// curve, 0.13 after ACES: a noon sky came out navy). Sunny 16: an 18 % card under
+/// 100 klx (5730 cd/m²) at EV100 15 shows at 1.4 × mid-grey before the curve.
+pub fn exposure_from_ev100(ev100: f64, curve: ToneCurve) -> f64 {
+    curve.inverse(DISPLAY_MID_GREY) / metered_luminance(ev100)
+}
+
+/// EV100 that a reflected-light meter (K = 12.5, ISO 2720) reads for the scene's average
+/// luminance: EV100 = log2(L_avg·100/K). With [`exposure_from_ev100`] that average shows
+/// at display mid-grey.
 pub fn auto_ev100(mean_luminance_cd_m2: f64) -> f64 {
-    (mean_luminance_cd_m2.max(1e-6) * 100.0 / 12.5).log2()
+    (mean_luminance_cd_m2.max(1e-6) * 100.0 / METER_K).log2()
 }
 
 #[cfg(test)]
@@ -84,10 +121,18 @@ mod tests {
 
     #[test]
     fn sunny_16_exposure() {
-        // Sunny-16 daylight scenes are EV100 ≈ 15; a mid-grey 18 % surface under 100 klx
-        // has L = 0.18·100000/π ≈ 5730 cd/m², which exposes to about 0.0011·5730 ≈ 0.15.
-        let e = exposure_from_ev100(15.0);
-        assert!((e * 5730.0 - 0.146).abs() < 0.01);
+        // Sunny-16 daylight scenes are EV100 ≈ 15: a meter reads 2^15·12.5/100 = 4096
+        // cd/m² there, which every curve shows at display mid-grey.
         assert!((auto_ev100(4096.0) - 15.0).abs() < 1e-9);
+        for c in [ToneCurve::Aces, ToneCurve::Filmic, ToneCurve::Clamp] {
+            let shown = c.apply(exposure_from_ev100(15.0, c) * 4096.0);
+            assert!((shown - 0.18).abs() < 1e-9, "{c:?}: {shown}");
+        }
+        // The clamp curve is the identity below 1: mid-grey exposes to exactly 0.18.
+        assert!((ToneCurve::Clamp.inverse(0.18) - 0.18).abs() < 1e-12);
+        // A mid-grey card under 100 klx in sunshine (L = 0.18·100000/π ≈ 5730 cd/m²) is a
+        // little brighter than the meter's average: 1.4 × mid-grey at EV100 15.
+        let e = exposure_from_ev100(15.0, ToneCurve::Clamp);
+        assert!((e * 5730.0 / 0.18 - 1.4).abs() < 0.01);
     }
 }

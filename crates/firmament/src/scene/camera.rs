@@ -15,12 +15,14 @@ use crate::{Error, Result};
 pub enum Projection {
     /// Pinhole camera with a vertical field of view.
     Perspective,
-    /// Equidistant all-sky fisheye: zenith at the centre, horizon on the circle, north up,
-    /// east to the left (as seen looking up, the standard for sky cameras).
+    /// Equidistant all-sky fisheye: zenith at the centre, horizon on the circle, the heading
+    /// (north by default) up, east of it to the left (as seen looking up, the standard for
+    /// sky cameras).
     Fisheye,
-    /// Equirectangular 360×180 map: columns are azimuth clockwise from north, from −180°
-    /// (south) at the left edge through north (0°) at the centre column and east (90°) at
-    /// three quarters of the width; rows are elevation, +90° at the top row.
+    /// Equirectangular 360×180 map: columns are azimuth clockwise from the heading (north by
+    /// default), from −180° at the left edge through the heading at the centre column and
+    /// 90° east of it at three quarters of the width; rows are elevation, +90° at the top
+    /// row. See docs/conventions.md for where this lands in Blender, Unity, Godot, Unreal.
     Equirect,
     /// Six square faces side by side in the order +X (east), −X (west), +Y (north),
     /// −Y (south), +Z (up), −Z (down); each is a 90° view as seen from the inside, side
@@ -91,6 +93,29 @@ impl Camera {
                 "a number in [-90, 90] degrees",
             ));
         }
+        let level = match self.projection {
+            Projection::Fisheye | Projection::Equirect => ["pitch_deg", "roll_deg"].as_slice(),
+            Projection::Cubemap => &["heading_deg", "pitch_deg", "roll_deg"],
+            Projection::Orbit => &["pitch_deg"],
+            Projection::Perspective => &[],
+        };
+        for name in level {
+            let v = match *name {
+                "heading_deg" => self.heading_deg,
+                "pitch_deg" => self.pitch_deg,
+                _ => self.roll_deg,
+            };
+            if v != 0.0 {
+                return Err(Error::invalid(
+                    format!("camera.{name}"),
+                    v,
+                    format!(
+                        "0 for the {:?} projection (it would be ignored: all-round maps are level, a cube map's faces face the axes, an orbit camera looks down)",
+                        self.projection
+                    ),
+                ));
+            }
+        }
         if !(self.fov_deg.is_finite() && self.fov_deg > 0.0 && self.fov_deg < 180.0) {
             return Err(Error::invalid(
                 "camera.fov_deg",
@@ -158,7 +183,10 @@ impl Camera {
                 // the azimuth θ has sin θ = −x/ρ, cos θ = y/ρ (no arctangent needed).
                 let (sin_z, cos_z) = (rho * PI / 2.0).sin_cos();
                 if rho > 0.0 {
-                    Vec3::new(-x / rho * sin_z, y / rho * sin_z, cos_z)
+                    turned(
+                        Vec3::new(-x / rho * sin_z, y / rho * sin_z, cos_z),
+                        self.heading_deg,
+                    )
                 } else {
                     Vec3::Z
                 }
@@ -166,7 +194,7 @@ impl Camera {
             Projection::Equirect => {
                 // Column: azimuth from −180° (south, left edge) through 0° (north, centre)
                 // to 180°; row: elevation +90° (top) to −90° (bottom).
-                let azimuth = u * PI;
+                let azimuth = u * PI + self.heading_deg.to_radians();
                 let elevation = v * PI / 2.0;
                 direction_from_zenith_azimuth(PI / 2.0 - elevation, azimuth)
             }
@@ -265,6 +293,7 @@ impl PreparedCamera {
                 )
             }
             Projection::Fisheye => {
+                let dir = turned(dir, -self.camera.heading_deg);
                 let zenith = dir.z.clamp(-1.0, 1.0).acos();
                 let rho = zenith / (PI / 2.0);
                 if rho > 1.0 {
@@ -283,10 +312,13 @@ impl PreparedCamera {
                     (x, y * aspect)
                 }
             }
-            Projection::Equirect => (
-                dir.x.atan2(dir.y) / PI,
-                dir.z.clamp(-1.0, 1.0).asin() / (PI / 2.0),
-            ),
+            Projection::Equirect => {
+                let dir = turned(dir, -self.camera.heading_deg);
+                (
+                    dir.x.atan2(dir.y) / PI,
+                    dir.z.clamp(-1.0, 1.0).asin() / (PI / 2.0),
+                )
+            }
             Projection::Cubemap => {
                 // The face of the major axis; cube_direction solved for (u, v).
                 let a = dir.abs();
@@ -334,6 +366,17 @@ impl PreparedCamera {
     }
 }
 
+/// `v` turned clockwise (seen from above) by `heading_deg` about the zenith: its azimuth
+/// grows by the heading. Exact at a zero heading.
+fn turned(v: Vec3, heading_deg: f64) -> Vec3 {
+    if heading_deg == 0.0 {
+        return v;
+    }
+    let (s, c) = heading_deg.to_radians().sin_cos();
+    // Azimuth θ has (x, y) = (sin θ, cos θ): sin(θ + h), cos(θ + h).
+    Vec3::new(v.x * c + v.y * s, v.y * c - v.x * s, v.z)
+}
+
 /// Vertical field of view (degrees) that frames a sphere of `radius_m` seen from
 /// `distance_m` from its centre with a 15 % margin (120° when the camera is too close).
 pub fn orbit_fit_fov_deg(radius_m: f64, distance_m: f64) -> f64 {
@@ -377,6 +420,7 @@ mod tests {
                 roll_deg: 5.0,
                 fov_deg: 60.0,
             };
+            // (Unvalidated: the all-round projections ignore the pitch and roll.)
             let p = camera.prepare(6_360_000.0, w, h);
             for (px, py) in [(10.3, 20.7), (w as f64 * 0.6, h as f64 * 0.45), (5.5, 90.2)] {
                 let Some(ray) = p.ray(px, py) else { continue };
@@ -386,6 +430,31 @@ mod tests {
                     "{projection:?}: ({px}, {py}) → ({qx}, {qy})"
                 );
             }
+        }
+        // The heading turns the level all-round maps: at 90° the equirect's centre column
+        // and the fisheye's top face east, and the equirect's three-quarter column south.
+        let east = Vec3::X;
+        for (projection, w, h, px, py, want) in [
+            (Projection::Equirect, 400, 200, 200.0, 100.0, east),
+            (Projection::Equirect, 400, 200, 300.0, 100.0, -Vec3::Y),
+            (Projection::Fisheye, 200, 200, 100.0, 0.0, east),
+        ] {
+            let camera = Camera {
+                projection,
+                altitude_m: 0.0,
+                heading_deg: 90.0,
+                pitch_deg: 0.0,
+                roll_deg: 0.0,
+                fov_deg: 60.0,
+            };
+            let d = camera.prepare(6_360_000.0, w, h).ray(px, py).unwrap().dir;
+            assert!((d - want).length() < 1e-9, "{projection:?}: {d:?}");
+            camera.validate().unwrap();
+            let tilted = Camera {
+                pitch_deg: 10.0,
+                ..camera
+            };
+            assert!(tilted.validate().is_err(), "{projection:?} refuses a pitch");
         }
         // A fisheye's pixels tile the upper hemisphere: their solid angles sum to 2π.
         let camera = Camera {

@@ -48,12 +48,16 @@ pub struct SceneImage {
 pub struct SceneSun {
     /// Zenith angle (degrees, 0–180).
     pub zenith_deg: f64,
-    /// Azimuth (degrees clockwise from north).
-    #[serde(default)]
+    /// Azimuth (degrees clockwise from north); the default scene's when absent.
+    #[serde(default = "default_sun_azimuth")]
     pub azimuth_deg: f64,
     /// Draw the solar disk.
     #[serde(default = "yes")]
     pub disk: bool,
+}
+
+fn default_sun_azimuth() -> f64 {
+    SceneSun::default().azimuth_deg
 }
 
 fn yes() -> bool {
@@ -80,10 +84,10 @@ pub struct SceneLocation {
 }
 
 fn standard_pressure() -> f64 {
-    1013.25
+    crate::astro::Weather::default().pressure_hpa
 }
 fn standard_temperature() -> f64 {
-    15.0
+    crate::astro::Weather::default().temperature_c
 }
 
 /// When: an instant, ISO 8601 with `Z` or an offset.
@@ -318,6 +322,13 @@ impl SceneFile {
                 "image.width",
                 w,
                 format!("6 × image.height ({}) for a cube map", 6 * h),
+            ));
+        }
+        if self.camera.projection == Projection::Equirect && w != 2 * h {
+            return Err(Error::invalid(
+                "image.width",
+                w,
+                format!("2 × image.height ({}) for an equirect map", 2 * h),
             ));
         }
         if !(self.sun.zenith_deg.is_finite() && (0.0..=180.0).contains(&self.sun.zenith_deg)) {
