@@ -430,6 +430,14 @@ impl<'a> RenderSky<'a> {
         uploaded
     }
 
+    /// The tables' configuration (sizes, orders, Mie storage).
+    pub fn config(&self) -> TableConfig {
+        match self {
+            RenderSky::Cpu(sky) => sky.tables.config,
+            RenderSky::Gpu { config, .. } => *config,
+        }
+    }
+
     /// The model the sky's tables hold (lights are built from it).
     pub fn model(&self) -> &Model {
         match self {

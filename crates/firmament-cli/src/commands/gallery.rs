@@ -13,7 +13,7 @@ use firmament::scene::file::{SceneLocation, SceneTime};
 use firmament::scene::{Camera, Projection, SceneFile as Scene};
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
-use crate::commands::outputs::{write_outputs, FileOptions};
+use crate::commands::outputs::{write_outputs, FileNotes, FileOptions};
 use crate::commands::render::{atmosphere_args, render_scene, terrain_and_atmosphere};
 
 /// Arguments of `firmament gallery`.
@@ -212,8 +212,9 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
                     half: false,
                     gamut: firmament::spectrum::gamut::Gamut::Rec709,
                     dither: true,
+                    layout: firmament::render::cube_layout::CubeLayout::Firmament,
                 };
-                write_outputs(&frame, &scene, ev100, files, true)?;
+                write_outputs(&frame, &scene, ev100, files, &FileNotes::default(), true)?;
                 ev100
             }
             Some((frames, minutes)) => {

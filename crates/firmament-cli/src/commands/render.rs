@@ -10,10 +10,12 @@ use firmament::reference::{self, ReferenceSettings};
 use firmament::render::{self, tonemap, RenderSettings};
 use firmament::scene::sky_lights::{sources_of, SkySources};
 use firmament::scene::terrain::Heightfield;
-use firmament::scene::{sun_direction, SceneFile as Scene};
+use firmament::scene::{sun_direction, Projection, SceneFile as Scene};
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
-use crate::commands::outputs::{write_outputs, FileOptions};
+use crate::commands::lamps::{lamps, MapFrame};
+use crate::commands::outputs::{write_outputs, FileNotes, FileOptions};
+use crate::commands::provenance::{exr_attributes, merged, provenance};
 use crate::commands::render_args::{scene_from_args, RenderArgs};
 use crate::commands::timelapse;
 use crate::common::{
@@ -274,7 +276,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                     ev100
                 );
             }
-            return write_outputs(&frame, &scene, ev100, files, args.quiet);
+            let provenance = provenance(&model, "reference (Monte Carlo path tracer)", None);
+            let notes = file_notes(&model, &scene, terrain.as_ref(), &files, ev100, provenance)?;
+            return write_outputs(&frame, &scene, ev100, files, &notes, args.quiet);
         }
         other => anyhow::bail!("invalid value for `--method`: {other} (accepted: lut, reference)"),
     }
@@ -349,5 +353,78 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             }
         );
     }
-    write_outputs(&frame, &scene, ev100, files, args.quiet)
+    let provenance = provenance(
+        sky.model(),
+        "bruneton4d (precomputed tables)",
+        Some(&sky.config()),
+    );
+    let notes = file_notes(
+        sky.model(),
+        &scene,
+        terrain.as_ref(),
+        &files,
+        ev100,
+        provenance,
+    )?;
+    write_outputs(&frame, &scene, ev100, files, &notes, args.quiet)
+}
+
+/// The files' notes: the provenance with the camera, the lights and the exposure as EXR
+/// attributes, and the lamps of an environment map.
+fn file_notes(
+    model: &Model,
+    scene: &Scene,
+    terrain: Option<&Heightfield>,
+    files: &FileOptions,
+    ev100: f64,
+    provenance: serde_json::Value,
+) -> Result<FileNotes> {
+    let camera = scene.camera_over(terrain, model.bottom_radius_m);
+    let sources = sources_of_scene(model, scene)?;
+    let extra = serde_json::json!({
+        "camera": camera,
+        "image": { "width": scene.image.width, "height": scene.image.height },
+        "sun": match scene.astro()? {
+            Some(_) => serde_json::json!({ "time": scene.time, "location": scene.location }),
+            None => serde_json::json!({
+                "zenith_deg": scene.sun.zenith_deg,
+                "azimuth_deg": scene.sun.azimuth_deg,
+            }),
+        },
+        "exposure": {
+            "ev100": ev100,
+            "automatic": scene.output.ev100.is_none(),
+            "tonemap": scene.output.tonemap,
+            "note": "EV100 and the tone curve apply to PNG files; EXR, HDR and DDS files hold linear values, Y in cd/m²",
+        },
+        "colour_space": files.gamut.name(),
+    });
+    let serde_json::Value::Object(extra) = extra else {
+        unreachable!("an object")
+    };
+    let full = merged(provenance.clone(), extra);
+    let all_round = matches!(
+        scene.camera.projection,
+        Projection::Equirect | Projection::Cubemap
+    );
+    let lamps = all_round.then(|| {
+        let frame = MapFrame {
+            projection: scene.camera.projection,
+            heading_deg: scene.camera.heading_deg,
+            layout: files.layout,
+        };
+        let radius = model.bottom_radius_m + camera.altitude_m;
+        lamps(
+            model,
+            &sources.lights,
+            radius,
+            frame,
+            scene.sun.disk,
+            full.clone(),
+        )
+    });
+    Ok(FileNotes {
+        attributes: exr_attributes(&full),
+        lamps,
+    })
 }

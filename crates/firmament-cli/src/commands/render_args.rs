@@ -134,6 +134,14 @@ pub struct RenderArgs {
     /// at their luminance: no file holds a negative component.
     #[arg(long, default_value = "rec709", value_name = "rec709|rec2020|acescg")]
     pub gamut: String,
+    /// A cube map's faces in the files: `firmament` (its own 6×1 strip, +Z up: +X east,
+    /// −X west, +Y north, −Y south, +Z up, −Z down), `y-up` (the graphics APIs' faces
+    /// +X −X +Y −Y +Z −Z in a 6×1 strip, +Y up, north on +Z), `cross` (those faces in a
+    /// 4×3 horizontal cross) or `unreal` (the standard faces in Unreal's axes: +X north,
+    /// +Y east, +Z up). A .dds file holds the standard faces (y-up, or unreal's). See
+    /// docs/conventions.md [default: firmament].
+    #[arg(long, value_name = "firmament|y-up|cross|unreal")]
+    pub layout: Option<String>,
     /// Round PNG output to the nearest code instead of dithering (triangular, ±1 code).
     #[arg(long)]
     pub no_dither: bool,
@@ -240,6 +248,11 @@ fn parse_projection(s: &str) -> Result<Projection> {
 /// a cube map's faces face the world's axes, an orbit camera looks straight down.
 fn refuse_ignored_flags(args: &RenderArgs, projection: Projection) -> Result<()> {
     let name = format!("{projection:?}").to_lowercase();
+    if args.layout.is_some() && projection != Projection::Cubemap {
+        anyhow::bail!(
+            "--layout arranges a cube map's faces; the {name} camera has none (--camera cubemap)"
+        );
+    }
     if args.size.is_some() && projection != Projection::Cubemap {
         anyhow::bail!(
             "--size is a cube map's face edge; the {name} camera takes --width and --height"

@@ -12,7 +12,7 @@ use firmament::scene::SceneFile as Scene;
 use serde_json::json;
 
 use crate::backend::RenderSky;
-use crate::commands::outputs::{write_outputs, FileOptions};
+use crate::commands::outputs::{write_outputs, FileNotes, FileOptions};
 use crate::commands::render::render_scene;
 use crate::common::{cancel_flag, progress_bar};
 use firmament::scene::terrain::Heightfield;
@@ -116,7 +116,14 @@ pub fn run(
         }
         frame_scene.output.files = files;
         let (frame, ev100) = render_scene(sky, &frame_scene, terrain, true)?;
-        write_outputs(&frame, &frame_scene, ev100, options, true)?;
+        write_outputs(
+            &frame,
+            &frame_scene,
+            ev100,
+            options,
+            &FileNotes::default(),
+            true,
+        )?;
         rendered += 1;
         bar.inc(1);
     }

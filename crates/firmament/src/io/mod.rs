@@ -7,6 +7,7 @@
 //! a failed or interrupted write never leaves a partial output file.
 
 pub mod atomic;
+pub mod dds;
 pub mod exr;
 pub mod hdr;
 pub mod png;
@@ -20,6 +21,7 @@ pub use self::exr::{
 pub use self::hdr::{read_hdr, rgbe_decode, rgbe_encode, write_hdr, write_hdr_uncompressed};
 pub use self::png::{read_png_srgb8, write_png_srgb8};
 pub use atomic::write_atomic;
+pub use dds::{read_dds_cube, write_dds_cube};
 
 use crate::{Error, Result};
 
@@ -102,10 +104,12 @@ pub enum OutputFormat {
     Exr,
     /// Radiance RGBE, linear.
     Hdr,
+    /// DirectDraw Surface cube map, linear float (cube-map cameras only).
+    Dds,
 }
 
 impl OutputFormat {
-    /// The format named by `path`'s extension (`.png`, `.exr`, `.hdr`, any case).
+    /// The format named by `path`'s extension (`.png`, `.exr`, `.hdr`, `.dds`, any case).
     pub fn from_path(path: impl AsRef<Path>) -> Result<OutputFormat> {
         let path = path.as_ref();
         let ext = path
@@ -116,10 +120,11 @@ impl OutputFormat {
             Some("png") => Ok(OutputFormat::Png),
             Some("exr") => Ok(OutputFormat::Exr),
             Some("hdr") => Ok(OutputFormat::Hdr),
+            Some("dds") => Ok(OutputFormat::Dds),
             _ => Err(Error::invalid(
                 "out",
                 path.display(),
-                "a file name ending in .png, .exr or .hdr",
+                "a file name ending in .png, .exr, .hdr or .dds",
             )),
         }
     }
@@ -130,6 +135,7 @@ impl OutputFormat {
             OutputFormat::Png => "png",
             OutputFormat::Exr => "exr",
             OutputFormat::Hdr => "hdr",
+            OutputFormat::Dds => "dds",
         }
     }
 

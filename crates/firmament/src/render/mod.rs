@@ -8,6 +8,7 @@
 //! the lights for their disks. A second surface or light needs no change here.
 
 pub mod air_volume;
+pub mod cube_layout;
 pub mod disk_edges;
 pub mod frame;
 pub mod sky_dome;

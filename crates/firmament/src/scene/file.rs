@@ -368,13 +368,22 @@ impl SceneFile {
             return Err(Error::invalid("output.files", "[]", "at least one file"));
         }
         for (i, f) in self.output.files.iter().enumerate() {
-            crate::io::OutputFormat::from_path(f).map_err(|_| {
+            let format = crate::io::OutputFormat::from_path(f).map_err(|_| {
                 Error::invalid(
                     format!("output.files[{i}]"),
                     f.display(),
-                    "a file name ending in .png, .exr or .hdr",
+                    "a file name ending in .png, .exr, .hdr or .dds",
                 )
             })?;
+            if format == crate::io::OutputFormat::Dds
+                && self.camera.projection != Projection::Cubemap
+            {
+                return Err(Error::invalid(
+                    format!("output.files[{i}]"),
+                    f.display(),
+                    "a .png, .exr or .hdr file: a .dds file holds a cube map (projection = \"cubemap\")",
+                ));
+            }
         }
         Ok(())
     }
