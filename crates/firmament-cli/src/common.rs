@@ -206,6 +206,14 @@ pub fn progress_bar(len: u64, quiet: bool) -> ProgressBar {
     )
 }
 
+/// A progress bar drawn with `template` (indicatif's keys), hidden when `quiet`.
+pub fn drawn_bar(len: u64, quiet: bool, template: &str) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    drawn(ProgressBar::new(len), template)
+}
+
 /// A spinner on stderr for work that reports no progress (the GPU's); hidden when `quiet`.
 pub fn spinner(message: &str, quiet: bool) -> ProgressBar {
     if quiet {

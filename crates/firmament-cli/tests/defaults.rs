@@ -1,6 +1,7 @@
 //! Honest defaults (issue 16, item 3): `--help` names every default, `render`, `query` and
 //! scene files share them, flags a projection would ignore are refused, sizes follow the
-//! map's aspect, and the automatic exposure shows a noon sky bright and blue.
+//! map's aspect, and the automatic exposure shows a noon sky bright and blue; a reference
+//! render estimates its time and reports its noise (item 7).
 
 mod common;
 
@@ -186,4 +187,32 @@ fn automatic_exposure_shows_a_noon_sky_bright_and_blue() {
     let (r, b) = (r / n, b / n);
     assert!(b > 130.0, "sky too dark: blue {b:.0}");
     assert!(b - r > 45.0, "sky not blue: red {r:.0}, blue {b:.0}");
+}
+
+#[test]
+fn a_reference_render_says_how_long_it_will_take_and_how_noisy_it_is() {
+    // Item 7: an estimate before it starts (from a pilot), the noise reached at the end.
+    let out = tmp().join("reference.png");
+    let o = run(&[
+        "render",
+        "--method",
+        "reference",
+        "--backend",
+        "cpu",
+        "--no-terrain",
+        "--samples",
+        "16",
+        "--width",
+        "24",
+        "--height",
+        "12",
+        "--sun-zenith-deg",
+        "60",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    succeeds(&o);
+    let e = stderr(&o);
+    assert!(e.contains("about") && e.contains("pilot"), "{e}");
+    assert!(e.contains("mean relative standard error"), "{e}");
 }

@@ -13,5 +13,6 @@ pub mod query;
 pub mod query_scene;
 pub mod render;
 pub mod render_args;
+pub mod render_reference;
 pub mod timelapse;
 pub mod validate;

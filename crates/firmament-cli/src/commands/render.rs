@@ -6,7 +6,6 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use firmament::atmosphere::Model;
 use firmament::io::OutputFormat;
-use firmament::reference::{self, ReferenceSettings};
 use firmament::render::{self, tonemap, RenderSettings};
 use firmament::scene::sky_lights::{sources_of, SkySources};
 use firmament::scene::terrain::Heightfield;
@@ -18,9 +17,7 @@ use crate::commands::outputs::{write_outputs, FileNotes, FileOptions};
 use crate::commands::provenance::{exr_attributes, merged, provenance};
 use crate::commands::render_args::{scene_from_args, RenderArgs};
 use crate::commands::timelapse;
-use crate::common::{
-    cancel_flag, check_output_dir, check_reference_samples, progress_bar, AtmosphereArgs,
-};
+use crate::common::{check_output_dir, AtmosphereArgs};
 
 /// Atmosphere arguments equivalent to the scene's.
 pub fn atmosphere_args(scene: &Scene, tables: Option<PathBuf>, table_size: &str) -> AtmosphereArgs {
@@ -39,7 +36,7 @@ pub fn atmosphere_args(scene: &Scene, tables: Option<PathBuf>, table_size: &str)
 }
 
 /// The render settings of the scene's camera and image.
-fn render_settings(scene: &Scene) -> RenderSettings<'_> {
+pub fn render_settings(scene: &Scene) -> RenderSettings<'_> {
     RenderSettings {
         camera: &scene.camera,
         width: scene.image.width,
@@ -80,7 +77,7 @@ fn twilight_note(model: &Model, scene: &Scene) -> Result<()> {
 }
 
 /// The scene's EV100, or the automatic exposure of the frame.
-fn ev100(scene: &Scene, frame: &render::Frame) -> f64 {
+pub fn ev100(scene: &Scene, frame: &render::Frame) -> f64 {
     scene
         .output
         .ev100
@@ -172,54 +169,6 @@ pub fn render_scene(
     Ok((frame, ev100))
 }
 
-/// Render the scene with the Monte Carlo reference (`reference::render_frame`); returns the
-/// frame and the EV100 used. Ctrl-C stops it between batches of pixels.
-fn render_scene_reference(
-    model: &Model,
-    scene: &Scene,
-    terrain: Option<&Heightfield>,
-    samples: usize,
-    quiet: bool,
-) -> Result<(render::Frame, f64)> {
-    check_reference_samples(samples)?;
-    let sources = sources_of_scene(model, scene)?;
-    let lights = &sources.lights;
-    if lights.len() > 1 || sources.background.is_some() {
-        anyhow::bail!(
-            "`--method reference` traces the sun's light only so far: a --time with the moon up or the sun down is not supported with it"
-        );
-    }
-    let sun = &lights[0];
-    let surfaces: Vec<Box<dyn firmament::scene::Surface + '_>> =
-        terrain.iter().map(|t| Box::new(*t) as _).collect();
-    let camera = scene.camera_over(terrain, model.bottom_radius_m);
-    let bar = progress_bar(1000, quiet);
-    bar.set_message(format!("reference, {samples} paths/λ"));
-    let result = reference::render_frame(
-        model,
-        &[],
-        &surfaces,
-        &RenderSettings {
-            camera: &camera,
-            ..render_settings(scene)
-        },
-        sun,
-        &ReferenceSettings::with_samples(samples),
-        &|f| bar.set_position((f * 1000.0) as u64),
-        Some(cancel_flag()),
-    );
-    bar.finish_and_clear();
-    let (frame, mean_stderr) = result?;
-    if !quiet && mean_stderr > 0.0 {
-        eprintln!(
-            "reference: mean relative standard error of pixel luminance {:.2}% ({samples} paths/λ)",
-            100.0 * mean_stderr
-        );
-    }
-    let ev100 = ev100(scene, &frame);
-    Ok((frame, ev100))
-}
-
 /// Run `firmament render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
     let scene = scene_from_args(args)?;
@@ -264,8 +213,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 terrain_and_atmosphere(&scene, None, &args.table_size, args.quiet)?;
             let model = atmosphere.unlifted().model()?;
             let t = Instant::now();
-            let (frame, ev100) =
-                render_scene_reference(&model, &scene, terrain.as_ref(), args.samples, args.quiet)?;
+            let (frame, ev100) = super::render_reference::render_scene_reference(
+                &model,
+                &scene,
+                terrain.as_ref(),
+                args.samples,
+                args.quiet,
+            )?;
             if !args.quiet {
                 eprintln!(
                     "render (reference): {}×{} {:?} in {:.2} s (EV100 {:.1})",

@@ -47,7 +47,7 @@ use crate::atmosphere::Model;
 use crate::math::sphere::ray_sphere;
 use crate::math::Vec3;
 use crate::scene::{Surface, Volume};
-pub use render::render_frame;
+pub use render::{render_frame, Progress};
 pub use results::{FluxBudget, IrradianceEstimate, RadianceEstimate, Tally};
 use sampler::{estimate, Stats};
 pub use settings::ReferenceSettings;

@@ -4,7 +4,7 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use super::{render_pixels, ReferenceSettings};
+use super::{render_pixels, RadianceEstimate, ReferenceSettings};
 use crate::atmosphere::Model;
 use crate::io::ImageRgbF32;
 use crate::math::sphere::ray_sphere;
@@ -14,13 +14,23 @@ use crate::scene::{Light, Ray, Surface, Volume};
 use crate::spectrum::ColourMatrix;
 use crate::{Error, Result};
 
+/// How far [`render_frame`] is.
+#[derive(Clone, Copy, Debug)]
+pub struct Progress {
+    /// Fraction of the pixels done, 0–1.
+    pub fraction: f64,
+    /// Mean relative standard error of the luminance of the pixels done in whole batches
+    /// (NaN before the first batch ends).
+    pub mean_relative_stderr: f64,
+}
+
 /// The frame of `settings` lit by `sun` (the model's sun in a direction) through the
 /// atmosphere and `volumes`, with `surfaces` besides the ground sphere (see
 /// [`super::scene_radiance`]), every pixel traced with `reference.samples` paths per
 /// wavelength (`include_ground` is forced on: a picture shows the ground). Colour and white
 /// balance as [`crate::render::render`]; the sun's disk is added where a view ray meets
 /// neither the ground nor a surface, attenuated by the transmittance of the model's column
-/// integrals. `progress` receives the fraction done; `cancel` stops it
+/// integrals. `progress` receives the fraction done and the noise reached; `cancel` stops it
 /// between batches of pixels. Returns the frame and the mean relative standard error of the
 /// pixels' luminance.
 #[allow(clippy::too_many_arguments)]
@@ -31,7 +41,7 @@ pub fn render_frame(
     settings: &RenderSettings,
     sun: &Light,
     reference: &ReferenceSettings,
-    progress: &(dyn Fn(f64) + Sync),
+    progress: &(dyn Fn(Progress) + Sync),
     cancel: Option<&AtomicBool>,
 ) -> Result<(Frame, f64)> {
     settings.validate()?;
@@ -54,7 +64,12 @@ pub fn render_frame(
     }
     let batch = (4 * w).clamp(256, 16_384);
     let done = std::sync::atomic::AtomicUsize::new(0);
-    let mut estimates = Vec::with_capacity(rays.len());
+    let mut estimates: Vec<RadianceEstimate> = Vec::with_capacity(rays.len());
+    let colour = ColourMatrix::new(model.wavelengths.nm());
+    // The mean relative standard error of the pixels done so far (f64 bits; updated
+    // between batches).
+    let noise = std::sync::atomic::AtomicU64::new(f64::NAN.to_bits());
+    let (mut noise_sum, mut noise_count) = (0.0, 0usize);
     for (b, chunk) in rays.chunks(batch).enumerate() {
         if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
             return Err(Error::Interrupted);
@@ -70,16 +85,28 @@ pub fn render_frame(
             &|| {
                 let d = done.fetch_add(1, Ordering::Relaxed) + 1;
                 if d.is_multiple_of(256) {
-                    progress(d as f64 / rays.len() as f64);
+                    progress(Progress {
+                        fraction: d as f64 / rays.len() as f64,
+                        mean_relative_stderr: f64::from_bits(noise.load(Ordering::Relaxed)),
+                    });
                 }
             },
         ));
+        for e in &estimates[noise_count.min(estimates.len())..] {
+            let (y, se) = colour.luminance_and_stderr(&e.radiance, &e.stderr);
+            if y > 0.0 {
+                noise_sum += se / y;
+            }
+        }
+        noise_count = estimates.len();
+        noise.store(
+            (noise_sum / noise_count as f64).to_bits(),
+            Ordering::Relaxed,
+        );
     }
     if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
         return Err(Error::Interrupted);
     }
-    let nm = model.wavelengths.nm();
-    let colour = ColourMatrix::new(nm);
     let balance = colour.white_balance(&model.solar_irradiance, settings.white_balance);
     // The tracer's source is the model's sun; another light's irradiance scales it.
     let scale = sun.scale_against(&model.solar_irradiance);
