@@ -9,16 +9,14 @@ mod common;
 
 use common::sky;
 use firmament::math::Vec3;
-use firmament::render::{render, RenderSettings, ShadeScratch, Shader};
-use firmament::scene::{sun_direction, Camera, Projection, Ray, Scene};
-use firmament::sky::SkyMethod;
-use firmament::spectrum::ColourMatrix;
+use firmament::render::disk_edges::disk_illuminance;
+use firmament::render::{render, RenderSettings};
+use firmament::scene::{sun_direction, Camera, Projection, Scene};
 
 /// The sun's illuminance (lux) in a frame of `camera` at `width`×`height`, and the direct
 /// normal illuminance at the observer.
 fn illuminance(camera: &Camera, width: usize, height: usize, sun: Vec3) -> (f64, f64) {
     let sky = sky();
-    let model = sky.model();
     let scene = Scene::clear_sky(sky, sun, true);
     let settings = RenderSettings {
         camera,
@@ -27,47 +25,7 @@ fn illuminance(camera: &Camera, width: usize, height: usize, sun: Vec3) -> (f64,
         white_balance: false,
     };
     let frame = render(&scene, &settings, &|_| {}, None).unwrap();
-    let prepared = camera.prepare(model.bottom_radius_m, width, height);
-    let observer = Vec3::new(0.0, 0.0, model.bottom_radius_m + camera.altitude_m);
-    // The sky alone along each pixel's centre ray.
-    let plain = Shader::plain(&scene, observer).unwrap().without_disks();
-    let colour = ColourMatrix::new(model.wavelengths.nm());
-    let mut scratch = ShadeScratch::default();
-    let y = |c: [f64; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
-    let radius = scene.lights[0].angular_radius_rad;
-    let mut sum = 0.0;
-    for j in 0..height {
-        for i in 0..width {
-            let Some(ray) = prepared.ray(i as f64 + 0.5, j as f64 + 0.5) else {
-                continue;
-            };
-            // Within a few footprints of the disk (a point's splat included).
-            let footprint = prepared.pixel_solid_angle(i, j).sqrt();
-            if ray.dir.dot(sun).acos() > radius + 3.0 * footprint {
-                continue;
-            }
-            let mut l = [0.0; 3];
-            plain.shade(
-                &Ray {
-                    origin: observer,
-                    dir: ray.dir,
-                },
-                &mut scratch,
-                &mut l,
-            );
-            let p = frame.image.data[j * width + i];
-            let pixel = y([p[0] as f64, p[1] as f64, p[2] as f64]);
-            sum += (pixel - y(colour.to_srgb(&l))) * prepared.pixel_solid_angle(i, j);
-        }
-    }
-    // Direct normal illuminance: the light's irradiance through the air to the observer.
-    let view = sky.view(observer, &scene.lights[0]);
-    let mut t = [0.0; 3];
-    view.transmittance_to_light(observer, &mut t);
-    let e: Vec<f64> = (0..3)
-        .map(|k| scene.lights[0].irradiance[k] * t[k])
-        .collect();
-    (sum, colour.to_xyz(&e)[1])
+    disk_illuminance(&frame, &scene, &settings, 0).unwrap()
 }
 
 fn camera(projection: Projection, heading: f64, pitch: f64, fov: f64) -> Camera {

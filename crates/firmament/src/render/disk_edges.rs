@@ -8,7 +8,10 @@
 //! The WGSL twin is `shaders/render/disk_edges.wgsl`.
 
 use crate::math::Vec3;
-use crate::scene::{Light, PreparedCamera};
+use crate::render::{Frame, RenderSettings, ShadeScratch, Shader};
+use crate::scene::{Light, PreparedCamera, Ray, Scene};
+use crate::spectrum::ColourMatrix;
+use crate::Result;
 
 /// Sub-pixel rays per side on a disk's edge.
 pub const SUBSAMPLES: usize = 8;
@@ -88,4 +91,56 @@ pub fn subpixels() -> impl Iterator<Item = (f64, f64)> {
             ((k / n) as f64 + 0.5) / n as f64,
         )
     })
+}
+
+/// What a frame carries of `scene.lights[light]`'s disk, and what it should: the frame's
+/// luminance minus the sky's without disks along each pixel's centre ray, times the
+/// pixel's solid angle, summed over the pixels within three footprints of the disk (lux);
+/// and the light's direct normal illuminance at the observer (its irradiance times the
+/// transmittance to it). The two agree when the disk is drawn with its whole light.
+pub fn disk_illuminance(
+    frame: &Frame,
+    scene: &Scene,
+    settings: &RenderSettings,
+    light: usize,
+) -> Result<(f64, f64)> {
+    let model = scene.sky.model();
+    let (width, height) = (settings.width, settings.height);
+    let camera = settings.camera;
+    let prepared = camera.prepare(model.bottom_radius_m, width, height);
+    let observer = Vec3::new(0.0, 0.0, model.bottom_radius_m + camera.altitude_m);
+    let plain = Shader::plain(scene, observer)?.without_disks();
+    let colour = ColourMatrix::new(model.wavelengths.nm());
+    let mut scratch = ShadeScratch::default();
+    let y = |c: [f64; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    let l = &scene.lights[light];
+    let mut sum = 0.0;
+    let mut sky = vec![0.0; model.channels()];
+    for j in 0..height {
+        for i in 0..width {
+            let Some(ray) = prepared.ray(i as f64 + 0.5, j as f64 + 0.5) else {
+                continue;
+            };
+            // Within a few footprints of the disk (a point's splat included).
+            let footprint = prepared.pixel_solid_angle(i, j).sqrt();
+            if ray.dir.dot(l.direction).clamp(-1.0, 1.0).acos()
+                > l.angular_radius_rad + 3.0 * footprint
+            {
+                continue;
+            }
+            let centre = Ray {
+                origin: observer,
+                dir: ray.dir,
+            };
+            plain.shade(&centre, &mut scratch, &mut sky);
+            let p = frame.image.data[j * width + i];
+            let pixel = y([p[0] as f64, p[1] as f64, p[2] as f64]);
+            sum += (pixel - y(colour.to_srgb(&sky))) * prepared.pixel_solid_angle(i, j);
+        }
+    }
+    let view = scene.sky.view(observer, l);
+    let mut t = vec![0.0; model.channels()];
+    view.transmittance_to_light(observer, &mut t);
+    let e: Vec<f64> = l.irradiance.iter().zip(&t).map(|(e, t)| e * t).collect();
+    Ok((sum, colour.to_xyz(&e)[1]))
 }
