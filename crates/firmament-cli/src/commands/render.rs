@@ -231,7 +231,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 );
             }
             let provenance = provenance(&model, "reference (Monte Carlo path tracer)", None);
-            let notes = file_notes(&model, &scene, terrain.as_ref(), &files, ev100, provenance)?;
+            let notes = notes_of(&model, &scene, terrain.as_ref(), &files, ev100, provenance)?;
             return write_outputs(&frame, &scene, ev100, files, &notes, args.quiet);
         }
         other => anyhow::bail!("invalid value for `--method`: {other} (accepted: lut, reference)"),
@@ -307,25 +307,26 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             }
         );
     }
-    let provenance = provenance(
-        sky.model(),
-        "bruneton4d (precomputed tables)",
-        Some(&sky.config()),
-    );
-    let notes = file_notes(
-        sky.model(),
-        &scene,
-        terrain.as_ref(),
-        &files,
-        ev100,
-        provenance,
-    )?;
+    let notes = file_notes(&sky, &scene, terrain.as_ref(), &files, ev100)?;
     write_outputs(&frame, &scene, ev100, files, &notes, args.quiet)
+}
+
+/// The files' notes for a frame drawn from the tables of `sky`.
+pub fn file_notes(
+    sky: &RenderSky,
+    scene: &Scene,
+    terrain: Option<&Heightfield>,
+    files: &FileOptions,
+    ev100: f64,
+) -> Result<FileNotes> {
+    let method = format!("bruneton4d (precomputed tables{})", sky.on());
+    let provenance = provenance(sky.model(), &method, Some(&sky.config()));
+    notes_of(sky.model(), scene, terrain, files, ev100, provenance)
 }
 
 /// The files' notes: the provenance with the camera, the lights and the exposure as EXR
 /// attributes, and the lamps of an environment map.
-fn file_notes(
+fn notes_of(
     model: &Model,
     scene: &Scene,
     terrain: Option<&Heightfield>,

@@ -12,8 +12,8 @@ use firmament::scene::SceneFile as Scene;
 use serde_json::json;
 
 use crate::backend::RenderSky;
-use crate::commands::outputs::{write_outputs, FileNotes, FileOptions};
-use crate::commands::render::render_scene;
+use crate::commands::outputs::{write_outputs, FileOptions};
+use crate::commands::render::{file_notes, render_scene};
 use crate::common::{cancel_flag, progress_bar};
 use firmament::scene::terrain::Heightfield;
 
@@ -116,14 +116,9 @@ pub fn run(
         }
         frame_scene.output.files = files;
         let (frame, ev100) = render_scene(sky, &frame_scene, terrain, true)?;
-        write_outputs(
-            &frame,
-            &frame_scene,
-            ev100,
-            options,
-            &FileNotes::default(),
-            true,
-        )?;
+        // Each frame's files carry its provenance and, for maps, its lamps.
+        let notes = file_notes(sky, &frame_scene, terrain, &options, ev100)?;
+        write_outputs(&frame, &frame_scene, ev100, options, &notes, true)?;
         rendered += 1;
         bar.inc(1);
     }
