@@ -4,6 +4,7 @@
 //! ([`table`]), lookups ([`lookup`]), the versioned file format ([`file`]), and the
 //! evaluation of the paper's eq. 16 pieces from them ([`view`]).
 
+pub mod cache;
 pub mod compact;
 pub mod file;
 pub mod lookup;
