@@ -19,7 +19,8 @@ use crate::backend::{Backend, BackendChoice, RenderSky};
 use crate::commands::astro::AstroArgs;
 use crate::commands::timelapse;
 use crate::common::{
-    cancel_flag, check_output_dir, check_reference_samples, progress_bar, AtmosphereArgs,
+    cancel_flag, check_output_dir, check_reference_samples, print_wavelengths, progress_bar,
+    AtmosphereArgs,
 };
 
 /// Arguments of `firmament render`; flags override the scene file, which overrides the
@@ -94,12 +95,19 @@ pub struct RenderArgs {
     /// Atmosphere TOML file.
     #[arg(long, value_name = "FILE")]
     pub atmosphere: Option<PathBuf>,
-    /// Wavelengths: rgb, spectral or NM,NM,...
-    #[arg(long)]
+    /// Wavelengths: `spectral` (16 samples 365–815 nm, the default: right colours and
+    /// luminance), `rgb` (680, 550, 440 nm: fast, a sunset mauve) or `NM,NM,...`. With
+    /// --tables: the file's.
+    #[arg(long, value_name = "spectral|rgb|NM,NM,...")]
     pub wavelengths: Option<String>,
     /// Precomputed tables from `firmament bake`.
     #[arg(long, value_name = "FILE")]
     pub tables: Option<PathBuf>,
+    /// Neither read nor write the table cache (`$FIRMAMENT_CACHE_DIR`, else
+    /// `$XDG_CACHE_HOME/firmament` or `~/.cache/firmament`): compute the tables and keep
+    /// nothing.
+    #[arg(long, conflicts_with = "tables")]
+    pub no_cache: bool,
     /// Table sizes when computing: default or small.
     #[arg(long, default_value = "default")]
     pub table_size: String,
@@ -246,7 +254,7 @@ fn scene_from_args(args: &RenderArgs) -> Result<Scene> {
         scene.atmosphere.file = Some(f.clone());
     }
     if let Some(w) = &args.wavelengths {
-        scene.atmosphere.wavelengths = w.clone();
+        scene.atmosphere.wavelengths = Some(w.clone());
     }
     if let Some(ev) = args.ev100 {
         scene.output.ev100 = Some(ev);
@@ -277,7 +285,12 @@ fn scene_from_args(args: &RenderArgs) -> Result<Scene> {
 }
 
 /// Atmosphere arguments equivalent to the scene's.
-pub fn atmosphere_args(scene: &Scene, tables: Option<PathBuf>, table_size: &str) -> AtmosphereArgs {
+pub fn atmosphere_args(
+    scene: &Scene,
+    tables: Option<PathBuf>,
+    table_size: &str,
+    no_cache: bool,
+) -> AtmosphereArgs {
     AtmosphereArgs {
         preset: if scene.atmosphere.file.is_none() {
             Some(scene.atmosphere.preset.clone())
@@ -288,6 +301,7 @@ pub fn atmosphere_args(scene: &Scene, tables: Option<PathBuf>, table_size: &str)
         wavelengths: scene.atmosphere.wavelengths.clone(),
         tables,
         table_size: table_size.to_string(),
+        no_cache,
         ..AtmosphereArgs::default()
     }
 }
@@ -367,9 +381,10 @@ pub fn terrain_and_atmosphere(
     scene: &Scene,
     tables: Option<PathBuf>,
     table_size: &str,
+    no_cache: bool,
     quiet: bool,
 ) -> Result<(Option<Heightfield>, AtmosphereArgs)> {
-    let mut atmosphere = atmosphere_args(scene, tables, table_size);
+    let mut atmosphere = atmosphere_args(scene, tables, table_size, no_cache);
     if scene.terrain.is_none() {
         return Ok((None, atmosphere));
     }
@@ -596,8 +611,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 eprintln!("backend: cpu (the reference path tracer runs on the CPU only)");
             }
             let (terrain, atmosphere) =
-                terrain_and_atmosphere(&scene, None, &args.table_size, args.quiet)?;
+                terrain_and_atmosphere(&scene, None, &args.table_size, true, args.quiet)?;
             let model = atmosphere.unlifted().model()?;
+            print_wavelengths(&model, args.quiet);
             let t = Instant::now();
             let (frame, ev100) =
                 render_scene_reference(&model, &scene, terrain.as_ref(), args.samples, args.quiet)?;
@@ -631,8 +647,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
         backend => backend,
     };
-    let (terrain, atmosphere) =
-        terrain_and_atmosphere(&scene, args.tables.clone(), &args.table_size, args.quiet)?;
+    let (terrain, atmosphere) = terrain_and_atmosphere(
+        &scene,
+        args.tables.clone(),
+        &args.table_size,
+        args.no_cache,
+        args.quiet,
+    )?;
+    print_wavelengths(&atmosphere.model()?, args.quiet);
     let t = Instant::now();
     let sky = RenderSky::new(&backend, &atmosphere, args.quiet)?;
     if !args.quiet && args.tables.is_some() {

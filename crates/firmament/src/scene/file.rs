@@ -20,16 +20,20 @@ pub struct SceneAtmosphere {
     /// Atmosphere TOML file, relative to the scene file.
     #[serde(default)]
     pub file: Option<PathBuf>,
-    /// `rgb`, `spectral` or `NM,NM,...`.
-    #[serde(default = "default_wavelengths")]
-    pub wavelengths: String,
+    /// `spectral`, `rgb` or `NM,NM,...`; absent: the wavelengths of the tables file a
+    /// program is given, else [`DEFAULT_WAVELENGTHS`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wavelengths: Option<String>,
 }
+
+/// The wavelengths a picture is rendered at unless told otherwise: spectral. With the RGB
+/// mode's three wavelengths a sunset's sky is mauve and its luminance 5–18 % off the
+/// spectral value; once the tables are cached (`sky::bruneton4d::cache`) the 16 wavelengths
+/// cost about twice the RGB frame time (`docs/accuracy.md`).
+pub const DEFAULT_WAVELENGTHS: &str = "spectral";
 
 fn default_preset() -> String {
     "earth".into()
-}
-fn default_wavelengths() -> String {
-    "rgb".into()
 }
 
 /// Image size.
@@ -174,7 +178,7 @@ impl Default for SceneFile {
             atmosphere: SceneAtmosphere {
                 preset: default_preset(),
                 file: None,
-                wavelengths: default_wavelengths(),
+                wavelengths: None,
             },
             camera: Camera {
                 projection: Projection::Perspective,
