@@ -6,7 +6,7 @@
 //! | 4 | format version (u32, = 4; version 3 is read too: the same without `encoding`, always f32; version 1 folded multiple scattering into `scattering`, version 2 stored the transmittance instead of the optical depth; both are refused) |
 //! | 4 | header length L (u32) |
 //! | L | header, UTF-8 JSON: `config` (sizes, orders, mie storage), `wavelengths_nm`, `atmosphere_hash` (hex), `channels`, `order_means`, `mie_ratio`, `encoding` (`f32` or `half`) |
-//! | … | f32 arrays: optical depth to the top (τ = −ln T), irradiance; then single Rayleigh (molecular), single Mie, multiple scattering, as f32 arrays (`f32`) or each as per-texel exponents and half floats ([`compact`](super::compact), `half`); sizes from the header |
+//! | … | f32 arrays: optical depth to the top (τ = −ln T), irradiance; then single Rayleigh (molecular), single Mie, multiple scattering, as f32 arrays (`f32`) or each as per-texel exponents and half floats ([`compact`], `half`); sizes from the header |
 //! | 8 | checksum of everything before it: FNV-1a 64 over its 8-byte little-endian words, the last one zero-padded, then its length in bytes (version 3: FNV-1a 64 over its bytes, eight times slower to check) |
 //!
 //! A truncated, corrupt, wrong-version or mismatched file is refused, never used.
