@@ -1,5 +1,6 @@
 //! What several subcommands share: choosing the atmosphere and wavelengths, getting the
-//! tables (from a file or computed with a progress bar), progress bars and spinners,
+//! tables (from a file, from the cache, or computed with a progress bar and cached),
+//! progress bars and spinners,
 //! Ctrl-C, the checks of flag values, and the median that bench and validate report.
 
 use std::path::{Path, PathBuf};
@@ -10,6 +11,8 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use clap::Args;
 use firmament::atmosphere::{Atmosphere, Model};
+use firmament::scene::file::DEFAULT_WAVELENGTHS;
+use firmament::sky::bruneton4d::cache::{Loaded, TableCache};
 use firmament::sky::bruneton4d::{
     self as lut, Bruneton4d, MieStorage, TableConfig, TableSizes, Tables,
 };
@@ -40,12 +43,19 @@ pub struct AtmosphereArgs {
     /// Atmosphere TOML file (see `firmament atmosphere show earth` for the schema).
     #[arg(long, value_name = "FILE")]
     pub atmosphere: Option<PathBuf>,
-    /// Wavelengths: `rgb` (680, 550, 440 nm), `spectral` (16 samples 365–815 nm) or a list `NM,NM,...`.
-    #[arg(long, default_value = "rgb")]
-    pub wavelengths: String,
+    /// Wavelengths: `spectral` (16 samples 365–815 nm, the default: right colours and
+    /// luminance), `rgb` (680, 550, 440 nm: fast, a sunset mauve) or a list `NM,NM,...`.
+    /// With --tables: the file's.
+    #[arg(long, value_name = "spectral|rgb|NM,NM,...")]
+    pub wavelengths: Option<String>,
     /// Precomputed tables from `firmament bake` (must match the atmosphere and wavelengths).
     #[arg(long, value_name = "FILE")]
     pub tables: Option<PathBuf>,
+    /// Neither read nor write the table cache: compute the tables (in f32) and keep nothing.
+    /// The cache is `$FIRMAMENT_CACHE_DIR`, else `$XDG_CACHE_HOME/firmament` or
+    /// `~/.cache/firmament`, at most `$FIRMAMENT_CACHE_LIMIT_MB` MiB (default 2048).
+    #[arg(long)]
+    pub no_cache: bool,
     /// Scattering orders to precompute when no --tables are given.
     #[arg(long, default_value_t = 4)]
     pub orders: usize,
@@ -92,9 +102,20 @@ impl AtmosphereArgs {
         })
     }
 
+    /// The wavelengths: --wavelengths, else those of the --tables file, else spectral.
+    pub fn wavelengths(&self) -> Result<Wavelengths> {
+        Ok(match (&self.wavelengths, &self.tables) {
+            (Some(w), _) => Wavelengths::parse(w)?,
+            (None, Some(path)) => {
+                Wavelengths::from_list(&lut::file::read_header(path)?.wavelengths_nm)?
+            }
+            (None, None) => Wavelengths::parse(DEFAULT_WAVELENGTHS)?,
+        })
+    }
+
     /// The resolved model.
     pub fn model(&self) -> Result<Model> {
-        let wavelengths = Wavelengths::parse(&self.wavelengths)?;
+        let wavelengths = self.wavelengths()?;
         let mut atmosphere = self.atmosphere()?;
         if let Some(lift) = self.ground_lift_m {
             atmosphere = atmosphere.lifted(lift, &wavelengths)?;
@@ -141,7 +162,8 @@ impl AtmosphereArgs {
         Ok(config)
     }
 
-    /// Model and tables (read from --tables, or computed), paired.
+    /// Model and tables (read from --tables, from the cache, or computed and cached),
+    /// paired.
     pub fn sky(&self, quiet: bool) -> Result<Bruneton4d> {
         let model = self.model()?;
         let tables = match &self.tables {
@@ -150,17 +172,86 @@ impl AtmosphereArgs {
                 t.check_matches(&model, &path.display().to_string())?;
                 t
             }
-            None => compute_tables(&model, &self.table_config()?, quiet)?,
+            None if self.no_cache => compute_tables(&model, &self.table_config()?, quiet)?,
+            None => cached_tables(&model, &self.table_config()?, quiet)?,
         };
         Ok(Bruneton4d::new(model, tables)?)
     }
 }
 
-/// Precompute with a progress bar on stderr (hidden when `quiet` or not a terminal).
+/// Precompute with a progress bar on stderr (hidden when `quiet` or not a terminal) and say
+/// how long it took.
 pub fn compute_tables(model: &Model, config: &TableConfig, quiet: bool) -> Result<Tables> {
+    let started = Instant::now();
+    let tables = precompute_with_bar(model, config, quiet)?;
+    if !quiet {
+        print_tables_time(started, model, config, "", "");
+    }
+    Ok(tables)
+}
+
+/// The tables from the user's cache ([`TableCache::from_env`]), or computed and cached
+/// there, with a line on stderr saying which (unless `quiet`) and a warning when a cached
+/// file was unusable (deleted, computed again) or the tables could not be cached.
+pub fn cached_tables(model: &Model, config: &TableConfig, quiet: bool) -> Result<Tables> {
+    let Some(cache) = TableCache::from_env()? else {
+        if !quiet {
+            eprintln!("note: no table cache (neither $FIRMAMENT_CACHE_DIR, $XDG_CACHE_HOME nor $HOME is set)");
+        }
+        return compute_tables(model, config, quiet);
+    };
+    let started = Instant::now();
+    match cache.load(model, config) {
+        Loaded::Hit { tables, path } => {
+            if !quiet {
+                eprintln!(
+                    "tables: from cache {} in {:.2} s ({} wavelengths, {} orders)",
+                    path.display(),
+                    started.elapsed().as_secs_f64(),
+                    model.channels(),
+                    config.orders
+                );
+            }
+            return Ok(*tables);
+        }
+        Loaded::Discarded { path, reason } => eprintln!(
+            "warning: the cached tables {} were unusable ({reason}): deleted, computing them again",
+            path.display()
+        ),
+        Loaded::Missing { .. } => {}
+    }
+    let started = Instant::now();
+    let tables = precompute_with_bar(model, config, quiet)?;
+    let line = tables_line(started.elapsed().as_secs_f64(), model, config, "", "");
+    match cache.store(&tables, model, config) {
+        Ok(stored) => {
+            if !quiet {
+                let evicted = match stored.evicted.len() {
+                    0 => String::new(),
+                    n => format!(
+                        " ({n} least recently used file{} removed to stay within {} MiB)",
+                        if n == 1 { "" } else { "s" },
+                        cache.limit_bytes >> 20
+                    ),
+                };
+                eprintln!("{line}; cached at {}{evicted}", stored.path.display());
+            }
+            Ok(*stored.tables)
+        }
+        Err(e) => {
+            if !quiet {
+                eprintln!("{line}");
+            }
+            eprintln!("warning: tables not cached: {e}");
+            Ok(tables)
+        }
+    }
+}
+
+/// The precomputation under a progress bar.
+fn precompute_with_bar(model: &Model, config: &TableConfig, quiet: bool) -> Result<Tables> {
     let bar = progress_bar(1000, quiet);
     bar.set_message("precomputing tables");
-    let started = Instant::now();
     let tables = lut::precompute::precompute(
         model,
         config,
@@ -171,11 +262,7 @@ pub fn compute_tables(model: &Model, config: &TableConfig, quiet: bool) -> Resul
         Some(cancel_flag()),
     );
     bar.finish_and_clear();
-    let tables = tables.context("precomputing the tables")?;
-    if !quiet {
-        print_tables_time(started, model, config, "", "");
-    }
-    Ok(tables)
+    tables.context("precomputing the tables")
 }
 
 /// The line on stderr after a precomputation started at `started`: `tables: SECONDS
@@ -187,12 +274,31 @@ pub fn print_tables_time(
     place: &str,
     note: &str,
 ) {
-    eprintln!(
-        "tables: {:.2} s{place} ({} wavelengths, {} orders{note})",
-        started.elapsed().as_secs_f64(),
+    let seconds = started.elapsed().as_secs_f64();
+    eprintln!("{}", tables_line(seconds, model, config, place, note));
+}
+
+/// `tables: SECONDS s{place} (N wavelengths, M orders{note})`.
+fn tables_line(
+    seconds: f64,
+    model: &Model,
+    config: &TableConfig,
+    place: &str,
+    note: &str,
+) -> String {
+    format!(
+        "tables: {seconds:.2} s{place} ({} wavelengths, {} orders{note})",
         model.channels(),
         config.orders
-    );
+    )
+}
+
+/// `wavelengths: spectral (16 samples 365–815 nm)` on stderr, unless `quiet`: which
+/// wavelengths a picture or an answer is computed at.
+pub fn print_wavelengths(model: &Model, quiet: bool) {
+    if !quiet {
+        eprintln!("wavelengths: {}", model.wavelengths.describe());
+    }
 }
 
 /// A progress bar drawn on stderr only for work long enough to need one.

@@ -285,6 +285,8 @@ fn gpu_precompute_and_render_matches_cpu() {
         &[
             "--table-size",
             "small",
+            "--wavelengths",
+            "rgb",
             "--width",
             "48",
             "--height",
@@ -319,7 +321,14 @@ fn gpu_terrain_render_matches_cpu() {
     std::fs::write(&scene, coarse).unwrap();
     let [(cpu_png, cpu_exr), (gpu_png, gpu_exr)] = render_both(
         "valley",
-        &["--scene", scene.to_str().unwrap(), "--table-size", "small"],
+        &[
+            "--scene",
+            scene.to_str().unwrap(),
+            "--table-size",
+            "small",
+            "--wavelengths",
+            "rgb",
+        ],
     );
     let d8 = png_mean_abs_diff(&gpu_png, &cpu_png);
     assert!(d8 <= 1.0, "mean |Δ| of 8-bit values {d8}");
@@ -367,6 +376,8 @@ fn gpu_baked_tables_work_with_query() {
             "small",
             "--orders",
             "1",
+            "--wavelengths",
+            "rgb",
             "--out",
             lut.to_str().unwrap(),
         ]);

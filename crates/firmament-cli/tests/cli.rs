@@ -351,12 +351,16 @@ fn example_scenes_are_valid() {
             ));
             let text = std::fs::read_to_string(&p).unwrap();
             // Scenes on the baked tables' atmosphere reuse them; others compute small ones.
-            let tables_args: Vec<&str> =
-                if text.contains("preset = \"earth\"") && !text.contains("spectral") {
+            // Others compute small ones, RGB unless the scene says spectral.
+            let tables_args: Vec<&str> = if !text.contains("spectral") {
+                if text.contains("preset = \"earth\"") {
                     vec!["--tables", t]
                 } else {
-                    vec!["--table-size", "small"]
-                };
+                    vec!["--table-size", "small", "--wavelengths", "rgb"]
+                }
+            } else {
+                vec!["--table-size", "small"]
+            };
             let mut a = vec![
                 "render",
                 "--scene",
@@ -390,6 +394,8 @@ fn no_order_tail_bakes_the_truncated_sum() {
         "small",
         "--orders",
         "3",
+        "--wavelengths",
+        "rgb",
         "--no-order-tail",
         "--out",
         plain.to_str().unwrap(),

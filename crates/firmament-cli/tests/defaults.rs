@@ -34,7 +34,10 @@ fn render_help_names_every_default_and_they_are_the_scenes() {
         ("--sun-zenith-deg", d.sun.zenith_deg.to_string()),
         ("--sun-azimuth-deg", d.sun.azimuth_deg.to_string()),
         ("--preset", d.atmosphere.preset.clone()),
-        ("--wavelengths", d.atmosphere.wavelengths.clone()),
+        (
+            "--wavelengths",
+            firmament::scene::file::DEFAULT_WAVELENGTHS.to_string(),
+        ),
         ("--pressure-hpa", "1013.25".to_string()),
         ("--temperature-c", "15".to_string()),
         ("--ev100", "automatic".to_string()),

@@ -96,6 +96,8 @@ fn the_sea_shows_the_suns_glint_and_a_map_its_colour() {
         "reference",
         "--samples",
         "300",
+        "--wavelengths",
+        "rgb",
     ]);
     let lut = q(&flat, "180,0");
     assert!(

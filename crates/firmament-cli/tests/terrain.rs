@@ -90,6 +90,8 @@ fn query_scene_answers_the_terrain_with_the_tables_and_the_reference() {
         s,
         "--table-size",
         "small",
+        "--wavelengths",
+        "rgb",
         "-q",
         "--view",
         "95,60",

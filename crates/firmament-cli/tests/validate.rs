@@ -94,6 +94,8 @@ fn query_method_reference_adds_stderr_and_samples() {
         "80,180",
         "--table-size",
         "small",
+        "--wavelengths",
+        "rgb",
         "--method",
         "reference",
         "--samples",
@@ -130,6 +132,8 @@ fn query_method_reference_adds_stderr_and_samples() {
         "0,0",
         "--table-size",
         "small",
+        "--wavelengths",
+        "rgb",
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let v: Value = serde_json::from_slice(&out.stdout).unwrap();
@@ -192,6 +196,8 @@ fn render_method_reference_writes_the_same_formats() {
         "-5",
         "--sun-zenith-deg",
         "70",
+        "--wavelengths",
+        "rgb",
         "--out",
         png.to_str().unwrap(),
         "--out",

@@ -6,6 +6,7 @@ use firmament::atmosphere::Atmosphere;
 use firmament::math::sphere::{distance_to_top_atmosphere_boundary, safe_sqrt};
 use firmament::math::Vec3;
 use firmament::scene::Light;
+use firmament::sky::bruneton4d::file::Encoding;
 use firmament::sky::bruneton4d::{
     self as lut, params, Bruneton4d, MieStorage, TableConfig, TableSizes, Tables,
 };
@@ -478,6 +479,59 @@ fn table_files_round_trip_and_bad_files_are_refused() {
         .unwrap_err()
         .to_string()
         .contains("wavelengths"));
+
+    // Compact (half floats, a scale per texel): about half the 4D tables' bytes, the 2D
+    // tables exact, every 4D value within 2⁻¹¹ of its f32, corruption refused likewise.
+    let compact = lut::file::to_bytes_encoded(&t, Encoding::Half);
+    // Three 4D tables of three channels: 1 + 2·3 bytes a texel in place of 4·3 (the
+    // header's `"half"` one byte longer than `"f32"`).
+    let texels = t.multiple.data.len() / 3;
+    assert_eq!(bytes.len() - compact.len(), 3 * texels * (12 - 7) - 1);
+    let half = lut::file::from_bytes(&compact, "x").unwrap();
+    assert_eq!(half.optical_depth, t.optical_depth);
+    assert_eq!(half.irradiance, t.irradiance);
+    for (a, b) in [
+        (&half.single_rayleigh, &t.single_rayleigh),
+        (&half.single_mie, &t.single_mie),
+        (&half.multiple, &t.multiple),
+    ] {
+        // Channels 10⁹ below their texel's brightest fade through half's subnormals.
+        for (xs, ys) in a.data.chunks(a.channels).zip(b.data.chunks(b.channels)) {
+            let brightest = ys.iter().fold(0.0f32, |m, y| m.max(y.abs()));
+            for (x, y) in xs.iter().zip(ys) {
+                let tolerance = y.abs() * 4.9e-4 + brightest * 2e-9;
+                assert!((x - y).abs() <= tolerance, "{x} for {y}");
+            }
+        }
+    }
+    let mut bad = compact.clone();
+    bad[compact.len() * 2 / 3] ^= 0x01;
+    assert!(lut::file::from_bytes(&bad, "x")
+        .unwrap_err()
+        .to_string()
+        .contains("checksum"));
+
+    // A version 3 file (the same f32 layout, no `encoding` in its header) still reads.
+    let v3 = as_version_3(&bytes);
+    let old = lut::file::from_bytes(&v3, "x").unwrap();
+    assert_eq!(old.multiple, t.multiple);
+    assert_eq!(old.optical_depth, t.optical_depth);
+}
+
+/// A version 4 f32 file's bytes rewritten as version 3 wrote them.
+fn as_version_3(v4: &[u8]) -> Vec<u8> {
+    let hlen = u32::from_le_bytes(v4[12..16].try_into().unwrap()) as usize;
+    let header = std::str::from_utf8(&v4[16..16 + hlen]).unwrap();
+    assert!(header.ends_with(r#","encoding":"f32"}"#), "{header}");
+    let header = header.replace(r#","encoding":"f32"}"#, "}");
+    let mut out = b"FIRMLUT\0".to_vec();
+    out.extend_from_slice(&3u32.to_le_bytes());
+    out.extend_from_slice(&(header.len() as u32).to_le_bytes());
+    out.extend_from_slice(header.as_bytes());
+    out.extend_from_slice(&v4[16 + hlen..v4.len() - 8]);
+    let sum = firmament::atmosphere::model::fnv1a(&out);
+    out.extend_from_slice(&sum.to_le_bytes());
+    out
 }
 
 /// Single scattering along nearly horizontal rays from the ground, where the ray is

@@ -25,9 +25,16 @@ pub struct GalleryArgs {
     /// Embedded preset.
     #[arg(long, default_value = "earth")]
     pub preset: String,
-    /// Precomputed tables (must match the preset, rgb).
+    /// Precomputed tables (must match the preset; their wavelengths are used).
     #[arg(long, value_name = "FILE")]
     pub tables: Option<PathBuf>,
+    /// Wavelengths: `spectral` (16 samples 365–815 nm, the default), `rgb` (680, 550, 440
+    /// nm: fast, a sunset mauve) or `NM,NM,...`. With --tables: the file's.
+    #[arg(long, value_name = "spectral|rgb|NM,NM,...")]
+    pub wavelengths: Option<String>,
+    /// Neither read nor write the table cache: compute the tables and keep nothing.
+    #[arg(long, conflicts_with = "tables")]
+    pub no_cache: bool,
     /// Width of the perspective views (height is 9/16 of it).
     #[arg(long, default_value_t = 960)]
     pub width: usize,
@@ -129,14 +136,16 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
         .with_context(|| format!("creating {}", args.out.display()))?;
     let mut base = Scene::default();
     base.atmosphere.preset = args.preset.clone();
+    base.atmosphere.wavelengths = args.wavelengths.clone();
     let terrain_config = base.terrain.take();
     let backend = Backend::open(args.backend, args.quiet)?;
+    let atmosphere = atmosphere_args(&base, args.tables.clone(), "default", args.no_cache);
+    let wavelengths = atmosphere.wavelengths()?;
+    if !args.quiet {
+        eprintln!("wavelengths: {}", wavelengths.describe());
+    }
     let t = Instant::now();
-    let sky = RenderSky::new(
-        &backend,
-        &atmosphere_args(&base, args.tables.clone(), "default"),
-        args.quiet,
-    )?;
+    let sky = RenderSky::new(&backend, &atmosphere, args.quiet)?;
     if !args.quiet {
         eprintln!("tables ready in {:.2} s", t.elapsed().as_secs_f64());
     }
@@ -149,8 +158,13 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
                 terrain: Some(config),
                 ..base.clone()
             };
-            let (terrain, atmosphere) =
-                terrain_and_atmosphere(&with, args.tables.clone(), "default", args.quiet)?;
+            let (terrain, atmosphere) = terrain_and_atmosphere(
+                &with,
+                args.tables.clone(),
+                "default",
+                args.no_cache,
+                args.quiet,
+            )?;
             let terrain_sky = match args.tables {
                 Some(_) => None,
                 None => Some(RenderSky::new(&backend, &atmosphere, args.quiet)?),
@@ -164,8 +178,9 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
     );
     let _ = writeln!(
         html,
-        "<p>Preset <code>{}</code>, RGB, default tables, automatic exposure, ACES tone curve.</p>",
-        args.preset
+        "<p>Preset <code>{}</code>, wavelengths {}, default tables, automatic exposure, ACES tone curve.</p>",
+        args.preset,
+        wavelengths.describe()
     );
     for v in views(args.width) {
         if v.terrain && terrain.is_none() {

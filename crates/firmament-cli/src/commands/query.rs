@@ -14,7 +14,7 @@ use serde_json::json;
 
 use crate::backend::{Backend, BackendChoice};
 use crate::commands::astro::AstroArgs;
-use crate::common::{check_range, check_reference_samples, AtmosphereArgs};
+use crate::common::{check_range, check_reference_samples, print_wavelengths, AtmosphereArgs};
 
 /// Arguments of `firmament query`.
 #[derive(Args, Debug)]
@@ -210,6 +210,7 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
         .iter()
         .map(|v| parse_view(v))
         .collect::<Result<_>>()?;
+    print_wavelengths(&args.atmosphere.model()?, args.quiet);
     let sky = match &args.atmosphere.tables {
         // Nothing to compute: no adapter to open.
         Some(path) => {
@@ -223,7 +224,7 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
         }
         None => args
             .atmosphere
-            .sky_on(&Backend::open(args.backend, args.quiet)?, true)?,
+            .sky_on(&Backend::open(args.backend, args.quiet)?, args.quiet)?,
     };
     let model = &sky.model;
     let nm = model.wavelengths.nm().to_vec();

@@ -15,11 +15,15 @@ use serde_json::json;
 
 use super::query::{parse_view, QueryArgs, ViewAnswer};
 use super::render::{sources_of_scene, terrain_and_atmosphere};
+use crate::common::print_wavelengths;
 
 /// Run `query --scene`.
 pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<serde_json::Value> {
     let path = args.scene.as_ref().expect("--scene");
-    let scene = SceneFile::from_file(path)?;
+    let mut scene = SceneFile::from_file(path)?;
+    if let Some(w) = &args.atmosphere.wavelengths {
+        scene.atmosphere.wavelengths = Some(w.clone());
+    }
     let views: Vec<(f64, f64)> = (args.views.iter())
         .map(|v| parse_view(v))
         .collect::<Result<_>>()?;
@@ -27,18 +31,22 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
         &scene,
         args.atmosphere.tables.clone(),
         &args.atmosphere.table_size,
+        args.atmosphere.no_cache,
         args.quiet,
     )?;
-    let sky = atmosphere.sky(args.quiet)?;
-    let model = &sky.model;
-    let nm = model.wavelengths.nm().to_vec();
-    let sources = sources_of_scene(model, &scene)?;
+    // What the reference cannot trace is refused before the tables are computed.
     if reference.is_some() && scene.surface.as_ref().is_some_and(|s| s.glint) {
         anyhow::bail!("`--method reference` traces Lambertian surfaces only: the sun's glint on the sea is not in it (set `glint = false` in [surface] to compare the map)");
     }
+    let model = atmosphere.model()?;
+    let sources = sources_of_scene(&model, &scene)?;
     if reference.is_some() && (sources.lights.len() > 1 || sources.background.is_some()) {
         anyhow::bail!("`--method reference` traces the sun's light only so far: a [time] with the moon up or the sun down is not supported with it");
     }
+    print_wavelengths(&model, args.quiet);
+    let sky = atmosphere.sky(args.quiet)?;
+    let model = &sky.model;
+    let nm = model.wavelengths.nm().to_vec();
     let camera = scene.camera_over(terrain.as_ref(), model.bottom_radius_m);
     let observer = firmament::math::Vec3::new(0.0, 0.0, model.bottom_radius_m + camera.altitude_m);
     let radius = terrain

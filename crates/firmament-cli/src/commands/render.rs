@@ -17,10 +17,15 @@ use crate::commands::outputs::{write_outputs, FileNotes, FileOptions};
 use crate::commands::provenance::{exr_attributes, merged, provenance};
 use crate::commands::render_args::{scene_from_args, RenderArgs};
 use crate::commands::timelapse;
-use crate::common::{check_output_dir, AtmosphereArgs};
+use crate::common::{check_output_dir, print_wavelengths, AtmosphereArgs};
 
 /// Atmosphere arguments equivalent to the scene's.
-pub fn atmosphere_args(scene: &Scene, tables: Option<PathBuf>, table_size: &str) -> AtmosphereArgs {
+pub fn atmosphere_args(
+    scene: &Scene,
+    tables: Option<PathBuf>,
+    table_size: &str,
+    no_cache: bool,
+) -> AtmosphereArgs {
     AtmosphereArgs {
         preset: if scene.atmosphere.file.is_none() {
             Some(scene.atmosphere.preset.clone())
@@ -31,6 +36,7 @@ pub fn atmosphere_args(scene: &Scene, tables: Option<PathBuf>, table_size: &str)
         wavelengths: scene.atmosphere.wavelengths.clone(),
         tables,
         table_size: table_size.to_string(),
+        no_cache,
         ..AtmosphereArgs::default()
     }
 }
@@ -110,9 +116,10 @@ pub fn terrain_and_atmosphere(
     scene: &Scene,
     tables: Option<PathBuf>,
     table_size: &str,
+    no_cache: bool,
     quiet: bool,
 ) -> Result<(Option<Heightfield>, AtmosphereArgs)> {
-    let mut atmosphere = atmosphere_args(scene, tables, table_size);
+    let mut atmosphere = atmosphere_args(scene, tables, table_size, no_cache);
     if scene.terrain.is_none() {
         return Ok((None, atmosphere));
     }
@@ -210,8 +217,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 eprintln!("backend: cpu (the reference path tracer runs on the CPU only)");
             }
             let (terrain, atmosphere) =
-                terrain_and_atmosphere(&scene, None, &args.table_size, args.quiet)?;
+                terrain_and_atmosphere(&scene, None, &args.table_size, true, args.quiet)?;
             let model = atmosphere.unlifted().model()?;
+            print_wavelengths(&model, args.quiet);
             let t = Instant::now();
             let (frame, ev100) = super::render_reference::render_scene_reference(
                 &model,
@@ -252,8 +260,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
         backend => backend,
     };
-    let (terrain, atmosphere) =
-        terrain_and_atmosphere(&scene, args.tables.clone(), &args.table_size, args.quiet)?;
+    let (terrain, atmosphere) = terrain_and_atmosphere(
+        &scene,
+        args.tables.clone(),
+        &args.table_size,
+        args.no_cache,
+        args.quiet,
+    )?;
+    print_wavelengths(&atmosphere.model()?, args.quiet);
     let t = Instant::now();
     let sky = RenderSky::new(&backend, &atmosphere, args.quiet)?;
     if !args.quiet && args.tables.is_some() {

@@ -102,14 +102,19 @@ pub struct RenderArgs {
     /// Atmosphere TOML file.
     #[arg(long, value_name = "FILE")]
     pub atmosphere: Option<PathBuf>,
-    #[arg(long, help = with_default(
-        "Wavelengths: `spectral` (16 samples 365–815 nm), `rgb` (680, 550, 440 nm: fast, colours and luminance a few % off at sunset) or NM,NM,...",
-        defaults().atmosphere.wavelengths,
+    #[arg(long, value_name = "spectral|rgb|NM,NM,...", help = with_default(
+        "Wavelengths: `spectral` (16 samples 365–815 nm), `rgb` (680, 550, 440 nm: fast, a sunset lavender and 5–16 % too bright) or NM,NM,...; with --tables and none given, the file's",
+        firmament::scene::file::DEFAULT_WAVELENGTHS,
     ))]
     pub wavelengths: Option<String>,
     /// Precomputed tables from `firmament bake`.
     #[arg(long, value_name = "FILE")]
     pub tables: Option<PathBuf>,
+    /// Neither read nor write the table cache (`$FIRMAMENT_CACHE_DIR`, else
+    /// `$XDG_CACHE_HOME/firmament` or `~/.cache/firmament`): compute the tables and keep
+    /// nothing.
+    #[arg(long, conflicts_with = "tables")]
+    pub no_cache: bool,
     /// Table sizes when computing: default or small.
     #[arg(long, default_value = "default", value_name = "default|small")]
     pub table_size: String,
@@ -404,7 +409,7 @@ pub fn scene_from_args(args: &RenderArgs) -> Result<Scene> {
         scene.atmosphere.file = Some(f.clone());
     }
     if let Some(w) = &args.wavelengths {
-        scene.atmosphere.wavelengths = w.clone();
+        scene.atmosphere.wavelengths = Some(w.clone());
     }
     if let Some(ev) = args.ev100 {
         scene.output.ev100 = Some(ev);

@@ -1,6 +1,7 @@
-//! Helpers shared by the integration tests: the binary, a temporary directory per test
-//! binary, running a command and reading its stderr, the checks on success and failure, and
-//! small RGB tables baked once.
+//! Helpers shared by the integration tests: the binary (with a table cache of its own per
+//! test binary, never the user's), a temporary directory per test binary, running a command
+//! and reading its stderr, the checks on success and failure, and small RGB tables baked
+//! once.
 //!
 //! Each test file compiles its own copy (`mod common;`) and uses only some of these.
 #![allow(dead_code)]
@@ -9,9 +10,17 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
 
-/// The `firmament` binary under test.
+/// The `firmament` binary under test, its table cache in [`cache_dir`]: the tests of one
+/// binary that compute the same tables compute them once, and never touch the user's cache.
 pub fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_firmament"))
+    let mut command = Command::new(env!("CARGO_BIN_EXE_firmament"));
+    command.env("FIRMAMENT_CACHE_DIR", cache_dir());
+    command
+}
+
+/// This test binary's table cache.
+pub fn cache_dir() -> PathBuf {
+    tmp().join("cache")
 }
 
 /// A directory of this test binary (`backend`, `cli`, `validate`) and process, created once.
@@ -81,7 +90,15 @@ pub fn tables() -> &'static Path {
     T.get_or_init(|| {
         let p = tmp().join("earth-small.lut");
         let o = bin()
-            .args(["bake", "--backend", "cpu", "--table-size", "small"])
+            .args([
+                "bake",
+                "--backend",
+                "cpu",
+                "--table-size",
+                "small",
+                "--wavelengths",
+                "rgb",
+            ])
             .args(["--orders", "3", "--out"])
             .arg(&p)
             .output()

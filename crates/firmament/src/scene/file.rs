@@ -20,16 +20,21 @@ pub struct SceneAtmosphere {
     /// Atmosphere TOML file, relative to the scene file.
     #[serde(default)]
     pub file: Option<PathBuf>,
-    /// `rgb`, `spectral` or `NM,NM,...`.
-    #[serde(default = "default_wavelengths")]
-    pub wavelengths: String,
+    /// `spectral`, `rgb` or `NM,NM,...`; absent: the wavelengths of the tables file a
+    /// program is given, else [`DEFAULT_WAVELENGTHS`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wavelengths: Option<String>,
 }
+
+/// The wavelengths a picture is rendered at unless told otherwise: spectral. With the RGB
+/// mode's three wavelengths the sky at sunset is lavender where it is blue, and 5–16 %
+/// brighter than the spectral value; once the tables are cached (`sky::bruneton4d::cache`)
+/// the 16 wavelengths cost ×1.15 the RGB time of the default 1080p scene, ×1.6 for the sky
+/// alone (`docs/accuracy.md`).
+pub const DEFAULT_WAVELENGTHS: &str = "spectral";
 
 fn default_preset() -> String {
     "earth".into()
-}
-fn default_wavelengths() -> String {
-    "rgb".into()
 }
 
 /// Image size.
@@ -178,7 +183,7 @@ impl Default for SceneFile {
             atmosphere: SceneAtmosphere {
                 preset: default_preset(),
                 file: None,
-                wavelengths: default_wavelengths(),
+                wavelengths: None,
             },
             camera: Camera {
                 projection: Projection::Perspective,

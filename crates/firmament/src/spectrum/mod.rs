@@ -152,6 +152,34 @@ impl Wavelengths {
         &self.nm
     }
 
+    /// For messages: `rgb (680, 550, 440 nm)`, `spectral (16 samples 365–815 nm)`, or the
+    /// list's count and range.
+    pub fn describe(&self) -> String {
+        let nm = &self.nm;
+        let list = || {
+            nm.iter()
+                .map(|l| format!("{l}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        if *self == Self::rgb() {
+            format!("rgb ({} nm)", list())
+        } else if *self == Self::spectral() {
+            format!(
+                "spectral ({} samples {}–{} nm)",
+                nm.len(),
+                nm[0],
+                nm[nm.len() - 1]
+            )
+        } else if nm.len() <= 4 {
+            format!("{} nm", list())
+        } else {
+            let lo = nm.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = nm.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            format!("{} samples {lo}–{hi} nm", nm.len())
+        }
+    }
+
     /// Number of samples.
     pub fn len(&self) -> usize {
         self.nm.len()

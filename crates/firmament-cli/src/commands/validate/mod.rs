@@ -209,7 +209,7 @@ impl Selection {
     fn atmosphere(&self, preset: &str, orders: usize) -> AtmosphereArgs {
         AtmosphereArgs {
             preset: Some(preset.to_string()),
-            wavelengths: self.wavelengths.clone(),
+            wavelengths: Some(self.wavelengths.clone()),
             orders,
             table_size: self.table_size.clone(),
             order_tail: self.order_tail,

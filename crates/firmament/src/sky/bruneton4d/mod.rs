@@ -4,6 +4,8 @@
 //! ([`table`]), lookups ([`lookup`]), the versioned file format ([`file`](mod@file)), and the
 //! evaluation of the paper's eq. 16 pieces from them ([`view`]).
 
+pub mod cache;
+pub mod compact;
 pub mod file;
 pub mod lookup;
 pub mod params;
