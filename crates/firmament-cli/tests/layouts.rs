@@ -311,6 +311,18 @@ fn an_equirect_maps_sun_is_where_the_blender_note_says_and_its_lamp_matches_quer
     ]);
     succeeds(&q);
     let q: serde_json::Value = serde_json::from_slice(&q.stdout).unwrap();
+    // Its provenance (item 6): program, atmosphere, method, tables, wavelengths.
+    let p = &q["provenance"];
+    assert_eq!(p["program"], "firmament");
+    assert_eq!(p["atmosphere"]["name"], "earth");
+    assert_eq!(p["atmosphere"]["hash"].as_str().map(str::len), Some(16));
+    assert!(p["method"].as_str().unwrap().contains("bruneton4d"));
+    assert_eq!(p["tables"]["orders"], 3);
+    assert_eq!(p["wavelengths_nm"].as_array().map(Vec::len), Some(3));
+    assert!(
+        q["notes"].as_array().unwrap().len() >= 2,
+        "notes say what was approximated"
+    );
     let normal = q["irradiance"]["sun_lux"].as_f64().unwrap() / 0.5;
     let l = lamps(&tmp().join("equirect-0").join("sky.lights.json"));
     let lux = l["lamps"][0]["illuminance_lux"].as_f64().unwrap();

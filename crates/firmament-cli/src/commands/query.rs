@@ -12,6 +12,8 @@ use firmament::spectrum::{luminance_from_spectrum, spectrum_to_xyz, xyz_to_linea
 use serde::Serialize;
 use serde_json::json;
 
+use super::provenance::provenance;
+
 use crate::backend::{Backend, BackendChoice};
 use crate::commands::astro::AstroArgs;
 use crate::common::{check_range, check_reference_samples, print_wavelengths, AtmosphereArgs};
@@ -290,7 +292,12 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
             estimate,
         ));
     }
-    let notes = match &reference {
+    let mut notes = vec![
+        json!("views: the sky's radiance without the sun's disk; a view into the ground gives the air's radiance between the observer and the ground, without the ground's own reflected light"),
+        json!("irradiance: on a horizontal surface at the observer over the planet's smooth sphere (no terrain horizon): sun = the direct beam through the tables' transmittance times the cosine, sky = the tables' irradiance of the hemisphere above the surface, ground bounce included through the multiple scattering"),
+        json!("sun_transmittance: along the straight ray to the sun (no refraction), with the planet's occlusion of the disk"),
+    ];
+    let method_notes = match &reference {
         None => json!([]),
         Some(s) => json!([
             format!(
@@ -299,6 +306,15 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
             ),
             "transmittance (per view), sun_transmittance, irradiance and optical depths: from the precomputed tables and the model, as for `lut`",
         ]),
+    };
+    if let serde_json::Value::Array(m) = method_notes {
+        notes.extend(m);
+    }
+    let method = match &reference {
+        None => "bruneton4d (precomputed tables)",
+        Some(_) => {
+            "reference (Monte Carlo path tracer) for the views, bruneton4d tables for the rest"
+        }
     };
     Ok(json!({
         "method": args.method,
@@ -323,5 +339,6 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
         },
         "views": answers,
         "notes": notes,
+        "provenance": provenance(model, method, Some(&sky.tables.config)),
     }))
 }

@@ -13,6 +13,8 @@ use firmament::sky::SkyMethod;
 use firmament::spectrum::luminance_from_spectrum;
 use serde_json::json;
 
+use super::provenance::provenance;
+
 use super::query::{parse_view, QueryArgs, ViewAnswer};
 use super::render::{sources_of_scene, terrain_and_atmosphere};
 use crate::common::print_wavelengths;
@@ -152,5 +154,10 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
         "solar_illuminance_toa_lux": luminance_from_spectrum(&nm, &sun.irradiance),
         "views": answers,
         "notes": [method, "transmittance (per view): the air's, from the tables, to the first surface the view meets or out of the atmosphere"],
+        "provenance": provenance(
+            &sky.model,
+            if settings.is_none() { "bruneton4d (precomputed tables)" } else { "reference (Monte Carlo path tracer)" },
+            Some(&sky.tables.config),
+        ),
     }))
 }

@@ -84,7 +84,7 @@ fn output_format_from_path() {
             }) => {
                 assert_eq!(field, "out");
                 assert_eq!(value, bad);
-                assert!(expected.contains(".png, .exr or .hdr"));
+                assert!(expected.contains(".png, .exr, .hdr or .dds"));
             }
             other => panic!("{bad}: {other:?}"),
         }
