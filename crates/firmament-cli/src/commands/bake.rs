@@ -10,9 +10,10 @@ use crate::backend::{Backend, BackendChoice};
 use crate::common::{check_output_dir, compute_tables, AtmosphereArgs};
 
 /// Arguments of `firmament bake` (the shared atmosphere flags without `--tables`, which
-/// `bake` computes rather than reads: hidden from its help, refused if given).
+/// `bake` computes rather than reads, and `--no-cache`, since it never uses the cache:
+/// hidden from its help, refused if given).
 #[derive(Args, Debug)]
-#[command(mut_arg("tables", |a| a.hide(true)))]
+#[command(mut_arg("tables", |a| a.hide(true)), mut_arg("no_cache", |a| a.hide(true)))]
 pub struct BakeArgs {
     #[command(flatten)]
     pub atmosphere: AtmosphereArgs,
