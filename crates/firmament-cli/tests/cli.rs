@@ -303,7 +303,7 @@ fn render_errors_leave_no_file() {
             "--out",
             tmp().join("x.jpg").to_str().unwrap(),
         ]),
-        &["out", ".png, .exr, .hdr or .dds"],
+        &["out", ".png, .exr, .hdr, .dds or .ktx2"],
     );
     fails_with(
         &run(&["render", "--tables", t, "--out", "/nonexistent-dir/x.png"]),

@@ -2,14 +2,17 @@
 //! faces meet seamlessly and the sun lands on the face and pixel that docs/conventions.md
 //! says (checked here with the OpenGL face table written out independently of the
 //! library), the DDS file holds the same faces, an equirect map's sun sits where the
-//! Blender note puts it, and the lamps' JSON agrees with `query`.
+//! Blender note puts it, and the lamps' JSON agrees with `query`. The DDS and KTX2 files
+//! hold the standard faces.
 
 mod common;
 
 use std::path::{Path, PathBuf};
 
 use common::{run, stderr, succeeds, tables_arg, tmp};
-use firmament::io::{read_dds_cube, read_exr, read_exr_text_attributes, ImageRgbF32};
+use firmament::io::{
+    read_dds_cube, read_exr, read_exr_text_attributes, read_ktx2_cube, ImageRgbF32,
+};
 
 /// Sun 30° high at azimuth 100° (off every face's centre line and edge).
 const SUN: (f64, f64) = (60.0, 100.0);
@@ -92,6 +95,8 @@ fn render_cube(layout: &str) -> PathBuf {
         exr.to_str().unwrap(),
         "--out",
         dir.join("sky.dds").to_str().unwrap(),
+        "--out",
+        dir.join("sky.ktx2").to_str().unwrap(),
     ]);
     succeeds(&o);
     assert!(stderr(&o).contains("sky.lights.json"), "{}", stderr(&o));
@@ -205,6 +210,9 @@ fn every_cube_layout_is_seamless_and_puts_the_sun_where_the_docs_say() {
         for (g, (a, b)) in dds.iter().zip(expected).enumerate() {
             assert_eq!(a.data, b.data, "{layout}: DDS face {g}");
         }
+        // The KTX2 file (parsed by the `ktx2` crate's reader) holds the same faces.
+        let ktx = read_ktx2_cube(dir.join("sky.ktx2")).unwrap();
+        assert_eq!(ktx, dds, "{layout}: KTX2 faces");
         // The EXR carries the provenance.
         let attributes = read_exr_text_attributes(dir.join("sky.exr")).unwrap();
         let get = |k: &str| {

@@ -184,8 +184,17 @@ fn every_projection_renders_finite_pixels_and_hdr_files_read_back() {
             } else {
                 100.0
             },
-            heading_deg: 10.0,
-            pitch_deg: 5.0,
+            // Only a perspective view tilts; a cube map's faces face the axes.
+            heading_deg: if projection == Projection::Cubemap {
+                0.0
+            } else {
+                10.0
+            },
+            pitch_deg: if projection == Projection::Perspective {
+                5.0
+            } else {
+                0.0
+            },
             roll_deg: 0.0,
             fov_deg: 60.0,
         };

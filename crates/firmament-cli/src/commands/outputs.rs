@@ -16,13 +16,14 @@ use super::render_args::RenderArgs;
 /// How frames become files: EXR precision and colour space, PNG dither, cube layout.
 #[derive(Clone, Copy, Debug)]
 pub struct FileOptions {
-    /// 16-bit half-float EXR (and DDS).
+    /// 16-bit half-float EXR (and DDS, KTX2).
     pub half: bool,
     /// The EXR's colour space (PNG, Radiance HDR and DDS are Rec. 709).
     pub gamut: Gamut,
     /// Triangular dither in 8-bit PNG.
     pub dither: bool,
-    /// A cube map's layout in PNG, EXR and HDR files; DDS files hold its standard faces.
+    /// A cube map's layout in PNG, EXR and HDR files; DDS and KTX2 files hold its standard
+    /// faces.
     pub layout: CubeLayout,
 }
 
@@ -143,7 +144,7 @@ pub fn write_outputs(
                 io::write_exr_in(path, &image, precision, &attributes, Some(&chromaticities))?;
             }
             OutputFormat::Hdr => io::write_hdr(path, &frame.in_gamut(Gamut::Rec709))?,
-            OutputFormat::Dds => {
+            format @ (OutputFormat::Dds | OutputFormat::Ktx2) => {
                 // Standard faces: the layout's own, y-up for firmament's and the cross.
                 let layout = match files.layout {
                     CubeLayout::Unreal => CubeLayout::Unreal,
@@ -153,7 +154,11 @@ pub fn write_outputs(
                 if files.half {
                     faces.iter().for_each(|f| warn_half_clamps(f, path, quiet));
                 }
-                io::write_dds_cube(path, &faces, precision)?;
+                if format == OutputFormat::Dds {
+                    io::write_dds_cube(path, &faces, precision)?;
+                } else {
+                    io::write_ktx2_cube(path, &faces, precision)?;
+                }
             }
         }
         if let Some(l) = &notes.lamps {

@@ -143,7 +143,7 @@ pub struct RenderArgs {
     /// −X west, +Y north, −Y south, +Z up, −Z down), `y-up` (the graphics APIs' faces
     /// +X −X +Y −Y +Z −Z in a 6×1 strip, +Y up, north on +Z), `cross` (those faces in a
     /// 4×3 horizontal cross) or `unreal` (the standard faces in Unreal's axes: +X north,
-    /// +Y east, +Z up). A .dds file holds the standard faces (y-up, or unreal's). See
+    /// +Y east, +Z up). A .dds or .ktx2 file holds the standard faces (y-up, or unreal's). See
     /// docs/conventions.md [default: firmament].
     #[arg(long, value_name = "firmament|y-up|cross|unreal")]
     pub layout: Option<String>,
@@ -151,7 +151,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub no_dither: bool,
     #[arg(long = "out", value_name = "FILE", help = with_default(
-        "Output file, repeatable; format from the extension (.png, .exr, .hdr, .dds)",
+        "Output file, repeatable; format from the extension (.png, .exr, .hdr; .dds and .ktx2 for cube maps)",
         defaults().output.files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(" and "),
     ))]
     pub outputs: Vec<PathBuf>,

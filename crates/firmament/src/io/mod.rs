@@ -10,6 +10,7 @@ pub mod atomic;
 pub mod dds;
 pub mod exr;
 pub mod hdr;
+pub mod ktx;
 pub mod png;
 
 use std::path::{Path, PathBuf};
@@ -22,6 +23,7 @@ pub use self::hdr::{read_hdr, rgbe_decode, rgbe_encode, write_hdr, write_hdr_unc
 pub use self::png::{read_png_srgb8, write_png_srgb8};
 pub use atomic::write_atomic;
 pub use dds::{read_dds_cube, write_dds_cube};
+pub use ktx::{read_ktx2_cube, write_ktx2_cube};
 
 use crate::{Error, Result};
 
@@ -106,10 +108,12 @@ pub enum OutputFormat {
     Hdr,
     /// DirectDraw Surface cube map, linear float (cube-map cameras only).
     Dds,
+    /// KTX 2.0 cube map, linear float (cube-map cameras only).
+    Ktx2,
 }
 
 impl OutputFormat {
-    /// The format named by `path`'s extension (`.png`, `.exr`, `.hdr`, `.dds`, any case).
+    /// The format named by `path`'s extension (`.png`, `.exr`, `.hdr`, `.dds`, `.ktx2`, any case).
     pub fn from_path(path: impl AsRef<Path>) -> Result<OutputFormat> {
         let path = path.as_ref();
         let ext = path
@@ -121,10 +125,11 @@ impl OutputFormat {
             Some("exr") => Ok(OutputFormat::Exr),
             Some("hdr") => Ok(OutputFormat::Hdr),
             Some("dds") => Ok(OutputFormat::Dds),
+            Some("ktx2") => Ok(OutputFormat::Ktx2),
             _ => Err(Error::invalid(
                 "out",
                 path.display(),
-                "a file name ending in .png, .exr, .hdr or .dds",
+                "a file name ending in .png, .exr, .hdr, .dds or .ktx2",
             )),
         }
     }
@@ -136,6 +141,7 @@ impl OutputFormat {
             OutputFormat::Exr => "exr",
             OutputFormat::Hdr => "hdr",
             OutputFormat::Dds => "dds",
+            OutputFormat::Ktx2 => "ktx2",
         }
     }
 

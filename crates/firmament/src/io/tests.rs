@@ -84,7 +84,7 @@ fn output_format_from_path() {
             }) => {
                 assert_eq!(field, "out");
                 assert_eq!(value, bad);
-                assert!(expected.contains(".png, .exr, .hdr or .dds"));
+                assert!(expected.contains(".png, .exr, .hdr, .dds or .ktx2"));
             }
             other => panic!("{bad}: {other:?}"),
         }

@@ -377,16 +377,18 @@ impl SceneFile {
                 Error::invalid(
                     format!("output.files[{i}]"),
                     f.display(),
-                    "a file name ending in .png, .exr, .hdr or .dds",
+                    "a file name ending in .png, .exr, .hdr, .dds or .ktx2",
                 )
             })?;
-            if format == crate::io::OutputFormat::Dds
-                && self.camera.projection != Projection::Cubemap
-            {
+            let cube_file = matches!(
+                format,
+                crate::io::OutputFormat::Dds | crate::io::OutputFormat::Ktx2
+            );
+            if cube_file && self.camera.projection != Projection::Cubemap {
                 return Err(Error::invalid(
                     format!("output.files[{i}]"),
                     f.display(),
-                    "a .png, .exr or .hdr file: a .dds file holds a cube map (projection = \"cubemap\")",
+                    "a .png, .exr or .hdr file: a .dds or .ktx2 file holds a cube map (projection = \"cubemap\")",
                 ));
             }
         }
