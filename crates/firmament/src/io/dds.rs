@@ -7,12 +7,10 @@
 
 use std::path::Path;
 
-use ddsfile::{AlphaMode, Caps2, D3D10ResourceDimension, Dds, DxgiFormat, NewDxgiParams};
-use half::f16;
-
-use super::exr::HALF_MAX;
+use super::cube_faces::{channel_bytes, face_from_rgba, face_size, rgba_bytes};
 use super::{file_error, write_atomic, ExrPrecision, ImageRgbF32};
 use crate::Result;
+use ddsfile::{AlphaMode, Caps2, D3D10ResourceDimension, Dds, DxgiFormat, NewDxgiParams};
 
 /// Write six square faces (+X, −X, +Y, −Y, +Z, −Z) as a DDS cube map, atomically.
 pub fn write_dds_cube(
@@ -21,16 +19,7 @@ pub fn write_dds_cube(
     precision: ExrPrecision,
 ) -> Result<()> {
     let path = path.as_ref();
-    let n = faces.first().map_or(0, |f| f.width);
-    if faces.len() != 6 || n == 0 || faces.iter().any(|f| f.width != n || f.height != n) {
-        return Err(file_error(
-            path,
-            "cannot write DDS cube map: six square faces of one size are needed",
-        ));
-    }
-    for f in faces {
-        f.check(path)?;
-    }
+    let n = face_size(path, faces, "DDS")?;
     let dds_error = |e: ddsfile::Error| file_error(path, format!("cannot write DDS: {e}"));
     let mut dds = Dds::new_dxgi(NewDxgiParams {
         height: n as u32,
@@ -52,18 +41,7 @@ pub fn write_dds_cube(
     .map_err(dds_error)?;
     for (i, face) in faces.iter().enumerate() {
         let data = dds.get_mut_data(i as u32).map_err(dds_error)?;
-        let mut bytes = Vec::with_capacity(data.len());
-        for p in &face.data {
-            for v in [p[0], p[1], p[2], 1.0] {
-                match precision {
-                    ExrPrecision::F32 => bytes.extend_from_slice(&v.to_le_bytes()),
-                    // Half floats end at 65504: brighter samples are clamped there.
-                    ExrPrecision::F16 => {
-                        bytes.extend_from_slice(&f16::from_f32(v.min(HALF_MAX)).to_le_bytes())
-                    }
-                }
-            }
-        }
+        let bytes = rgba_bytes(face, precision);
         if bytes.len() != data.len() {
             return Err(file_error(path, "cannot write DDS: unexpected face size"));
         }
@@ -90,9 +68,9 @@ pub fn read_dds_cube(path: impl AsRef<Path>) -> Result<Vec<ImageRgbF32>> {
             "cannot read DDS: not a cube map with six faces",
         ));
     }
-    let half = match dds.get_dxgi_format() {
-        Some(DxgiFormat::R32G32B32A32_Float) => false,
-        Some(DxgiFormat::R16G16B16A16_Float) => true,
+    let precision = match dds.get_dxgi_format() {
+        Some(DxgiFormat::R32G32B32A32_Float) => ExrPrecision::F32,
+        Some(DxgiFormat::R16G16B16A16_Float) => ExrPrecision::F16,
         other => {
             return Err(file_error(
                 path,
@@ -105,18 +83,10 @@ pub fn read_dds_cube(path: impl AsRef<Path>) -> Result<Vec<ImageRgbF32>> {
             let data = dds
                 .get_data(i)
                 .map_err(|e| file_error(path, format!("cannot read DDS: {e}")))?;
-            let mut face = ImageRgbF32::new(n, n);
-            let size = if half { 2 } else { 4 };
-            for (k, p) in face.data.iter_mut().enumerate() {
-                for (c, v) in p.iter_mut().enumerate() {
-                    let at = (4 * k + c) * size;
-                    *v = if half {
-                        f16::from_le_bytes([data[at], data[at + 1]]).to_f32()
-                    } else {
-                        f32::from_le_bytes(data[at..at + 4].try_into().unwrap())
-                    };
-                }
+            if data.len() < n * n * 4 * channel_bytes(precision) {
+                return Err(file_error(path, "cannot read DDS: face too short"));
             }
+            let face = face_from_rgba(data, n, precision);
             Ok(face)
         })
         .collect()

@@ -11,9 +11,8 @@ use std::path::Path;
 
 use ::ktx2::dfd::{Basic, Block};
 use ::ktx2::{Format, Header, Index, LevelIndex};
-use half::f16;
 
-use super::exr::HALF_MAX;
+use super::cube_faces::{channel_bytes, face_from_rgba, face_size, rgba_bytes};
 use super::{file_error, write_atomic, ExrPrecision, ImageRgbF32};
 use crate::Result;
 
@@ -40,16 +39,7 @@ pub fn write_ktx2_cube(
     precision: ExrPrecision,
 ) -> Result<()> {
     let path = path.as_ref();
-    let n = faces.first().map_or(0, |f| f.width);
-    if faces.len() != 6 || n == 0 || faces.iter().any(|f| f.width != n || f.height != n) {
-        return Err(file_error(
-            path,
-            "cannot write KTX2 cube map: six square faces of one size are needed",
-        ));
-    }
-    for f in faces {
-        f.check(path)?;
-    }
+    let n = face_size(path, faces, "KTX2")?;
     let format = match precision {
         ExrPrecision::F32 => Format::R32G32B32A32_SFLOAT,
         ExrPrecision::F16 => Format::R16G16B16A16_SFLOAT,
@@ -62,20 +52,10 @@ pub fn write_ktx2_cube(
     dfd.extend_from_slice(&block);
     let kvd = key_values();
     // The level's texels: each face's rows, top first, RGBA.
-    let mut data = Vec::with_capacity(6 * n * n * 4 * type_size as usize);
-    for face in faces {
-        for p in &face.data {
-            for v in [p[0], p[1], p[2], 1.0] {
-                match precision {
-                    ExrPrecision::F32 => data.extend_from_slice(&v.to_le_bytes()),
-                    // Half floats end at 65504: brighter samples are clamped there.
-                    ExrPrecision::F16 => {
-                        data.extend_from_slice(&f16::from_f32(v.min(HALF_MAX)).to_le_bytes())
-                    }
-                }
-            }
-        }
-    }
+    let data: Vec<u8> = faces
+        .iter()
+        .flat_map(|f| rgba_bytes(f, precision))
+        .collect();
     let dfd_offset = Header::LENGTH + LevelIndex::LENGTH;
     let kvd_offset = dfd_offset + dfd.len();
     // Level data aligned to lcm(texel size, 4) (§3.9.7): the texel size, 8 or 16 bytes.
@@ -124,9 +104,9 @@ pub fn read_ktx2_cube(path: impl AsRef<Path>) -> Result<Vec<ImageRgbF32>> {
     let bad = |why: String| file_error(path, format!("cannot read KTX2: {why}"));
     let reader = ::ktx2::Reader::new(&bytes[..]).map_err(|e| bad(format!("{e:?}")))?;
     let header = reader.header();
-    let half = match header.format {
-        Some(Format::R32G32B32A32_SFLOAT) => false,
-        Some(Format::R16G16B16A16_SFLOAT) => true,
+    let precision = match header.format {
+        Some(Format::R32G32B32A32_SFLOAT) => ExrPrecision::F32,
+        Some(Format::R16G16B16A16_SFLOAT) => ExrPrecision::F16,
         other => return Err(bad(format!("format {other:?}"))),
     };
     if header.face_count != 6 || header.supercompression_scheme.is_some() {
@@ -137,32 +117,21 @@ pub fn read_ktx2_cube(path: impl AsRef<Path>) -> Result<Vec<ImageRgbF32>> {
         .levels()
         .next()
         .ok_or_else(|| bad("no level".into()))?;
-    let size = if half { 2 } else { 4 };
-    if level.data.len() != 6 * n * n * 4 * size {
+    let face_bytes = n * n * 4 * channel_bytes(precision);
+    if level.data.len() != 6 * face_bytes {
         return Err(bad("unexpected level size".into()));
     }
-    Ok((0..6)
-        .map(|f| {
-            let mut face = ImageRgbF32::new(n, n);
-            for (k, p) in face.data.iter_mut().enumerate() {
-                for (c, v) in p.iter_mut().enumerate() {
-                    let at = ((f * n * n + k) * 4 + c) * size;
-                    let d = level.data;
-                    *v = if half {
-                        f16::from_le_bytes([d[at], d[at + 1]]).to_f32()
-                    } else {
-                        f32::from_le_bytes(d[at..at + 4].try_into().unwrap())
-                    };
-                }
-            }
-            face
-        })
+    Ok(level
+        .data
+        .chunks(face_bytes)
+        .map(|d| face_from_rgba(d, n, precision))
         .collect())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::HALF_MAX;
 
     #[test]
     fn a_cube_round_trips_through_the_ktx2_reader() {

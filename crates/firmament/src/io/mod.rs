@@ -7,6 +7,7 @@
 //! a failed or interrupted write never leaves a partial output file.
 
 pub mod atomic;
+mod cube_faces;
 pub mod dds;
 pub mod exr;
 pub mod hdr;
