@@ -111,9 +111,10 @@ pub const BRUNETON4D_VIEW: [Module; 2] = [
 
 /// The terrain: its bindings, the grid and its walk, the surface, the materials, the
 /// horizons, the shadow fields.
-pub const TERRAIN: [Module; 6] = [
+pub const TERRAIN: [Module; 7] = [
     module!("terrain/terrain.wgsl"),
     module!("terrain/grid.wgsl"),
+    module!("terrain/walk.wgsl"),
     module!("terrain/heightfield.wgsl"),
     module!("terrain/materials.wgsl"),
     module!("terrain/occlusion.wgsl"),

@@ -6,10 +6,11 @@
 
 use std::sync::{Arc, RwLock};
 
-use super::grid::{bilinear, first_descent, fractions, CellSpan, Grid, GridRay, MaxPyramid, Walk};
+use super::grid::{bilinear, first_descent, fractions, CellSpan, Grid, GridRay, MaxPyramid};
 use super::materials::Materials;
 use super::occlusion::Occlusion;
 use super::shadow::ShadowField;
+use super::walk::Walk;
 use crate::math::Vec3;
 use crate::scene::camera::Ray;
 use crate::scene::surface::{Relief, Surface, SurfaceHit, HORIZON_AZIMUTHS};

@@ -13,6 +13,7 @@ pub mod materials;
 pub mod occlusion;
 pub mod relief;
 pub mod shadow;
+pub mod walk;
 
 use std::path::{Path, PathBuf};
 

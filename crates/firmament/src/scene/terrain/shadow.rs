@@ -22,8 +22,9 @@
 
 use rayon::prelude::*;
 
-use super::grid::{roots, Grid, GridRay, MaxPyramid, Walk};
+use super::grid::{roots, Grid, GridRay, MaxPyramid};
 use super::heightfield::Heightfield;
+use super::walk::Walk;
 use crate::math::Vec3;
 
 /// Lights within this angle of the zenith (rad) cast no shadow but their own: the sweep has
