@@ -280,7 +280,7 @@ fn cpu_frame_with_shadow_lengths(
     let observer = Vec3::new(0.0, 0.0, model.bottom_radius_m + settings.camera.altitude_m);
     let view = sky.view(observer, sun);
     let ground = Sphere::ground(model);
-    let colour = ColourMatrix::new(model.wavelengths.nm());
+    let colour = model.colour_matrix();
     let mut image = firmament::io::ImageRgbF32::new(w, h);
     let mut mask = vec![false; w * h];
     for y in 0..h {

@@ -215,7 +215,7 @@ fn accuracy_views_match_the_cpu_shading() {
     let shader = Shader::new(&scene, observer).unwrap();
     let gpu_sky = GpuSky::from_sky(&gpu.ctx, &sky).unwrap();
     let gpu_terrain = GpuTerrain::new(&gpu.ctx, &gpu_sky, &terrain, &shader).unwrap();
-    let colour = firmament::spectrum::ColourMatrix::new(sky.model.wavelengths.nm());
+    let colour = sky.model.colour_matrix();
     let mut scratch = firmament::render::ShadeScratch::default();
     let (mut worst, mut sum, mut count) = (0.0f64, 0.0, 0);
     for zenith in [60.0, 75.0, 82.0, 86.0, 88.5, 90.2, 92.0, 95.0, 100.0] {

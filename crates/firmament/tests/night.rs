@@ -59,14 +59,14 @@ fn luminance(scene: &Scene, dir: Vec3) -> f64 {
         &mut ShadeScratch::default(),
         &mut l,
     );
-    ColourMatrix::new(model.wavelengths.nm()).to_xyz(&l)[1]
+    model.colour_matrix().to_xyz(&l)[1]
 }
 
 /// Illuminance (lx) on a horizontal surface 2 m up: each light's direct beam through the air
 /// and the sky's light.
 fn horizontal_illuminance(scene: &Scene) -> f64 {
     let model = scene.sky.model();
-    let colour = ColourMatrix::new(model.wavelengths.nm());
+    let colour = model.colour_matrix();
     let point = Vec3::new(0.0, 0.0, model.bottom_radius_m + 2.0);
     let n = model.channels();
     let (mut direct, mut diffuse) = (vec![0.0; n], vec![0.0; n]);

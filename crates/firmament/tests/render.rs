@@ -24,7 +24,7 @@ fn look(sun: (f64, f64), elevation: f64, azimuth: f64) -> [f64; 3] {
     Shader::new(&scene, ray.origin)
         .unwrap()
         .shade(&ray, &mut ShadeScratch::default(), &mut l);
-    ColourMatrix::new(sky.model.wavelengths.nm()).to_srgb(&l)
+    sky.model.colour_matrix().to_srgb(&l)
 }
 
 fn lum(c: [f64; 3]) -> f64 {

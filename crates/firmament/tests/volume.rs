@@ -84,7 +84,7 @@ fn a_scattering_ball_matches_the_reference() {
     let mut scene = Scene::clear_sky(sky, sun, false);
     scene.volumes.push(Box::new(ball.clone()));
     let volumes: Vec<Box<dyn Volume>> = vec![Box::new(ball.clone())];
-    let colour = ColourMatrix::new(model.wavelengths.nm());
+    let colour = model.colour_matrix();
     let settings = ReferenceSettings::with_samples(16_384);
     let mut worst: f64 = 0.0;
     for (i, offset) in [(0.0, 0.0), (300.0, 0.0), (0.0, 350.0), (-420.0, 0.0)]

@@ -14,8 +14,6 @@ use firmament::math::sphere::distance_to_top_atmosphere_boundary;
 use firmament::math::Vec3;
 use firmament::render::cube_layout::CubeLayout;
 use firmament::scene::{Light, Projection};
-use firmament::spectrum::colour::ColourMatrix;
-use firmament::spectrum::luminance_from_spectrum;
 use serde_json::{json, Value};
 
 /// Lumens per watt that Blender assumes for its lamps' power and strength (the photopic
@@ -66,9 +64,9 @@ fn lamp(
         .zip(&t)
         .map(|(e, t)| e * t)
         .collect();
-    let nm = model.wavelengths.nm();
-    let lux = luminance_from_spectrum(nm, &irradiance);
-    let rgb = ColourMatrix::new(nm).to_srgb(&irradiance);
+    let colour = model.colour_matrix();
+    let lux = colour.to_xyz(&irradiance)[1];
+    let rgb = colour.to_srgb(&irradiance);
     let y = 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
     let colour: Vec<f64> = if y > 0.0 {
         rgb.iter().map(|c| (c / y).max(0.0)).collect()

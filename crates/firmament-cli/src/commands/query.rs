@@ -8,7 +8,7 @@ use firmament::reference::{self, ReferenceSettings};
 use firmament::scene::sky_lights::{sources_of, SkySources};
 use firmament::scene::sun_direction;
 use firmament::sky::{Shadow, SkyMethod, SkyView};
-use firmament::spectrum::{luminance_from_spectrum, spectrum_to_xyz, xyz_to_linear_srgb};
+use firmament::spectrum::{xyz_to_linear_srgb, ColourMatrix};
 use serde::Serialize;
 use serde_json::json;
 
@@ -94,12 +94,12 @@ impl ViewAnswer {
     /// when there is one (whose radiance `radiance` already holds).
     pub(crate) fn new(
         (zenith_deg, azimuth_deg): (f64, f64),
-        nm: &[f64],
+        colour: &ColourMatrix,
         radiance: Vec<f64>,
         transmittance: Vec<f64>,
         estimate: Option<reference::RadianceEstimate>,
     ) -> ViewAnswer {
-        let xyz = spectrum_to_xyz(nm, &radiance);
+        let xyz = colour.to_xyz(&radiance);
         ViewAnswer {
             zenith_deg,
             azimuth_deg,
@@ -108,7 +108,9 @@ impl ViewAnswer {
             srgb_linear: xyz_to_linear_srgb(xyz),
             radiance,
             transmittance,
-            luminance_cd_m2_stderr: estimate.as_ref().map(|e| e.luminance(nm).1),
+            luminance_cd_m2_stderr: estimate
+                .as_ref()
+                .map(|e| colour.luminance_and_stderr(&e.radiance, &e.stderr).1),
             samples: estimate.as_ref().map(|e| e.samples),
             radiance_stderr: estimate.map(|e| e.stderr),
         }
@@ -135,21 +137,22 @@ fn moon_json(
     views: &[Box<dyn SkyView + '_>],
     sources: &SkySources,
     camera: Vec3,
-    nm: &[f64],
+    colour: &ColourMatrix,
 ) -> serde_json::Value {
     let Some(s) = sky_now else {
         return serde_json::Value::Null;
     };
     let light = match (sources.lights.get(1), views.get(1)) {
         (Some(moon), Some(view)) => {
-            let n = nm.len();
+            let n = moon.irradiance.len();
             let (mut direct, mut diffuse) = (vec![0.0; n], vec![0.0; n]);
+            let lux = |v: &[f64]| colour.to_xyz(v)[1];
             view.sun_and_sky_irradiance(camera, Vec3::Z, &mut direct, &mut diffuse);
             json!({
                 "irradiance_toa": moon.irradiance,
-                "illuminance_toa_lux": luminance_from_spectrum(nm, &moon.irradiance),
-                "direct_lux": luminance_from_spectrum(nm, &direct),
-                "sky_lux": luminance_from_spectrum(nm, &diffuse),
+                "illuminance_toa_lux": lux(&moon.irradiance),
+                "direct_lux": lux(&direct),
+                "sky_lux": lux(&diffuse),
             })
         }
         _ => serde_json::Value::Null,
@@ -260,7 +263,8 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
     sky_view.transmittance_to_light(camera, &mut sun_transmittance);
     let (mut sun_irradiance, mut sky_irradiance) = (vec![0.0; n], vec![0.0; n]);
     sky_view.sun_and_sky_irradiance(camera, up, &mut sun_irradiance, &mut sky_irradiance);
-    let lux = |v: &[f64]| luminance_from_spectrum(&nm, v);
+    let colour = model.colour_matrix();
+    let lux = |v: &[f64]| colour.to_xyz(v)[1];
 
     let mut answers = Vec::new();
     for (i, &(zenith_deg, azimuth_deg)) in views.iter().enumerate() {
@@ -286,7 +290,7 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
         });
         answers.push(ViewAnswer::new(
             (zenith_deg, azimuth_deg),
-            &nm,
+            &colour,
             radiance,
             transmittance,
             estimate,
@@ -326,7 +330,7 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
         },
         "altitude_m": altitude_m,
         "sun": { "zenith_deg": sun_zenith_deg, "azimuth_deg": sun_azimuth_deg },
-        "moon": moon_json(&sky_now, &views_of_lights, &sources, camera, &nm),
+        "moon": moon_json(&sky_now, &views_of_lights, &sources, camera, &colour),
         "optical_depth_zenith": optical_depths,
         "solar_irradiance_toa": model.solar_irradiance,
         "solar_illuminance_toa_lux": lux(&model.solar_irradiance),

@@ -10,7 +10,6 @@ use firmament::reference::{self, ReferenceSettings};
 use firmament::render::{ShadeScratch, Shader};
 use firmament::scene::{Ray, Scene as RenderScene, SceneFile, Surface};
 use firmament::sky::SkyMethod;
-use firmament::spectrum::luminance_from_spectrum;
 use serde_json::json;
 
 use super::provenance::provenance;
@@ -49,6 +48,7 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
     let sky = atmosphere.sky(args.quiet)?;
     let model = &sky.model;
     let nm = model.wavelengths.nm().to_vec();
+    let colour = model.colour_matrix();
     let camera = scene.camera_over(terrain.as_ref(), model.bottom_radius_m);
     let observer = firmament::math::Vec3::new(0.0, 0.0, model.bottom_radius_m + camera.altitude_m);
     let radius = terrain
@@ -119,7 +119,7 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
         });
         answers.push(ViewAnswer::new(
             (zenith_deg, azimuth_deg),
-            &nm,
+            &colour,
             radiance,
             transmittance,
             estimate,
@@ -151,7 +151,7 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
             "zenith_deg": up.acos().to_degrees(),
             "azimuth_deg": sun.direction.x.atan2(sun.direction.y).to_degrees().rem_euclid(360.0),
         },
-        "solar_illuminance_toa_lux": luminance_from_spectrum(&nm, &sun.irradiance),
+        "solar_illuminance_toa_lux": colour.to_xyz(&sun.irradiance)[1],
         "views": answers,
         "notes": [method, "transmittance (per view): the air's, from the tables, to the first surface the view meets or out of the atmosphere"],
         "provenance": provenance(

@@ -7,7 +7,6 @@
 use firmament::atmosphere::Model;
 use firmament::sky::bruneton4d::params::Radii;
 use firmament::sky::bruneton4d::{Bruneton4d, MieStorage, TableConfig, TableSizes};
-use firmament::spectrum::ColourMatrix;
 
 use super::atmosphere::{self, groups, GROUP};
 use super::precompute::{GpuTables, Precomputer};
@@ -163,7 +162,7 @@ impl GpuSky {
     ) -> GpuSky {
         let n = model.channels();
         let n_groups = groups(n);
-        let colour = ColourMatrix::new(model.wavelengths.nm());
+        let colour = model.colour_matrix();
         let mie_ratio = model.groups.mie_ratio();
         // The uniform's full size (the shader declares a fixed-size array); lanes of
         // channel k in group k/4.

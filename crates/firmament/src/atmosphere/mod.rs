@@ -6,6 +6,7 @@ pub mod groups;
 mod lift;
 pub mod model;
 pub mod presets;
+mod sky_spectra;
 
 use std::path::Path;
 

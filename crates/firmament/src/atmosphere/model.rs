@@ -126,7 +126,7 @@ impl Model {
                     .zip(&t)
                     .map(|(e, tau)| e * (-tau).exp())
                     .collect();
-                let y = spectrum::spectrum_to_xyz(nm, &ground)[1];
+                let y = spectrum::luminance_from_spectrum(nm, &ground);
                 let scale = if y > 0.0 { lux / y } else { 0.0 };
                 shape.iter().map(|e| e * scale).collect()
             }

@@ -11,7 +11,6 @@ use crate::math::sphere::ray_sphere;
 use crate::math::Vec3;
 use crate::render::{Frame, RenderSettings};
 use crate::scene::{Light, Ray, Surface, Volume};
-use crate::spectrum::ColourMatrix;
 use crate::{Error, Result};
 
 /// How far [`render_frame`] is.
@@ -65,7 +64,7 @@ pub fn render_frame(
     let batch = (4 * w).clamp(256, 16_384);
     let done = std::sync::atomic::AtomicUsize::new(0);
     let mut estimates: Vec<RadianceEstimate> = Vec::with_capacity(rays.len());
-    let colour = ColourMatrix::new(model.wavelengths.nm());
+    let colour = model.colour_matrix();
     // The mean relative standard error of the pixels done so far (f64 bits; updated
     // between batches).
     let noise = std::sync::atomic::AtomicU64::new(f64::NAN.to_bits());

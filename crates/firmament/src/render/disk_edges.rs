@@ -10,7 +10,6 @@
 use crate::math::Vec3;
 use crate::render::{Frame, RenderSettings, ShadeScratch, Shader};
 use crate::scene::{Light, PreparedCamera, Ray, Scene};
-use crate::spectrum::ColourMatrix;
 use crate::Result;
 
 /// Sub-pixel rays per side on a disk's edge.
@@ -110,7 +109,7 @@ pub fn disk_illuminance(
     let prepared = camera.prepare(model.bottom_radius_m, width, height);
     let observer = Vec3::new(0.0, 0.0, model.bottom_radius_m + camera.altitude_m);
     let plain = Shader::plain(scene, observer)?.without_disks();
-    let colour = ColourMatrix::new(model.wavelengths.nm());
+    let colour = model.colour_matrix();
     let mut scratch = ShadeScratch::default();
     let y = |c: [f64; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
     let l = &scene.lights[light];

@@ -30,7 +30,7 @@ use crate::io::ImageRgbF32;
 use crate::scene::surface::{lit_intervals, HORIZON_AZIMUTHS};
 use crate::scene::{Camera, Projection, Ray, Scene};
 use crate::sky::{Shadow, SkyView};
-use crate::spectrum::{with_channel_buffers, ColourMatrix, MAX_CHANNELS};
+use crate::spectrum::{with_channel_buffers, MAX_CHANNELS};
 use crate::{Error, Result};
 
 /// What to render: the camera and the image.
@@ -290,7 +290,7 @@ pub fn render(
     settings.validate()?;
     let (w, h) = (settings.width, settings.height);
     let model = scene.sky.model();
-    let colour = ColourMatrix::new(model.wavelengths.nm());
+    let colour = model.colour_matrix();
     let balance = colour.white_balance(&model.solar_irradiance, settings.white_balance);
     let prepared = settings.camera.prepare(model.bottom_radius_m, w, h);
     let observer =

@@ -172,7 +172,7 @@ pub fn draw_points_into(
     let (w, h) = (settings.width, settings.height);
     let camera = settings.camera.prepare(model.bottom_radius_m, w, h);
     let observer = Vec3::new(0.0, 0.0, model.bottom_radius_m + settings.camera.altitude_m);
-    let colour = ColourMatrix::new(model.wavelengths.nm());
+    let colour = model.colour_matrix();
     let transmittance = |dir: Vec3, out: &mut [f64]| {
         let ray = Ray {
             origin: observer,

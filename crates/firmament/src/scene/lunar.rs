@@ -20,7 +20,6 @@ use crate::astro::photometry::{illuminance_from_magnitude_lx, scale_to_illuminan
 use crate::astro::sun::ASTRONOMICAL_UNIT_M;
 use crate::atmosphere::Model;
 use crate::math::Vec3;
-use crate::spectrum::ColourMatrix;
 
 /// B−V of the moon and of the sun (Allen 1973; Holmberg, Flynn & Portinari 2006).
 const MOON_B_V: f64 = 0.92;
@@ -112,7 +111,7 @@ fn disk_frame(towards_observer: Vec3) -> (Vec3, Vec3, Vec3) {
 /// the radiance across its disk.
 pub fn lunar_light(model: &Model, moon: &MoonGeometry) -> (Vec<f64>, LunarDisk) {
     let nm = model.wavelengths.nm();
-    let colour = ColourMatrix::new(nm);
+    let colour = model.colour_matrix();
     let au_m = ASTRONOMICAL_UNIT_M;
     let alpha_deg = moon.phase_angle_rad.to_degrees();
     let shape: Vec<f64> = (model.solar_irradiance.iter().zip(nm))

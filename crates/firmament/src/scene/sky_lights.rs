@@ -28,7 +28,6 @@ use crate::atmosphere::Model;
 use crate::math::Vec3;
 use crate::scene::light::Light;
 use crate::scene::lunar::MoonGeometry;
-use crate::spectrum::ColourMatrix;
 
 /// The night sky's surface brightness above the atmosphere at the zenith (V mag/arcsec²).
 pub const NIGHT_SKY_TOP_MAG_ARCSEC2: f64 = 21.8;
@@ -66,7 +65,7 @@ const MOON_CUTOFF_ALTITUDE_DEG: f64 = -3.0;
 
 /// The natural night sky's glow for `model`'s planet and wavelengths.
 pub fn night_sky_background(model: &Model) -> Background {
-    let colour = ColourMatrix::new(model.wavelengths.nm());
+    let colour = model.colour_matrix();
     Background {
         zenith_radiance: scale_to_illuminance(
             &model.solar_irradiance,
@@ -127,7 +126,7 @@ pub struct PointSource {
 /// `model`'s wavelengths.
 pub fn stars_of(model: &Model, sky: &Sky) -> Vec<PointSource> {
     let nm = model.wavelengths.nm();
-    let colour = ColourMatrix::new(nm);
+    let colour = model.colour_matrix();
     catalogue()
         .iter()
         .filter_map(|star| {

@@ -1,7 +1,31 @@
 //! Colour: spectra to CIE XYZ to linear sRGB ([`ColourMatrix`]), the sRGB transfer function
 //! (exact, and a table for whole frames), and white balance to a light's colour.
 
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
+
 use super::spectrum_to_xyz;
+use super::weights::{fit_xyz_weights, generic_family, SolarShape, TrainingSpectrum};
+
+/// The generic weights of a wavelength list, fitted once per list and kept (a fit takes a
+/// few milliseconds; luminances are asked for per view).
+pub(crate) fn generic_weights(nm: &[f64]) -> Arc<Vec<[f64; 3]>> {
+    type Cache = Mutex<HashMap<Vec<u64>, Arc<Vec<[f64; 3]>>>>;
+    static CACHE: OnceLock<Cache> = OnceLock::new();
+    let key: Vec<u64> = nm.iter().map(|l| l.to_bits()).collect();
+    let cache = CACHE.get_or_init(Default::default);
+    if let Some(w) = cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
+        return w;
+    }
+    let w = Arc::new(fit_xyz_weights(
+        &SolarShape::astm_g173(nm),
+        &generic_family(nm),
+    ));
+    if let Ok(mut c) = cache.lock() {
+        c.insert(key, w.clone());
+    }
+    w
+}
 
 /// CIE XYZ → linear sRGB (D65 white), with the matrix of IEC 61966-2-1:1999 (sRGB), §5.2.
 /// Units are kept (XYZ in cd/m² → RGB in cd/m² scale); no clamping, no transfer function.
@@ -15,15 +39,38 @@ pub fn xyz_to_linear_srgb(xyz: [f64; 3]) -> [f64; 3] {
     M.map(|r| r[0] * x + r[1] * y + r[2] * z)
 }
 
-/// Spectral → colour: XYZ = M·L for a set of wavelength samples (the spectrum is linearly
-/// interpolated between samples, so the map is linear), then linear sRGB. Rows: X, Y, Z.
+/// Spectral → colour: XYZ = M·L for a set of wavelength samples, then linear sRGB. Rows:
+/// X, Y, Z. The weights M are fitted to sky-like spectra under the sun's spectrum
+/// ([`super::weights`]), so that three or sixteen samples give the luminance and colour a
+/// dense spectrum would; [`ColourMatrix::piecewise_linear`] keeps the plain reading of the
+/// samples as a piecewise-linear spectrum.
+#[derive(Clone, Debug)]
 pub struct ColourMatrix {
     xyz: Vec<[f64; 3]>,
 }
 
 impl ColourMatrix {
-    /// For these wavelengths.
+    /// For these wavelengths under the ASTM G173 sun, fitted to the generic family of sky
+    /// spectra ([`super::weights::generic_family`]); cached per wavelength list. An
+    /// atmosphere's own matrix (its sun, its constituents' skies) is
+    /// `Model::colour_matrix`.
     pub fn new(wavelengths_nm: &[f64]) -> ColourMatrix {
+        ColourMatrix {
+            xyz: generic_weights(wavelengths_nm).as_ref().clone(),
+        }
+    }
+
+    /// Fitted to `family` under `sun` ([`super::weights::fit_xyz_weights`]).
+    pub fn fitted(sun: &SolarShape, family: &[TrainingSpectrum]) -> ColourMatrix {
+        ColourMatrix {
+            xyz: fit_xyz_weights(sun, family),
+        }
+    }
+
+    /// The samples read as a spectrum linearly interpolated between them and held beyond the
+    /// ends ([`spectrum_to_xyz`]): exact for such spectra, a few % off for a sky from three
+    /// samples (docs/accuracy.md).
+    pub fn piecewise_linear(wavelengths_nm: &[f64]) -> ColourMatrix {
         let n = wavelengths_nm.len();
         let xyz = (0..n)
             .map(|k| {
@@ -33,6 +80,11 @@ impl ColourMatrix {
             })
             .collect();
         ColourMatrix { xyz }
+    }
+
+    /// The weights: `xyz()[k]` multiplies sample k.
+    pub fn xyz(&self) -> &[[f64; 3]] {
+        &self.xyz
     }
 
     /// CIE XYZ (Y in cd/m² for radiance in W·m⁻²·sr⁻¹·nm⁻¹).

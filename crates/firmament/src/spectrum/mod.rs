@@ -9,6 +9,7 @@ pub mod colour;
 pub mod gamut;
 mod rayleigh;
 pub(crate) mod table;
+pub mod weights;
 
 pub use colour::{xyz_to_linear_srgb, ColourMatrix};
 pub use rayleigh::{
@@ -37,8 +38,10 @@ pub fn check_channels(channels: usize, what: &str) -> Result<()> {
     Ok(())
 }
 
-/// Runs `f` with `K` zeroed per-channel scratch buffers of length `n` (≤ [`MAX_CHANNELS`])
-/// on the stack, each the smallest of 4, 16 or `MAX_CHANNELS` values that holds `n`: the
+/// Runs `f` with `K` zeroed per-channel scratch buffers of length `n` (≤ 2 ×
+/// [`MAX_CHANNELS`]: a caller may keep two values per channel, as the 4D view's Rayleigh and
+/// Mie pair) on the stack, each the smallest of 4, 16, `MAX_CHANNELS` or twice that which
+/// holds `n`: the
 /// evaluators call this per pixel, where zeroing 64-value arrays for three channels cost a
 /// fifth of a sky pixel.
 #[inline]
@@ -55,8 +58,10 @@ pub fn with_channel_buffers<const K: usize, R>(
         run::<4, K, R>(n, f)
     } else if n <= 16 {
         run::<16, K, R>(n, f)
-    } else {
+    } else if n <= MAX_CHANNELS {
         run::<MAX_CHANNELS, K, R>(n, f)
+    } else {
+        run::<{ 2 * MAX_CHANNELS }, K, R>(n, f)
     }
 }
 
@@ -245,9 +250,9 @@ pub fn ozone_cross_section_m2(lambda_nm: f64) -> f64 {
 /// 1-nm steps and multiplied by 683 lm/W. Spectral radiance in W·m⁻²·sr⁻¹·nm⁻¹ gives XYZ with Y
 /// the luminance in cd/m²; spectral irradiance in W·m⁻²·nm⁻¹ gives Y in lux.
 ///
-/// The 3-sample RGB mode (680, 550, 440 nm) gets its luminance the same way: its three
-/// radiances are read as a coarse spectrum (linear between 440, 550 and 680 nm, constant
-/// outside), which is an approximation, not a colorimetric RGB.
+/// This is exact for a piecewise-linear spectrum; for a sky sampled at a few wavelengths it is
+/// a few % off (docs/accuracy.md), and the colour of samples is [`ColourMatrix`]'s (fitted
+/// weights) everywhere in the program.
 ///
 /// Returns zeros for empty input; extra values beyond the shorter of the two slices are ignored.
 pub fn spectrum_to_xyz(wavelengths_nm: &[f64], values: &[f64]) -> [f64; 3] {
@@ -287,9 +292,14 @@ pub fn spectrum_to_xyz(wavelengths_nm: &[f64], values: &[f64]) -> [f64; 3] {
 }
 
 /// Luminance (cd/m²) of a spectral radiance (W·m⁻²·sr⁻¹·nm⁻¹), or illuminance (lx) of a spectral
-/// irradiance: the Y of [`spectrum_to_xyz`].
+/// irradiance, sampled at `wavelengths_nm`: the Y of the fitted weights of
+/// [`ColourMatrix::new`] (a sky-like spectrum under the ASTM G173 sun; the solar spectrum's
+/// own illuminance is its full 1-nm integral). Extra values beyond the shorter slice are
+/// ignored.
 pub fn luminance_from_spectrum(wavelengths_nm: &[f64], values: &[f64]) -> f64 {
-    spectrum_to_xyz(wavelengths_nm, values)[1]
+    let n = wavelengths_nm.len().min(values.len());
+    let w = colour::generic_weights(&wavelengths_nm[..n]);
+    w.iter().zip(values).map(|(w, v)| w[1] * v).sum()
 }
 
 #[cfg(test)]

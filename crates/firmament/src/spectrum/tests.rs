@@ -142,8 +142,47 @@ fn spectrum_to_xyz_interpolates_and_holds_ends() {
     }
     // Y of a flat 1 W·m⁻²·sr⁻¹·nm⁻¹ spectrum is 683 × Σȳ ≈ 683 × 106.857 cd/m² (CIE 1931 ȳ
     // sums to 106.857 over 360–830 nm at 1 nm, CIE 015:2018).
-    assert!(rel(luminance_from_spectrum(&[550.0], &[1.0]), 683.0 * 106.857) < 1e-4);
+    assert!(rel(spectrum_to_xyz(&[550.0], &[1.0])[1], 683.0 * 106.857) < 1e-4);
     assert_eq!(spectrum_to_xyz(&[], &[]), [0.0; 3]);
+}
+
+/// The fitted weights read samples as a sky-like spectrum under the sun: the sun's own
+/// samples give the illuminance of the full ASTM G173 spectrum (1-nm sum against ȳ), from
+/// one, three or sixteen samples, and a Rayleigh sky (λ⁻⁴ times the sun) its own exact
+/// luminance within 0.5 % (three samples) or 0.1 % (sixteen).
+#[test]
+fn fitted_weights_read_sky_like_spectra() {
+    let full: f64 = weights::grid_nm()
+        .map(|l| solar_irradiance_astm_g173(l) * cie_1931_2deg(l)[1])
+        .sum::<f64>()
+        * LUMINOUS_EFFICACY_LM_W;
+    let rayleigh: f64 = weights::grid_nm()
+        .map(|l| solar_irradiance_astm_g173(l) * (l / 550.0).powi(-4) * cie_1931_2deg(l)[1])
+        .sum::<f64>()
+        * LUMINOUS_EFFICACY_LM_W;
+    for w in [
+        Wavelengths::from_list(&[550.0]).unwrap(),
+        Wavelengths::rgb(),
+        Wavelengths::spectral(),
+    ] {
+        let nm = w.nm();
+        let sun = w.solar_irradiance_w_m2_nm();
+        assert!(
+            rel(luminance_from_spectrum(nm, &sun), full) < 1e-4,
+            "{nm:?}"
+        );
+        if nm.len() > 1 {
+            let sky: Vec<f64> = sun
+                .iter()
+                .zip(nm)
+                .map(|(e, l)| e * (l / 550.0).powi(-4))
+                .collect();
+            let y = luminance_from_spectrum(nm, &sky);
+            // Measured: rgb +0.23 %, spectral < 0.01 %.
+            let tolerance = if nm.len() < 8 { 5e-3 } else { 1e-3 };
+            assert!(rel(y, rayleigh) < tolerance, "{nm:?}: {y} vs {rayleigh}");
+        }
+    }
 }
 
 #[test]
@@ -185,4 +224,17 @@ fn wavelengths_presets_and_parsing() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("wavelengths[1]"), "{e}");
+}
+
+/// Two values per channel for the most channels (the 4D view's Rayleigh and Mie pair).
+#[test]
+fn channel_buffers_hold_two_values_per_channel() {
+    for n in [1, 3, 16, 40, MAX_CHANNELS, 2 * MAX_CHANNELS] {
+        let len = with_channel_buffers(n, |[a, b]| {
+            a.fill(1.0);
+            b.fill(2.0);
+            a.len() + b.len()
+        });
+        assert_eq!(len, 2 * n);
+    }
 }
