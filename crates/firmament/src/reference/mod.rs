@@ -14,7 +14,10 @@
 //! absorption by weighting with the single-scattering albedo, Russian roulette after
 //! [`ReferenceSettings::roulette_after`] events; next-event estimation towards a point
 //! drawn on the sun disk (limb darkening as in the model) with a deterministically
-//! integrated transmittance (0 behind the planet). See [`tracer`] for the details.
+//! integrated transmittance (0 behind the planet); by default (`lit_sampling`) that NEE is
+//! made along each flight, at a point drawn ∝ its sunlit single scattering, rather than at
+//! the flight's collision, which keeps twilight as cheap as daylight. See [`tracer`] for
+//! the details.
 //!
 //! Meaning of the results (same as [`crate::sky::SkyView::sky_radiance`]): the radiance that
 //! reaches the camera along the view ray *after at least one scattering in the air*: the
@@ -40,6 +43,7 @@ mod settings;
 pub mod tracer;
 
 use std::f64::consts::PI;
+use std::sync::OnceLock;
 
 use rayon::prelude::*;
 
@@ -104,16 +108,16 @@ fn radiance_pixel(
     };
     let frame = Frame::below(start, model.bottom_radius_m);
     let o = frame.offset(start);
-    let primaries: Vec<tracer::Primary> = (0..n)
-        .map(|k| {
-            Channel::new(model, volumes, surfaces, k, settings).primary(
-                &frame,
-                o,
-                view,
-                tracer::PRIMARY_INTERVALS,
-            )
+    // Built on first use by the sampler's own channel (with its sun table), once per
+    // wavelength.
+    let primaries: Vec<OnceLock<tracer::Primary>> = (0..n).map(|_| OnceLock::new()).collect();
+    let primary = |ch: &Channel| -> &tracer::Primary {
+        primaries[ch.index()].get_or_init(|| {
+            let mut p = ch.primary(&frame, o, view, tracer::PRIMARY_INTERVALS);
+            ch.primary_line(&frame, &mut p, sun);
+            p
         })
-        .collect();
+    };
     let stats = estimate::<1, _>(
         model,
         volumes,
@@ -124,7 +128,7 @@ fn radiance_pixel(
         |ch, rng, scratch| {
             [ch.radiance_sample(
                 &frame,
-                &primaries[ch.index()],
+                primary(ch),
                 sun,
                 settings.include_ground,
                 rng,

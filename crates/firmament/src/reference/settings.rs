@@ -24,6 +24,12 @@ pub struct ReferenceSettings {
     /// closest approach and the altitudes where a profile has a kink; half as many on the
     /// pieces away from the lowest point) for the next-event transmittance.
     pub transmittance_segments: usize,
+    /// Next-event estimation along each flight rather than at its collision: the point
+    /// that receives sunlight is drawn along the whole flight in proportion to an estimate
+    /// of its sunlit single scattering (see `reference::tracer::lit`), so the parts of the
+    /// air in the planet's shadow cost nothing. Unbiased either way; it is what makes
+    /// twilight affordable. Without volumes only (with volumes the collisions' NEE is used).
+    pub lit_sampling: bool,
 }
 
 impl Default for ReferenceSettings {
@@ -35,6 +41,7 @@ impl Default for ReferenceSettings {
             roulette_after: 5,
             include_ground: false,
             transmittance_segments: 6,
+            lit_sampling: true,
         }
     }
 }

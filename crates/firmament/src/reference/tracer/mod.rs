@@ -26,6 +26,11 @@
 //! planet's shadow at twilight come out right). Light that reaches the sun by phase
 //! sampling is not counted (no double counting; the sun disk itself is never seen).
 //!
+//! Twilight sampling (`lit`, on by default without volumes): the NEE of each flight's
+//! collision is replaced by one along the whole flight, its point drawn ∝ an estimate of
+//! the sunlit single scattering there (a coarse table of the sun's optical depth,
+//! `sun_table`, gives the shape), so the air in the planet's shadow costs nothing.
+//!
 //! Surfaces. Besides the analytic ground sphere (the model's albedo), a flight ends at the
 //! nearest of the scene's surfaces inside the atmosphere, where the path is reflected as
 //! at the ground: Lambertian with the surface's albedo about the hit's normal, NEE with
@@ -33,14 +38,20 @@
 
 mod free_path;
 pub(crate) mod geometry;
+mod guide;
+mod lit;
 mod optical_depth;
 mod paths;
+mod sun_table;
 mod surfaces;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod twilight_tests;
 mod volumes;
 
 use std::f64::consts::PI;
+use std::sync::OnceLock;
 
 use super::rng::Rng;
 use super::ReferenceSettings;
@@ -51,6 +62,8 @@ use crate::scene::light::{disk_solid_angle_weighted, limb_darkening};
 use crate::scene::{Surface, SurfaceHit, Volume};
 use geometry::rotate;
 pub(crate) use geometry::{cosine_direction, Frame};
+use lit::LitLine;
+use sun_table::SunTable;
 
 /// One constituent at one wavelength.
 struct Part<'a> {
@@ -97,6 +110,10 @@ pub(crate) struct Channel<'a> {
     surfaces: &'a [Box<dyn Surface + 'a>],
     /// Wavelengths of the model (the volumes' coefficients come for all at once).
     channels: usize,
+    /// [`ReferenceSettings::lit_sampling`].
+    lit_sampling: bool,
+    /// The sun's optical depth for twilight sampling's pdfs, built on first use.
+    sun_table: OnceLock<SunTable>,
 }
 
 /// Graded intervals per monotone piece of a camera ray in [`Primary`].
@@ -111,6 +128,8 @@ pub(crate) struct Primary {
     tau: Vec<f64>,
     t_end: f64,
     end: End,
+    /// The distance pdf of twilight sampling along the ray (see `lit`), when built.
+    lit: Option<LitLine>,
 }
 
 /// Where a flight leaves the air.
@@ -138,6 +157,8 @@ pub(crate) struct Scratch {
     pub(crate) scattering: Vec<f64>,
     /// Per-channel buffer for `Surface::albedo`.
     pub(crate) albedo: Vec<f64>,
+    /// A flight's distance pdf under twilight sampling.
+    pub(crate) line: LitLine,
 }
 
 impl<'a> Channel<'a> {
@@ -214,7 +235,14 @@ impl<'a> Channel<'a> {
             volumes,
             surfaces,
             channels: model.channels(),
+            lit_sampling: settings.lit_sampling,
+            sun_table: OnceLock::new(),
         }
+    }
+
+    /// The sun's optical-depth table (built on first use, shared by the threads).
+    pub(super) fn sun_table(&self) -> &SunTable {
+        self.sun_table.get_or_init(|| SunTable::new(self))
     }
 
     /// Wavelength index.
@@ -230,6 +258,7 @@ impl<'a> Channel<'a> {
             extinction: vec![0.0; self.channels],
             scattering: vec![0.0; self.channels],
             albedo: vec![0.0; self.channels],
+            line: LitLine::default(),
         }
     }
 

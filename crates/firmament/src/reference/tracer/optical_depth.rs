@@ -168,6 +168,7 @@ impl Channel<'_> {
             tau,
             t_end,
             end,
+            lit: None,
         }
     }
 }

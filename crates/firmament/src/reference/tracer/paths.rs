@@ -1,6 +1,7 @@
 //! The paths: camera rays with a forced first collision, then delta tracking with
-//! next-event estimation towards the sun at every collision and reflection (on the ground
-//! sphere or a surface); photons from the sun for the flux budget.
+//! next-event estimation towards the sun at every collision (or, under twilight sampling,
+//! along every flight: `lit`) and reflection (on the ground sphere or a surface); photons
+//! from the sun for the flux budget.
 
 use std::f64::consts::PI;
 
@@ -44,7 +45,11 @@ impl Channel<'_> {
                 scratch,
             );
         }
+        let lit = self.lit();
         let mut radiance = 0.0;
+        if lit {
+            radiance += self.primary_estimate(frame, primary, sun, rng, scratch);
+        }
         let tau_l = *primary.tau.last().unwrap();
         if tau_l > 0.0 {
             let escape = (-tau_l).exp();
@@ -66,7 +71,11 @@ impl Channel<'_> {
                 let (_, ss) = self.coefficients(frame, o, self.alt(x0, b, t), scratch);
                 if ss > 0.0 {
                     let w = ss * (1.0 - escape) / mean_sigma;
-                    radiance += self.after_collision(frame, o, primary.d, w, ss, sun, rng, scratch);
+                    radiance += if lit {
+                        self.after_lit_collision(frame, o, primary.d, w, ss, sun, rng, scratch)
+                    } else {
+                        self.after_collision(frame, o, primary.d, w, ss, sun, rng, scratch)
+                    };
                 }
             }
         }
@@ -186,7 +195,30 @@ impl Channel<'_> {
         radiance + self.trace(frame, o, d, w, events, sun, rng, scratch)
     }
 
-    /// The path from `o` along `d` with weight `w` after `events` events (delta tracking).
+    /// A real collision at `o` under twilight sampling (see `lit`): its light came with
+    /// the flight's estimate, so no NEE; the rest of the path.
+    #[allow(clippy::too_many_arguments)]
+    fn after_lit_collision(
+        &self,
+        frame: &Frame,
+        o: Vec3,
+        d: Vec3,
+        mut w: f64,
+        ss: f64,
+        sun: Vec3,
+        rng: &mut Rng,
+        scratch: &mut Scratch,
+    ) -> f64 {
+        let events = 1;
+        if events >= self.max_bounces || !self.roulette(events, &mut w, rng) {
+            return 0.0;
+        }
+        let d = self.guided_scatter(frame, o, d, scratch, ss, sun, &mut w, rng);
+        self.trace(frame, o, d, w, events, sun, rng, scratch)
+    }
+
+    /// The path from `o` along `d` with weight `w` after `events` events (delta tracking;
+    /// under twilight sampling each flight's estimate replaces the NEE at its collision).
     pub(super) fn trace(
         &self,
         frame: &Frame,
@@ -198,11 +230,15 @@ impl Channel<'_> {
         rng: &mut Rng,
         scratch: &mut Scratch,
     ) -> f64 {
+        let lit = self.lit();
         let mut radiance = 0.0;
         loop {
             let x0 = frame.x(o);
             let b = frame.b(o, d);
             let (t_end, end) = self.flight(frame, o, d, x0, b);
+            if lit {
+                radiance += w * self.flight_estimate(frame, o, d, t_end, sun, rng, scratch);
+            }
             if let Some(t) = self.collide(frame, o, d, t_end, rng, scratch) {
                 o = advance(o, t, d);
                 let h = self.alt(x0, b, t);
@@ -212,15 +248,21 @@ impl Channel<'_> {
                 }
                 w *= ss / st;
                 events += 1;
-                let (ls, e) = self.sample_sun(sun, rng);
-                let tr = self.transmittance(frame, o, ls);
-                if tr > 0.0 {
-                    radiance += w * self.phase(scratch, ss, d.dot(ls)) * tr * e;
+                if !lit {
+                    let (ls, e) = self.sample_sun(sun, rng);
+                    let tr = self.transmittance(frame, o, ls);
+                    if tr > 0.0 {
+                        radiance += w * self.phase(scratch, ss, d.dot(ls)) * tr * e;
+                    }
                 }
                 if events >= self.max_bounces || !self.roulette(events, &mut w, rng) {
                     break;
                 }
-                d = self.scatter(d, scratch, ss, rng);
+                d = if lit {
+                    self.guided_scatter(frame, o, d, scratch, ss, sun, &mut w, rng)
+                } else {
+                    self.scatter(d, scratch, ss, rng)
+                };
             } else {
                 let Some((p, n, albedo)) = self.reflection(frame, o, d, t_end, &end, scratch)
                 else {
