@@ -12,7 +12,11 @@ use crate::sky::bruneton4d::table::Table4;
 /// the dominant eigenvalue of the scattering-plus-ground-reflection operator and their
 /// shape to its eigenfunction (the diffuse light of high orders; Hillaire 2020's
 /// 1/(1 − f_ms) is the isotropic, single-number form of the same series). None below 3
-/// orders (the single-scattering field is far from that shape). q is capped at 0.95.
+/// orders (the single-scattering field is far from that shape). q is capped at 0.95, and
+/// a channel whose orders do not decrease (q ≥ 1) gets no tail: that is no convergent
+/// series (a physical one decreases, light leaving through the top and into the ground), and
+/// its 0.95 cap would have multiplied the last order by 19 (with 10¹² DU of ozone the orders
+/// grew from numerical leaks and the sky at 440 nm read above the sun outside the air).
 ///
 /// Measured when introduced (`validate`, earth, altitudes 0 and 1 km, sun 60° and 10°, 398
 /// views, reference at 1 %): 4 orders + tail give a luminance bias of +0.36 % and 440 nm
@@ -27,7 +31,7 @@ pub fn order_tail_factors(order_means: &[Vec<f64>]) -> Option<Vec<f64>> {
         last.iter()
             .zip(before)
             .map(|(&l, &b)| {
-                let q = if b > 0.0 && l > 0.0 {
+                let q = if b > 0.0 && l > 0.0 && l < b {
                     (l / b).min(0.95)
                 } else {
                     0.0
@@ -82,4 +86,20 @@ pub(super) fn table_mean(t: &Table4) -> Vec<f64> {
     }
     let count = (t.data.len() / n) as f64;
     sum.iter().map(|v| v / count).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::order_tail_factors;
+
+    #[test]
+    fn orders_that_do_not_decrease_get_no_tail() {
+        let means = [vec![4.0, 4.0], vec![2.0, 1.0], vec![1.0, 1.5]];
+        let f = order_tail_factors(&means).unwrap();
+        assert!(
+            (f[0] - 1.0).abs() < 1e-12,
+            "q = 1/2 gives q/(1 − q) = 1: {f:?}"
+        );
+        assert_eq!(f[1], 0.0, "q = 1.5 is no convergent series");
+    }
 }
