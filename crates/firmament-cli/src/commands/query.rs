@@ -3,7 +3,6 @@
 use anyhow::Result;
 use clap::Args;
 use firmament::astro::Sky;
-use firmament::atmosphere::limits;
 use firmament::math::{direction_from_zenith_azimuth, Vec3};
 use firmament::reference::{self, ReferenceSettings};
 use firmament::scene::sky_lights::{sources_of, SkySources};
@@ -313,13 +312,9 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
         notes.extend(m);
     }
     // What the tables approximate here (with `--method reference` the transmittance and
-    // irradiance still come from them).
+    // irradiance still come from them): a sun below their lowest.
     let mu_s = camera.normalize().dot(sun);
-    notes.extend(
-        (lut::twilight::note(model.mu_s_min, mu_s).into_iter())
-            .chain(limits::thick_shell_note(&model.atmosphere))
-            .map(|s| json!(s)),
-    );
+    notes.extend(lut::twilight::note(model.mu_s_min, mu_s).map(|s| json!(s)));
     let method = match &reference {
         None => "bruneton4d (precomputed tables)",
         Some(_) => {

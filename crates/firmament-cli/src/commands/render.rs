@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use firmament::atmosphere::{limits, Model};
+use firmament::atmosphere::Model;
 use firmament::io::OutputFormat;
 use firmament::render::{self, tonemap, RenderSettings};
 use firmament::scene::sky_lights::{sources_of, SkySources};
@@ -68,17 +68,14 @@ pub fn sources_of_scene(model: &Model, scene: &Scene) -> Result<SkySources> {
     })
 }
 
-/// Notes on what the tables approximate in this scene: the sun below their lowest sun (the
-/// twilight extrapolated, `twilight::note`) and a shell thick for the air (`limits`).
+/// A note when the sun is below the tables' lowest sun (the twilight extrapolated,
+/// `twilight::note`).
 fn approximation_notes(model: &Model, scene: &Scene) -> Result<()> {
     let zenith_deg = match scene.astro()? {
         Some(sky) => sky.sun.apparent_zenith_deg,
         None => scene.sun.zenith_deg,
     };
-    let notes = twilight::note(model.mu_s_min, zenith_deg.to_radians().cos())
-        .into_iter()
-        .chain(limits::thick_shell_note(&model.atmosphere));
-    for note in notes {
+    if let Some(note) = twilight::note(model.mu_s_min, zenith_deg.to_radians().cos()) {
         eprintln!("note: {note}");
     }
     Ok(())

@@ -4,7 +4,7 @@
 
 use super::ScatteringGrid;
 use crate::atmosphere::ScatteringGroups;
-use crate::sky::bruneton4d::table::Table4;
+use crate::sky::bruneton4d::table::{Table2, Table4};
 
 /// Factors q/(1 − q) per channel for the orders beyond the last computed one, N: with
 /// q = mean(ΔS_N)/mean(ΔS_{N−1}) (`order_means`), the orders N+1, N+2, … are taken as
@@ -40,6 +40,26 @@ pub fn order_tail_factors(order_means: &[Vec<f64>]) -> Option<Vec<f64>> {
             })
             .collect(),
     )
+}
+
+/// Caps the tail factors `f` so that no texel of the sky's irradiance, `irradiance` (the
+/// orders computed) plus f·`last` (the last order's), passes the sun's irradiance outside
+/// the air, `solar`: no surface under the sky receives more than the sun delivers to one
+/// facing it (with no source in the air, the downward flux at any level is at most the
+/// incident one; Chandrasekhar 1960, *Radiative Transfer*, §8). The table-mean ratio of the
+/// orders can exceed the irradiance's own: Earth's air with a white ground and a haze of
+/// τ ≈ 0.9 under a 160 km top read q ≈ 0.95 and a sky of 4.9 W·m⁻²·nm⁻¹ at 550 nm after
+/// the tail, 0.93 before it, 1.41 with eight orders, the sun outside 1.87.
+pub(super) fn cap_by_energy(f: &mut [f64], irradiance: &Table2, last: &Table2, solar: &[f64]) {
+    let n = f.len();
+    for (sum, delta) in irradiance.data.chunks(n).zip(last.data.chunks(n)) {
+        for k in 0..n {
+            let room = (solar[k] - sum[k] as f64).max(0.0);
+            if delta[k] > 0.0 {
+                f[k] = f[k].min(room / delta[k] as f64);
+            }
+        }
+    }
 }
 
 /// a += b·f[channel], channels innermost.
