@@ -56,19 +56,15 @@ pub struct AtmosphereArgs {
     /// `~/.cache/firmament`, at most `$FIRMAMENT_CACHE_LIMIT_MB` MiB (default 2048).
     #[arg(long)]
     pub no_cache: bool,
-    /// Scattering orders to precompute when no --tables are given.
-    #[arg(long, default_value_t = 4)]
-    pub orders: usize,
+    /// Scattering orders and their tail, when no --tables are given.
+    #[command(flatten)]
+    pub order_args: OrderArgs,
     /// Table sizes when no --tables are given: `default` (Bruneton 2017's sizes) or `small` (fast, coarse).
     #[arg(long, default_value = "default", value_name = "default|small")]
     pub table_size: String,
     /// Store single Mie scattering for every wavelength (`separate`) or only the first (`red-only`, ratio rule).
     #[arg(long, default_value = "separate", value_name = "separate|red-only")]
     pub mie: String,
-    /// Without the geometric tail of the orders beyond --orders (by default added from the
-    /// ratio of the last two orders when --orders ≥ 3): the plain truncated sum.
-    #[arg(long = "no-order-tail", action = clap::ArgAction::SetFalse)]
-    pub order_tail: bool,
     /// The ground's albedo per wavelength in place of the atmosphere's (a scene's terrain
     /// sets it to its own mean, so the tables' ground bounce is the terrain's).
     #[arg(skip)]
@@ -78,6 +74,20 @@ pub struct AtmosphereArgs {
     /// tables' light comes from the air that the terrain leaves.
     #[arg(skip)]
     pub ground_lift_m: Option<f64>,
+}
+
+/// The orders of scattering computed tables sum (`query`, `bake`, `render`, through
+/// [`AtmosphereArgs`]); refused with --tables, whose file fixes them.
+#[derive(Args, Debug, Clone, Copy)]
+pub struct OrderArgs {
+    /// Scattering orders to precompute (not with --tables: the file's are used).
+    #[arg(long, default_value_t = 4, conflicts_with = "tables")]
+    pub orders: usize,
+    /// Without the geometric tail of the orders beyond --orders (by default added from the
+    /// ratio of the last two orders when --orders ≥ 3): the plain truncated sum (not with
+    /// --tables).
+    #[arg(long = "no-order-tail", action = clap::ArgAction::SetFalse, conflicts_with = "tables")]
+    pub order_tail: bool,
 }
 
 impl Default for AtmosphereArgs {
@@ -154,9 +164,9 @@ impl AtmosphereArgs {
         };
         let config = TableConfig {
             sizes,
-            orders: self.orders,
+            orders: self.order_args.orders,
             mie,
-            order_tail: self.order_tail,
+            order_tail: self.order_args.order_tail,
         };
         config.validate()?;
         Ok(config)

@@ -159,6 +159,11 @@ fn bad_atmosphere_files_are_refused_with_the_field() {
             vec!["ground_albedo", "[0, 1]"],
         ),
         (
+            "top_radius_m = 6420000.0",
+            "top_radius_m = 1e12",
+            vec!["top_radius_m", "at most bottom_radius_m + 200", "'mie'"],
+        ),
+        (
             "g = 0.76 }",
             "g = -1.0 }",
             vec!["constituents[1].phase.g", "-1"],
@@ -422,4 +427,22 @@ fn no_order_tail_bakes_the_truncated_sum() {
         without < with_tail && without > 0.95 * with_tail,
         "zenith luminance {without} without the tail, {with_tail} with"
     );
+}
+
+#[test]
+fn orders_with_tables_are_refused_not_ignored() {
+    // The file fixes its orders: `--orders` and `--no-order-tail` with it are refused.
+    let t = tables().to_str().unwrap();
+    let out = tmp().join("orders-refused.png");
+    let out = out.to_str().unwrap();
+    for flag in [&["--orders", "6"][..], &["--no-order-tail"][..]] {
+        let mut args = vec!["render", "--tables", t, "--out", out];
+        args.extend_from_slice(flag);
+        fails_with(&run(&args), &[flag[0], "--tables"]);
+        let mut args = vec!["query", "--tables", t, "--altitude-m", "0"];
+        args.extend_from_slice(&["--sun-zenith-deg", "30"]);
+        args.extend_from_slice(flag);
+        fails_with(&run(&args), &[flag[0], "--tables"]);
+    }
+    assert!(!Path::new(out).exists());
 }

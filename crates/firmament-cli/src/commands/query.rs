@@ -7,6 +7,7 @@ use firmament::math::{direction_from_zenith_azimuth, Vec3};
 use firmament::reference::{self, ReferenceSettings};
 use firmament::scene::sky_lights::{sources_of, SkySources};
 use firmament::scene::sun_direction;
+use firmament::sky::bruneton4d as lut;
 use firmament::sky::{Shadow, SkyMethod, SkyView};
 use firmament::spectrum::{xyz_to_linear_srgb, ColourMatrix};
 use serde::Serialize;
@@ -314,6 +315,10 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
     if let serde_json::Value::Array(m) = method_notes {
         notes.extend(m);
     }
+    // What the tables approximate here (with `--method reference` the transmittance and
+    // irradiance still come from them): a sun below their lowest.
+    let mu_s = camera.normalize().dot(sun);
+    notes.extend(lut::twilight::note(model.mu_s_min, mu_s).map(|s| json!(s)));
     let method = match &reference {
         None => "bruneton4d (precomputed tables)",
         Some(_) => {

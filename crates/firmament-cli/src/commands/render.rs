@@ -10,6 +10,7 @@ use firmament::render::{self, tonemap, RenderSettings};
 use firmament::scene::sky_lights::{sources_of, SkySources};
 use firmament::scene::terrain::Heightfield;
 use firmament::scene::{sun_direction, Projection, SceneFile as Scene};
+use firmament::sky::bruneton4d::twilight;
 
 use crate::backend::{Backend, BackendChoice, RenderSky};
 use crate::commands::lamps::{lamps, MapFrame};
@@ -67,17 +68,15 @@ pub fn sources_of_scene(model: &Model, scene: &Scene) -> Result<SkySources> {
     })
 }
 
-/// A note when the date's sun is in the twilight the tables do not hold (below their lowest
-/// sun, above −18°): that sky is missing from the picture.
-fn twilight_note(model: &Model, scene: &Scene) -> Result<()> {
-    if let Some(sky) = scene.astro()? {
-        let elevation = 90.0 - sky.sun.apparent_zenith_deg;
-        let lowest = 90.0 - model.mu_s_min.acos().to_degrees();
-        if elevation < lowest && elevation > -18.0 {
-            eprintln!(
-                "note: the sun is {elevation:.1}° high, below the lowest sun of these tables ({lowest:.0}°): the last twilight is left out; an atmosphere with min_sun_elevation_deg = -18 keeps it (docs/accuracy.md)"
-            );
-        }
+/// A note when the sun is below the tables' lowest sun (the twilight extrapolated,
+/// `twilight::note`).
+fn approximation_notes(model: &Model, scene: &Scene) -> Result<()> {
+    let zenith_deg = match scene.astro()? {
+        Some(sky) => sky.sun.apparent_zenith_deg,
+        None => scene.sun.zenith_deg,
+    };
+    if let Some(note) = twilight::note(model.mu_s_min, zenith_deg.to_radians().cos()) {
+        eprintln!("note: {note}");
     }
     Ok(())
 }
@@ -260,13 +259,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
         backend => backend,
     };
-    let (terrain, atmosphere) = terrain_and_atmosphere(
+    let (terrain, mut atmosphere) = terrain_and_atmosphere(
         &scene,
         args.tables.clone(),
         &args.table_size,
         args.no_cache,
         args.quiet,
     )?;
+    atmosphere.order_args = args.order_args;
     print_wavelengths(&atmosphere.model()?, args.quiet);
     let t = Instant::now();
     let sky = RenderSky::new(&backend, &atmosphere, args.quiet)?;
@@ -282,7 +282,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
     }
     if !args.quiet && times.is_none() {
-        twilight_note(sky.model(), &scene)?;
+        approximation_notes(sky.model(), &scene)?;
     }
     if let Some(times) = times {
         let t = Instant::now();

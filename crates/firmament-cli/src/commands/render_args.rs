@@ -11,6 +11,7 @@ use firmament::scene::{Projection, SceneFile as Scene};
 
 use crate::backend::BackendChoice;
 use crate::commands::astro::AstroArgs;
+use crate::common::OrderArgs;
 
 /// Arguments of `firmament render`; flags override the scene file, which overrides the
 /// built-in default scene.
@@ -118,6 +119,9 @@ pub struct RenderArgs {
     /// Table sizes when computing: default or small.
     #[arg(long, default_value = "default", value_name = "default|small")]
     pub table_size: String,
+    /// Scattering orders and their tail when computing (as `bake` and `query`).
+    #[command(flatten)]
+    pub order_args: OrderArgs,
     /// Exposure value at ISO 100 (PNG only) [default: automatic, as a camera's meter].
     #[arg(long, allow_hyphen_values = true, conflicts_with = "auto_exposure")]
     pub ev100: Option<f64>,

@@ -23,10 +23,11 @@ fn transmittance_to_top(r_km: f32, rho_km: f32, mu: f32, k: u32) -> vec4<f32> {
     return exp(-optical_depth_to_top(r_km, rho_km, mu, k));
 }
 
-// e^{−(τ_a − τ_b)} for the optical depths to the top from a ray's two ends, 0 where the far
+// e^{−(τ_a − τ_b)} for the optical depths to the top from a ray's two ends, 0 where either
 // end's τ stands for T = 0 (Lookup::transmittance).
 fn transmittance_between(tau_a: vec4<f32>, tau_b: vec4<f32>) -> vec4<f32> {
-    return select(vec4<f32>(0.0), exp(-max(tau_a - tau_b, vec4<f32>(0.0))), tau_b < vec4<f32>(MAX_OPTICAL_DEPTH));
+    let finite = tau_a < vec4<f32>(MAX_OPTICAL_DEPTH) & tau_b < vec4<f32>(MAX_OPTICAL_DEPTH);
+    return select(vec4<f32>(0.0), exp(-max(tau_a - tau_b, vec4<f32>(0.0))), finite);
 }
 
 // Transmittance over d km from (r, μ), from differences of table optical depths; the

@@ -4,6 +4,7 @@
 
 pub mod groups;
 mod lift;
+pub mod limits;
 pub mod model;
 pub mod presets;
 mod sky_spectra;
@@ -94,7 +95,8 @@ pub struct Atmosphere {
     /// Lambertian ground albedo in [0, 1].
     pub ground_albedo: Albedo,
     /// Lowest sun elevation (degrees) the scattering tables cover (Bruneton 2017's
-    /// `mu_s_min`); the sun lower than this contributes nothing to the tables.
+    /// `mu_s_min`); below it the sky the sun lights is extrapolated from the tables' last
+    /// rows (`Bruneton4dView`'s twilight fade).
     pub min_sun_elevation_deg: f64,
     /// The sun.
     pub sun: Sun,
@@ -226,7 +228,7 @@ impl Atmosphere {
         for (i, c) in self.constituents.iter().enumerate() {
             c.validate(&format!("constituents[{i}]"))?;
         }
-        Ok(())
+        limits::check_shell(self)
     }
 
     /// Resolve for a wavelength grid.

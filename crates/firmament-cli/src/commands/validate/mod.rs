@@ -41,7 +41,7 @@ use firmament::spectrum::ColourMatrix;
 use serde_json::{json, Value};
 
 use crate::common::{
-    check_output_dir, check_range, check_reference_samples, progress_bar, AtmosphereArgs,
+    check_output_dir, check_range, check_reference_samples, progress_bar, AtmosphereArgs, OrderArgs,
 };
 use compare::{compare_tables, ViewRecord};
 use sampling::{trace_views, SamplePlan, PILOT_SAMPLES};
@@ -210,9 +210,11 @@ impl Selection {
         AtmosphereArgs {
             preset: Some(preset.to_string()),
             wavelengths: Some(self.wavelengths.clone()),
-            orders,
+            order_args: OrderArgs {
+                orders,
+                order_tail: self.order_tail,
+            },
             table_size: self.table_size.clone(),
-            order_tail: self.order_tail,
             ..AtmosphereArgs::default()
         }
     }

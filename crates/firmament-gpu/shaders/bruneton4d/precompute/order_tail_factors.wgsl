@@ -1,7 +1,8 @@
 // Factors q/(1 − q) of the geometric tail of the orders beyond the last one, N (Rust twin
 // precompute/order_tail.rs, `order_tail_factors`): q = Σ ΔS_N / Σ ΔS_{N−1} per channel over
 // the order row sums (order_sums.wgsl, read at slot a), capped at 0.95; 0 where either sum
-// is 0. N is the pass order. One invocation per channel group.
+// is 0 or the orders do not decrease (no convergent series to extrapolate). N is the pass
+// order. One invocation per channel group.
 
 @group(0) @binding(7) var<storage, read_write> tail_factors: array<vec4<f32>>;
 
@@ -19,7 +20,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         last += scattering_a[((n - 1u) * rows + row) * atm.groups + k];
         before += scattering_a[((n - 2u) * rows + row) * atm.groups + k];
     }
-    let valid = (before > vec4<f32>(0.0)) & (last > vec4<f32>(0.0));
+    let valid = (before > vec4<f32>(0.0)) & (last > vec4<f32>(0.0)) & (last < before);
     let q = select(vec4<f32>(0.0), min(last / before, vec4<f32>(0.95)), valid);
     tail_factors[k] = q / (1.0 - q);
 }

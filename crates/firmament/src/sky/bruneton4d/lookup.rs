@@ -68,8 +68,10 @@ impl<'a> Lookup<'a> {
 
     /// Transmittance over `d` metres from (r, μ), from differences of table optical depths
     /// (Bruneton 2017 `GetTransmittance` takes ratios of transmittances); uses the reversed
-    /// ray when it hits the ground. 0 where the far end's optical depth is the table's
-    /// stand-in for T = 0.
+    /// ray when it hits the ground. 0 where either end's optical depth is the table's
+    /// stand-in for T = 0: a difference of two capped depths means nothing (with 10¹² DU
+    /// of ozone the near end's τ of 3.6·10⁶, capped, less the far end's true 100 inside the
+    /// layer gave T = e⁻⁴ through the layer, and a sky brighter than the sun above it).
     #[inline]
     pub fn transmittance(&self, r: f64, mu: f64, d: f64, ground: bool, out: &mut [f64]) {
         let (r_d, mu_d) = advance(r, mu, d, self.radii.bottom, self.radii.top);
@@ -83,7 +85,7 @@ impl<'a> Lookup<'a> {
                 self.optical_depth_to_top(r_d, mu_d, b);
             }
             for (o, &b) in out.iter_mut().zip(b.iter()) {
-                *o = if b < MAX_OPTICAL_DEPTH as f64 {
+                *o = if *o < MAX_OPTICAL_DEPTH as f64 && b < MAX_OPTICAL_DEPTH as f64 {
                     (-(*o - b).max(0.0)).exp()
                 } else {
                     0.0

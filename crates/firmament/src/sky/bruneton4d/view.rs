@@ -10,7 +10,7 @@
 //! use the 4D tables.
 
 use super::lookup::Lookup;
-use super::{params, Bruneton4d, MieStorage};
+use super::{params, twilight, Bruneton4d, MieStorage};
 use crate::atmosphere::groups::{AEROSOLS, MOLECULES};
 use crate::math::sphere::{advance, distance_to_enter_sphere, ray_intersects_ground};
 use crate::math::{smoothstep, Vec3};
@@ -172,14 +172,6 @@ impl<'a> Bruneton4dView<'a> {
                 ((ray.r * ray.mu_s + d * ray.nu) / r_d).clamp(-1.0, 1.0),
             )
         };
-        // Below the tables' lowest sun (Bruneton 2017's μ_s,min) the light scatters
-        // nothing here: the tables end there, and clamping would give every deeper night
-        // the sky of the lowest tabulated sun.
-        if mu_s < sky.model.mu_s_min {
-            scat.iter_mut().for_each(|v| *v = 0.0);
-            mie.iter_mut().for_each(|v| *v = 0.0);
-            return;
-        }
         let at = with_channel_buffers(2 * n, |[both]| {
             let at = match self.slice.as_ref().filter(|_| at_start && ray.at_observer) {
                 Some(s) => {
@@ -217,18 +209,15 @@ impl<'a> Bruneton4dView<'a> {
             }
             at
         });
-        if orders == Orders::Multiple {
-            mie.iter_mut().for_each(|v| *v = 0.0);
-            return;
-        }
         let single_mie = &tables.single_mie;
         let sample = |out: &mut [f64]| match at {
             At::Slice(s, u_nu, u_mu) => single_mie.sample_slice_into(&s.mie, u_nu, u_mu, out),
             At::Table(uvwz) => single_mie.sample_into(uvwz, out),
         };
-        match tables.config.mie {
-            MieStorage::Separate => sample(mie),
-            MieStorage::RedOnly => {
+        match (orders, tables.config.mie) {
+            (Orders::Multiple, _) => mie.iter_mut().for_each(|v| *v = 0.0),
+            (_, MieStorage::Separate) => sample(mie),
+            (_, MieStorage::RedOnly) => {
                 let mut red = [0.0];
                 sample(&mut red);
                 for k in 0..n {
@@ -239,6 +228,18 @@ impl<'a> Bruneton4dView<'a> {
                     };
                 }
             }
+        }
+        // Below the tables' lowest sun (Bruneton 2017's μ_s,min) the lookups above read the
+        // μ_s,min row; the sky there falls on from it (`twilight`: clamping gave every
+        // deeper night the sky of the lowest tabulated sun, a cut to 0 a jump at μ_s,min).
+        if mu_s < sky.model.mu_s_min {
+            with_channel_buffers(n, |[fade]| {
+                twilight::fade(lk, &tables.irradiance, r, mu_s, fade);
+                for k in 0..n {
+                    scat[k] *= fade[k];
+                    mie[k] *= fade[k];
+                }
+            });
         }
     }
 
@@ -520,7 +521,7 @@ impl SkyView for Bruneton4dView<'_> {
         }
         let r = length.max(model.bottom_radius_m);
         let mu_s = (point.dot(light) / length).clamp(-1.0, 1.0);
-        lk.irradiance(&self.sky.tables.irradiance, r, mu_s, sky);
+        twilight::sky_irradiance(lk, &self.sky.tables.irradiance, r, mu_s, sky);
         let occlusion = (1.0 + normal.dot(point) / length) * 0.5;
         for (v, s) in sky[..n].iter_mut().zip(&self.scale) {
             *v *= occlusion * s;

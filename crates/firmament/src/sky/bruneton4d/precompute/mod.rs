@@ -34,7 +34,7 @@ pub(crate) use grid::{MuSPositions, ScatteringGrid};
 use indirect_irradiance::compute_indirect_irradiance;
 use multiple_scattering::compute_multiple_scattering;
 pub use order_tail::order_tail_factors;
-use order_tail::{add_scaled, table_mean, table_mean_radiance};
+use order_tail::{add_scaled, cap_by_energy, table_mean, table_mean_radiance};
 use phase_kernels::PhaseKernels;
 use scattering_density::compute_scattering_density;
 use single_scattering::compute_single_scattering;
@@ -151,7 +151,13 @@ pub fn precompute(
             multiple.add_assign(&delta_multiple);
         }
         if config.order_tail {
-            if let Some(f) = order_tail_factors(&order_means) {
+            if let Some(mut f) = order_tail_factors(&order_means) {
+                cap_by_energy(
+                    &mut f,
+                    &irradiance,
+                    &delta_irradiance,
+                    &model.solar_irradiance,
+                );
                 add_scaled(&mut multiple.data, &delta_multiple.data, &f);
                 add_scaled(&mut irradiance.data, &delta_irradiance.data, &f);
             }
