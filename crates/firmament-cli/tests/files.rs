@@ -86,7 +86,7 @@ fn exr_files_hold_no_negative_and_name_their_gamut() {
         }
     }
     // The sun's disk was outside Rec. 709: mapped there (a component at exactly 0 in its
-    // brightest pixels), inside Rec. 2020 as it is; the same light in every file.
+    // brightest pixels), kept in Rec. 2020 (below); the same light in every file.
     let image = firmament::io::read_exr(&rec709).unwrap();
     let brightest = (image.data.iter())
         .max_by(|a, b| a[0].total_cmp(&b[0]))
@@ -96,10 +96,13 @@ fn exr_files_hold_no_negative_and_name_their_gamut() {
         "the disk's blue is mapped to 0: {brightest:?}"
     );
     let wide = firmament::io::read_exr(&rec2020).unwrap();
+    // In Rec. 2020 the disk keeps its red and green; its blue sits on the gamut's red–green
+    // edge (the dense-spectrum truth of the sun's beam: +2 % of Y in Rec. 2020 blue at 1°
+    // elevation, −0.4 % at 0°; `examples/luminance_weights`), so it is mapped at most a hair.
     assert!(wide
         .data
         .iter()
-        .any(|p| p.iter().all(|&v| v > 0.0) && p[0] > 1e6));
+        .any(|p| p[0] > 1e6 && p[1] > 0.1 * p[0] && p[2] >= 0.0));
     // Rec. 2020 shares Rec. 709's white: Y is the same; ACEScg's white is the ACES one, and
     // the Bradford adaptation moves the luminance of saturated colours a little.
     let y709 = luminance(&image, Gamut::Rec709);

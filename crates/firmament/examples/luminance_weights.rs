@@ -20,6 +20,8 @@ use firmament::spectrum::{self, ColourMatrix, Wavelengths};
 struct Sky {
     sun_elevation_deg: f64,
     radiance: Vec<f64>,
+    /// The sun's beam (irradiance through the air) rather than the sky.
+    beam: bool,
 }
 
 /// The 48-wavelength skies of `atmosphere` on the grid starting at `first_nm`.
@@ -43,6 +45,20 @@ fn dense_skies(atmosphere: &Atmosphere, first_nm: f64) -> (Model, Vec<Sky>) {
                 direction_from_zenith_azimuth((90.0f64 - sun_elevation_deg).to_radians(), 0.0);
             let light = Light::sun(&model, sun, false);
             let view = sky.view(observer, &light);
+            if sun_elevation_deg >= 0.0 {
+                let (mut l, mut t) = (vec![0.0; n], vec![0.0; n]);
+                view.sky_radiance(sun, Shadow::None, &mut l, &mut t);
+                let beam: Vec<f64> = (t.iter().zip(&model.solar_irradiance))
+                    .map(|(t, e)| t * e)
+                    .collect();
+                if beam.iter().all(|v| *v > 0.0) {
+                    out.push(Sky {
+                        sun_elevation_deg,
+                        radiance: beam,
+                        beam: true,
+                    });
+                }
+            }
             for zenith_deg in (0..=12).map(|i| i as f64 * 15.0) {
                 for azimuth_deg in (0..8).map(|i| i as f64 * 45.0) {
                     let dir = direction_from_zenith_azimuth(
@@ -55,6 +71,7 @@ fn dense_skies(atmosphere: &Atmosphere, first_nm: f64) -> (Model, Vec<Sky>) {
                         out.push(Sky {
                             sun_elevation_deg,
                             radiance: l,
+                            beam: false,
                         });
                     }
                 }
@@ -119,8 +136,8 @@ fn main() {
     } else {
         args
     };
-    println!("| preset | mode | method | daylight (sun ≥ 5°): median / p95 / max ΔY · median Δu′v′ (10⁻³) | twilight (sun 2° to −6°) |");
-    println!("|---|---|---|---|---|");
+    println!("| preset | mode | method | sky, daylight (sun ≥ 5°): median / p95 / max ΔY · median Δu′v′ (10⁻³) | sky, twilight (sun 2° to −6°) | the sun's beam (sun 0° to 90°) |");
+    println!("|---|---|---|---|---|---|");
     for preset in &presets {
         let atmosphere = Atmosphere::preset(preset).unwrap();
         for (mode, first_nm, sparse) in [
@@ -140,22 +157,27 @@ fn main() {
                 ("model fit", sparse_model.colour_matrix()),
             ];
             for (name, matrix) in &methods {
-                let mut errors = [(Vec::new(), Vec::new()), (Vec::new(), Vec::new())];
+                let mut errors: [(Vec<f64>, Vec<f64>); 3] = Default::default();
                 for sky in &skies {
                     let samples: Vec<f64> = index.iter().map(|&i| sky.radiance[i]).collect();
                     let xyz = matrix.to_xyz(&samples);
                     let t = truth(&dense, &sky.radiance);
-                    let set = &mut errors[usize::from(sky.sun_elevation_deg < 5.0)];
+                    let set = &mut errors[if sky.beam {
+                        2
+                    } else {
+                        usize::from(sky.sun_elevation_deg < 5.0)
+                    }];
                     set.0.push((xyz[1] / t[1] - 1.0).abs());
                     let (a, b) = (uv(xyz), uv(t));
                     set.1
                         .push(((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt());
                 }
-                let [day, twilight] = errors;
+                let [day, twilight, beam] = errors;
                 println!(
-                    "| {preset} | {mode} | {name} | {} | {} |",
+                    "| {preset} | {mode} | {name} | {} | {} | {} |",
                     summary(day.0, day.1),
-                    summary(twilight.0, twilight.1)
+                    summary(twilight.0, twilight.1),
+                    summary(beam.0, beam.1)
                 );
             }
             let toa = |m: &ColourMatrix| m.to_xyz(&sparse_model.solar_irradiance)[1];

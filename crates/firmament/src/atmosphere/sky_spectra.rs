@@ -1,6 +1,6 @@
 //! An atmosphere's own colour weights: [`Model::colour_matrix`] fits the XYZ weights of the
 //! model's wavelength samples (`spectrum::weights`) to the generic family of sky-like
-//! spectra plus this atmosphere's single-scattering skies, computed at the sample
+//! spectra plus this atmosphere's single-scattering skies and the sun's beam through it, computed at the sample
 //! wavelengths and on a 10-nm grid, so that three samples of a sky whose constituents are
 //! known give its luminance and colour as a dense spectrum would (docs/accuracy.md,
 //! "Luminance from a few wavelengths").
@@ -74,6 +74,7 @@ impl Model {
                 .filter(|e| *e > 0.0 || self.channels() >= TWILIGHT_SAMPLES)
                 .collect();
             family.extend(single_scattering_skies(self, &dense, &elevations));
+            family.extend(direct_beams(self, &dense));
         }
         ColourMatrix::fitted(&self.solar_shape(), &family)
     }
@@ -175,6 +176,45 @@ fn single_scattering_skies(
                         });
                     }
                 }
+            }
+        }
+    }
+    out
+}
+
+/// Sun elevations (°) of the training beams: the sun's own disk, down to the horizon.
+const BEAM_ELEVATIONS_DEG: [f64; 9] = [0.5, 1.0, 2.0, 3.0, 5.0, 8.0, 15.0, 30.0, 90.0];
+
+/// The sun's beam through the air, `exp(−τ(λ))` to the top, from each training altitude:
+/// the disk's colour and the lights' colours (lamps) are read through the same weights.
+fn direct_beams(model: &Model, dense: &Model) -> Vec<TrainingSpectrum> {
+    let mut columns = vec![0.0; model.constituents.len()];
+    let mut out = Vec::new();
+    for &altitude in &ALTITUDES_M {
+        let r = model.bottom_radius_m + altitude.min(model.height_m() * 0.5);
+        // The low sun's deep red beam only where the samples can serve it (see elevations).
+        let low = model.channels() >= TWILIGHT_SAMPLES;
+        for &elevation in BEAM_ELEVATIONS_DEG.iter().filter(|e| low || **e >= 3.0) {
+            let mu_s = elevation.to_radians().sin();
+            let to_top = sphere::distance_to_top_atmosphere_boundary(r, mu_s, model.top_radius_m);
+            model.columns_along_ray(r, mu_s, to_top, 16, &mut columns);
+            let beam = |m: &Model| -> Vec<f64> {
+                (0..m.channels())
+                    .map(|k| {
+                        let tau: f64 = (m.constituents.iter().zip(&columns))
+                            .map(|(c, col)| col * c.extinction[k])
+                            .sum();
+                        (-tau).exp()
+                    })
+                    .collect()
+            };
+            let (sparse, dense_f) = (beam(model), beam(dense));
+            if sparse.iter().all(|v| *v > 0.0) && dense_f.iter().all(|v| *v > 0.0) {
+                out.push(TrainingSpectrum {
+                    at_samples: sparse,
+                    on_grid: onto_grid(dense.wavelengths.nm(), &dense_f),
+                    weight: 1.0,
+                });
             }
         }
     }

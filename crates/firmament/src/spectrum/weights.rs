@@ -15,7 +15,8 @@
 //! The generic family ([`generic_family`]) is `(λ/550)^−p · exp(−a·(λ/550)^−4) ·
 //! exp(−b·σ_O₃(λ)/σ_O₃(600))`: a power law from red (p = −3, a dusty sky) to bluer than Rayleigh
 //! (p = 4.5), reddened by up to 1.2 vertical Rayleigh optical depths at 550 nm and by up to
-//! 0.3 of ozone's Chappuis band; a model adds its own single-scattering skies
+//! 0.3 of ozone's Chappuis band (4 and 2 for eight samples or more, which can serve the
+//! sun's beam at the horizon and twilight too); a model adds its own single-scattering skies
 //! (`atmosphere::sky_spectra`). What that achieves against 48-wavelength computations is in
 //! docs/accuracy.md ("Luminance from a few wavelengths").
 
@@ -80,15 +81,15 @@ impl TrainingSpectrum {
     }
 }
 
-/// The generic family (module documentation): 16 slopes × 7 Rayleigh reddenings × 4 or 6
-/// ozone amounts.
+/// The generic family (module documentation): 16 slopes × 7 or 10 Rayleigh reddenings ×
+/// 4 or 6 ozone amounts.
 pub fn generic_family(nm: &[f64]) -> Vec<TrainingSpectrum> {
     let ozone = table::ozone();
     let s600 = ozone.interp(0, 600.0);
     let mut out = Vec::new();
     for ip in 0..16 {
         let p = -3.0 + 0.5 * ip as f64;
-        for a in [0.0, 0.05, 0.1, 0.2, 0.4, 0.8, 1.2] {
+        for &a in reddenings(nm.len()) {
             for &b in ozone_amounts(nm.len()) {
                 out.push(TrainingSpectrum::from_fn(nm, |l| {
                     let x = l / 550.0;
@@ -98,6 +99,17 @@ pub fn generic_family(nm: &[f64]) -> Vec<TrainingSpectrum> {
         }
     }
     out
+}
+
+/// Rayleigh reddenings of the generic family, in vertical optical depths at 550 nm: up to
+/// 1.2 (a daylight sky's paths) for fewer than [`TWILIGHT_SAMPLES`] samples; up to 4 (the
+/// sun's own beam at the horizon, ~40 air masses of τ ≈ 0.1) for more.
+fn reddenings(samples: usize) -> &'static [f64] {
+    if samples < TWILIGHT_SAMPLES {
+        &[0.0, 0.05, 0.1, 0.2, 0.4, 0.8, 1.2]
+    } else {
+        &[0.0, 0.05, 0.1, 0.2, 0.4, 0.8, 1.2, 2.0, 3.0, 4.0]
+    }
 }
 
 /// Ozone amounts of the generic family, relative to the Chappuis band's cross-section at
@@ -137,28 +149,34 @@ pub fn fit_xyz_weights(sun: &SolarShape, family: &[TrainingSpectrum]) -> Vec<[f6
         }
         t
     };
-    // Rows: the samples of each member over its exact Y, against its exact XYZ over Y.
+    // Rows, per component c: the samples of each member over a scale, against its exact
+    // component over the same scale. The scale is the component itself, but at least
+    // `FLOOR`·Y: a relative error per component keeps the small Z of a red sunset (and X of a
+    // deep blue) from changing sign, and the floor keeps a component near 0 from weighing
+    // a member without end.
+    const FLOOR: f64 = 0.005;
     let sun_member = TrainingSpectrum {
         at_samples: vec![1.0; n],
         on_grid: vec![1.0; GRID_LEN],
         weight: 1.0,
     };
-    let mut ata = vec![vec![0.0; n]; n];
-    let mut atb = vec![[0.0; 3]; n];
+    let mut ata = vec![vec![vec![0.0; n]; n]; 3];
+    let mut atb = vec![vec![0.0; n]; 3];
     let mut add_row = |m: &TrainingSpectrum, weight: f64| {
         let t = target(&m.on_grid);
         if t[1].is_nan() || t[1] <= 0.0 {
             return;
         }
-        let row: Vec<f64> = (0..n)
-            .map(|k| weight * sun.at_samples[k] * m.at_samples[k] / t[1])
-            .collect();
-        for i in 0..n {
-            for j in 0..n {
-                ata[i][j] += row[i] * row[j];
-            }
-            for c in 0..3 {
-                atb[i][c] += row[i] * weight * t[c] / t[1];
+        for c in 0..3 {
+            let scale = weight / t[c].max(FLOOR * t[1]);
+            let row: Vec<f64> = (0..n)
+                .map(|k| scale * sun.at_samples[k] * m.at_samples[k])
+                .collect();
+            for i in 0..n {
+                for j in 0..n {
+                    ata[c][i][j] += row[i] * row[j];
+                }
+                atb[c][i] += row[i] * scale * t[c];
             }
         }
     };
@@ -166,16 +184,22 @@ pub fn fit_xyz_weights(sun: &SolarShape, family: &[TrainingSpectrum]) -> Vec<[f6
     for m in family {
         add_row(m, m.weight);
     }
-    let mean_diag = (0..n).map(|i| ata[i][i]).sum::<f64>() / n as f64;
-    for (i, r) in ata.iter_mut().enumerate() {
-        r[i] += RIDGE * mean_diag;
+    let mut out = vec![[0.0; 3]; n];
+    for (c, (mut a, b)) in ata.into_iter().zip(atb).enumerate() {
+        let mean_diag = (0..n).map(|i| a[i][i]).sum::<f64>() / n as f64;
+        for (i, r) in a.iter_mut().enumerate() {
+            r[i] += RIDGE * mean_diag;
+        }
+        for (o, x) in out.iter_mut().zip(solve(a, b)) {
+            o[c] = x;
+        }
     }
-    solve(ata, atb)
+    out
 }
 
-/// Solves the symmetric positive definite system `a·x = b` (three right-hand sides) by
-/// Gaussian elimination with partial pivoting.
-fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<[f64; 3]>) -> Vec<[f64; 3]> {
+/// Solves the symmetric positive definite system `a·x = b` by Gaussian elimination with
+/// partial pivoting.
+fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
     let n = b.len();
     for col in 0..n {
         let pivot = (col..n)
@@ -193,22 +217,18 @@ fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<[f64; 3]>) -> Vec<[f64; 3]> {
                 for k in col..n {
                     a[row][k] -= f * a[col][k];
                 }
-                for c in 0..3 {
-                    b[row][c] -= f * b[col][c];
-                }
+                b[row] -= f * b[col];
             }
         }
     }
-    let mut x = vec![[0.0; 3]; n];
+    let mut x = vec![0.0; n];
     for row in (0..n).rev() {
-        for c in 0..3 {
-            let s: f64 = (row + 1..n).map(|k| a[row][k] * x[k][c]).sum();
-            x[row][c] = if a[row][row] != 0.0 {
-                (b[row][c] - s) / a[row][row]
-            } else {
-                0.0
-            };
-        }
+        let s: f64 = (row + 1..n).map(|k| a[row][k] * x[k]).sum();
+        x[row] = if a[row][row] != 0.0 {
+            (b[row] - s) / a[row][row]
+        } else {
+            0.0
+        };
     }
     x
 }
