@@ -104,9 +104,10 @@ pub mod passes {
 
 /// The sky method's render-time modules (the view of one observer and one light; its
 /// questions towards any point and over lit intervals).
-pub const BRUNETON4D_VIEW: [Module; 2] = [
+pub const BRUNETON4D_VIEW: [Module; 3] = [
     module!("bruneton4d/view.wgsl"),
     module!("bruneton4d/view_point.wgsl"),
+    module!("bruneton4d/twilight.wgsl"),
 ];
 
 /// The terrain: its bindings, the grid and its walk, the surface, the materials, the

@@ -137,6 +137,29 @@ fn twilight_from_the_ground_itself() {
 }
 
 #[test]
+fn deep_twilight_below_the_tables_lowest_sun() {
+    // The sun 21° below the horizon, under the tables' lowest (−18° for earth), 2 m above the
+    // ground: the sky and the ground's sky light fall on from the lowest tabulated sun
+    // (sky/bruneton4d/twilight.rs and its twin twilight.wgsl), not cut to 0.
+    let cam = camera(Projection::Fisheye, 2.0, 0.0, 0.0, 60.0);
+    let settings = RenderSettings {
+        camera: &cam,
+        width: 96,
+        height: 96,
+        white_balance: false,
+    };
+    let sky = earth_rgb();
+    assert!(sky.model.mu_s_min > (111.0f64).to_radians().cos());
+    check(
+        "deep twilight fisheye",
+        sky,
+        &settings,
+        sun_direction(111.0, 80.0),
+        false,
+    );
+}
+
+#[test]
 fn orbit_view_from_space() {
     // The whole planet from 30 000 km, sun 75° from the zenith of the point below: limb,
     // terminator, night side, black space.

@@ -158,7 +158,7 @@ fn at_along(s: ViewStart, nu: f32, d_km: f32, ground: bool) -> At {
     let r_d_km = radius_from_rho(rho_d_km);
     let mu_d = clamp_cosine((s.r_km * s.mu + d_km) / r_d_km);
     let mu_s_d = clamp_cosine((s.r_km * s.mu_s + d_km * nu) / r_d_km);
-    return at_table(scattering_uvwz(r_d_km, rho_d_km, mu_d, mu_s_d, nu, ground), mu_s_d);
+    return at_table(scattering_uvwz(r_d_km, rho_d_km, mu_d, mu_s_d, nu, ground), r_d_km, mu_s_d);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -286,16 +286,23 @@ struct At {
     // red-only ratio rule; computed once per ray by `at_red`.
     red: f32,
     scat0: f32,
-    // Below the tables' lowest sun (μ_s < μ_s,min): nothing scattered here
-    // (Bruneton4dView::combined_scattering).
-    dark: bool,
+    // Where the lookup is: its altitude and μ_s (below the tables' lowest sun the light
+    // falls on from there: twilight_fade, Bruneton4dView::combined_scattering).
+    altitude_km: f32,
+    mu_s: f32,
 }
 
-fn at_table(uvwz: vec4<f32>, mu_s: f32) -> At {
+// twilight_fade at the lookup, channel group k (1 at and above μ_s,min).
+fn at_fade(a: At, k: u32) -> vec4<f32> {
+    return twilight_fade(a.altitude_km, a.mu_s, k);
+}
+
+fn at_table(uvwz: vec4<f32>, r_km: f32, mu_s: f32) -> At {
     var a: At;
     a.sliced = false;
     a.table = scattering_filter(uvwz);
-    a.dark = mu_s < atm.mu_s_min;
+    a.altitude_km = r_km - atm.bottom_radius_km;
+    a.mu_s = mu_s;
     return a;
 }
 
@@ -305,7 +312,8 @@ fn at_start(s: ViewStart, light: ViewLight, nu: f32, ground: bool) -> At {
     var a: At;
     a.sliced = s.at_observer;
     a.slice = light.slice;
-    a.dark = s.mu_s < atm.mu_s_min;
+    a.altitude_km = s.r_km - atm.bottom_radius_km;
+    a.mu_s = s.mu_s;
     let u_nu = u_nu_from_nu(s.mu, s.mu_s, nu);
     if (a.sliced) {
         a.slice_filter = slice_filter(u_nu, start_u_mu(s, ground));
@@ -340,13 +348,13 @@ fn at_red(v: View, a_in: At, p_r: f32) -> At {
 
 fn combined_scattering(v: View, a: At, k: u32, p_r: f32) -> Combined {
     var c: Combined;
-    if (a.dark) {
-        c.scattering = vec4<f32>(0.0);
-        c.mie = vec4<f32>(0.0);
-        return c;
-    }
     c.scattering = rayleigh_and_multiple(a, k, p_r);
     c.mie = single_mie(v, a, c.scattering, k);
+    if (a.mu_s < atm.mu_s_min) {
+        let f = at_fade(a, k);
+        c.scattering *= f;
+        c.mie *= f;
+    }
     return c;
 }
 
@@ -484,7 +492,7 @@ fn ground_ray(v: View, o: Observer, light: ViewLight, dir: vec3<f32>, shadow_len
         ray.at_end = at_red(v, at_along(s, nu, e_km, true), p_r);
         ray.t_end = transmittance_filters(s.r_km, s.rho_km, s.mu, e_km, true);
     } else {
-        ray.at_end = at_red(v, at_table(scattering_uvwz(atm.bottom_radius_km, 0.0, mu_p, ray.mu_s_ground, nu, true), ray.mu_s_ground), p_r);
+        ray.at_end = at_red(v, at_table(scattering_uvwz(atm.bottom_radius_km, 0.0, mu_p, ray.mu_s_ground, nu, true), atm.bottom_radius_km, ray.mu_s_ground), p_r);
         ray.t_end = ray.t_point;
     }
     return ray;
@@ -511,7 +519,8 @@ fn transmittance_to_point(ray: GroundRay, k: u32) -> vec4<f32> {
 // (normal straight up: the sky occlusion factor is 1).
 
 struct GroundLight {
-    irradiance: Filter2,
+    // The sky's irradiance at the ground: μ_s (twilight_sky_irradiance).
+    mu_s: f32,
     fraction: f32,
     to_light: Filter2,
     cos_light: f32,
@@ -519,7 +528,7 @@ struct GroundLight {
 
 fn ground_light(light: ViewLight, mu_s: f32) -> GroundLight {
     var g: GroundLight;
-    g.irradiance = table2_filter(irradiance_uv(0.0, mu_s), atm.irradiance_mu_s, atm.irradiance_r);
+    g.mu_s = mu_s;
     // Lookup::sun_visible_fraction with the light's angular radius (sin θ_h = 1 at the ground).
     let e = light.angular_radius;
     g.fraction = smoothstep_safe(-e, e, mu_s);
@@ -545,7 +554,7 @@ struct Irradiance {
 
 fn sun_and_sky_irradiance(g: GroundLight, k: u32) -> Irradiance {
     var e: Irradiance;
-    e.sky = sample_irradiance(g.irradiance, k);
+    e.sky = twilight_sky_irradiance(0.0, g.mu_s, k);
     e.direct = transmittance_to_light(g, k) * g.cos_light;
     return e;
 }

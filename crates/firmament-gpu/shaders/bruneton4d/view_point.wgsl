@@ -93,9 +93,6 @@ fn piece_transmittance(p: Piece, k: u32) -> vec4<f32> {
 // Orders::Single at a piece: single Rayleigh and single Mie, times T(0, x).
 fn piece_single(v: View, p: Piece, k: u32) -> Combined {
     var c: Combined;
-    if (p.at.dark) {
-        return c;
-    }
     let a = p.at;
     if (a.sliced) {
         c.scattering = sample_slice(a.slice, a.slice_filter, k);
@@ -103,7 +100,10 @@ fn piece_single(v: View, p: Piece, k: u32) -> Combined {
         c.scattering = sample_scattering_a(a.table, k);
     }
     c.mie = single_mie(v, a, c.scattering, k);
-    let t = piece_transmittance(p, k);
+    var t = piece_transmittance(p, k);
+    if (a.mu_s < atm.mu_s_min) {
+        t *= at_fade(a, k);
+    }
     c.scattering *= t;
     c.mie *= t;
     return c;
@@ -111,16 +111,17 @@ fn piece_single(v: View, p: Piece, k: u32) -> Combined {
 
 // Orders::Multiple at a piece: the multiple scattering (radiance) times T(0, x).
 fn piece_multiple(p: Piece, k: u32) -> vec4<f32> {
-    if (p.at.dark) {
-        return vec4<f32>(0.0);
-    }
     var m: vec4<f32>;
     if (p.at.sliced) {
         m = sample_slice(p.at.slice, p.at.slice_filter, atm.groups + k);
     } else {
         m = sample_multiple(p.at.table, k);
     }
-    return m * piece_transmittance(p, k);
+    var t = piece_transmittance(p, k);
+    if (p.at.mu_s < atm.mu_s_min) {
+        t *= at_fade(p.at, k);
+    }
+    return m * t;
 }
 
 // Bruneton4dView::lit_radiance of one lit interval [a, b] for the single scattering, channel
@@ -159,7 +160,9 @@ fn point_transmittance(ray: PointRay, end: Piece, k: u32) -> vec4<f32> {
 // `normal`, `up` the local vertical there (both in the observer's frame).
 
 struct PointLight {
-    irradiance: Filter2,
+    // The sky's irradiance at the point: altitude and μ_s (twilight_sky_irradiance).
+    altitude_km: f32,
+    mu_s: f32,
     to_light: Filter2,
     fraction: f32,
     // max(n·l, 0) and the sky's (1 + n·up)/2.
@@ -173,7 +176,8 @@ fn point_light(light: ViewLight, altitude_km: f32, up: vec3<f32>, normal: vec3<f
     let r_km = atm.bottom_radius_km + alt;
     let rho_km = sqrt(alt * (2.0 * atm.bottom_radius_km + alt));
     let mu_s = clamp_cosine(dot(up, light.direction));
-    g.irradiance = table2_filter(irradiance_uv(alt, mu_s), atm.irradiance_mu_s, atm.irradiance_r);
+    g.altitude_km = alt;
+    g.mu_s = mu_s;
     // Lookup::sun_visible_fraction: sin θ_h = R_g/r, cos θ_h = −ρ/r.
     let e = atm.bottom_radius_km / r_km * light.angular_radius;
     g.fraction = smoothstep_safe(-e, e, mu_s + rho_km / r_km);
@@ -187,7 +191,7 @@ fn point_light(light: ViewLight, altitude_km: f32, up: vec3<f32>, normal: vec3<f
 // it) and the sky's (before the light's scale), channel group k.
 fn point_irradiance(g: PointLight, k: u32) -> Irradiance {
     var e: Irradiance;
-    e.sky = sample_irradiance(g.irradiance, k) * g.occlusion;
+    e.sky = twilight_sky_irradiance(g.altitude_km, g.mu_s, k) * g.occlusion;
     if (g.fraction > 0.0) {
         e.direct = sample_transmittance(g.to_light, k) * g.fraction * g.cos_light;
     }

@@ -87,10 +87,9 @@ impl ColourMatrix {
         &self.xyz
     }
 
-    /// CIE XYZ (Y in cd/m² for radiance in W·m⁻²·sr⁻¹·nm⁻¹). Each component is kept ≥ 0:
-    /// a non-negative spectrum has non-negative tristimulus values, but fitted weights dip
-    /// below zero at the ends of a grid, and a spectrum lit only there (the night side seen
-    /// from orbit) could read a negative sum.
+    /// CIE XYZ (Y in cd/m² for radiance in W·m⁻²·sr⁻¹·nm⁻¹): linear in the samples (the
+    /// GPU applies the same weights per channel), so a spectrum lit only where fitted
+    /// weights dip below zero, at a grid's ends, could read a slightly negative component.
     #[inline]
     pub fn to_xyz(&self, l: &[f64]) -> [f64; 3] {
         let mut o = [0.0; 3];
@@ -99,7 +98,7 @@ impl ColourMatrix {
             o[1] += v * m[1];
             o[2] += v * m[2];
         }
-        o.map(|v| v.max(0.0))
+        o
     }
 
     /// Linear sRGB with Y in cd/m².

@@ -20,12 +20,16 @@ use super::lookup::Lookup;
 use super::table::Table2;
 use crate::spectrum::with_channel_buffers;
 
+/// Tolerance of the texel index in [`lowest_texel`]: a μ_s,min this close below a texel
+/// centre counts as on it (the WGSL twin computes it in f32).
+const TEXEL_TOLERANCE: f64 = 1e-4;
+
 /// μ_s of the irradiance table's lowest texel centre at or above μ_s,min, and the spacing
 /// of texel centres in μ_s (the table is linear in μ_s over [−1, 1]).
 fn lowest_texel(lookup: &Lookup) -> (f64, f64) {
     let n = lookup.sizes.irradiance_mu_s;
     let step = 2.0 / (n - 1) as f64;
-    let x = ((lookup.radii.mu_s_min + 1.0) / step - 1e-9)
+    let x = ((lookup.radii.mu_s_min + 1.0) / step - TEXEL_TOLERANCE)
         .ceil()
         .min((n - 2) as f64);
     (x * step - 1.0, step)
