@@ -40,19 +40,20 @@ fn small_tables(atmosphere: &Atmosphere) -> Bruneton4d {
 
 /// `earth` with the ozone column, the haze's turbidity and scale height, the ground albedo
 /// and the shell's thickness drawn at random; the first draws are the extremes (10¹² DU of
-/// ozone, a haze of optical depth 6 at 550 nm, a white ground, thin and thick shells).
+/// ozone, the thickest haze the tables take, a white ground, thin and thick shells).
 fn random_earth(rng: &mut Rng, case: usize) -> Atmosphere {
     let mut a = Atmosphere::earth();
     let (ozone_du, beta, haze_m, albedo, shell_m) = match case {
         0 => (1e12, 0.04, 1200.0, 0.1, 60e3),
-        1 => (300.0, 3.0, 1200.0, 1.0, 60e3),
+        // The thickest haze the tables take (τ_s ≈ 2.9 at 440 nm: `thickness`).
+        1 => (300.0, 1.0, 1200.0, 1.0, 60e3),
         2 => (300.0, 0.04, 1200.0, 1.0, 20e3),
         3 => (0.0, 0.5, 2000.0, 1.0, 160e3),
         _ => {
             let haze_m = rng.log_uniform(500.0, 5000.0);
             (
                 rng.log_uniform(1.0, 1e5),
-                rng.log_uniform(1e-3, 3.0),
+                rng.log_uniform(1e-3, 1.0),
                 haze_m,
                 rng.uniform(),
                 // Within what is accepted: at most 200 haze layers, 20 of the air's.
@@ -234,4 +235,47 @@ fn nothing_comes_through_an_ozone_layer_of_opaque_optical_depth() {
             "{radiance:?} {diffuse:?}"
         );
     }
+}
+
+/// `hazy` with its haze's Ångström β set to `beta` (β = 0.2 is the preset: τ ≈ 0.36 at
+/// 550 nm).
+fn haze(beta: f64) -> Atmosphere {
+    let mut a = Atmosphere::preset("hazy").unwrap();
+    for c in &mut a.constituents {
+        for coefficient in [&mut c.scattering, &mut c.absorption] {
+            if let Coefficient::Angstrom { beta: b, .. } = coefficient {
+                *b = beta;
+            }
+        }
+    }
+    a
+}
+
+/// Air too thick for the tables is refused with the reason (the reference takes it), air
+/// that is thick but taken gets a note, the presets neither (`sky::bruneton4d::thickness`).
+#[test]
+fn air_too_thick_for_the_tables_is_refused_and_thick_air_noted() {
+    use firmament::sky::bruneton4d::thickness;
+    let resolve = |a: &Atmosphere| a.resolve(&Wavelengths::rgb()).unwrap();
+    let thick = resolve(&haze(2.0));
+    let config = TableConfig {
+        sizes: TableSizes::small(),
+        ..Default::default()
+    };
+    let Err(e) = Bruneton4d::compute(thick.clone(), &config) else {
+        panic!("a haze of τ_s ≈ 4.3 was taken");
+    };
+    let e = e.to_string();
+    assert!(
+        e.contains("scattering optical depth") && e.contains("--method reference"),
+        "{e}"
+    );
+    // The reference still answers.
+    let settings = firmament::reference::ReferenceSettings::with_samples(64);
+    let observer = Vec3::new(0.0, 0.0, thick.bottom_radius_m + 1.0);
+    let r = firmament::reference::sky_radiance(&thick, observer, Vec3::Z, Vec3::Z, &settings);
+    assert!(r.radiance.iter().all(|v| v.is_finite() && *v > 0.0));
+    assert!(thickness::note(&resolve(&haze(0.5))).is_some());
+    assert!(thickness::note(&resolve(&Atmosphere::earth())).is_none());
+    assert!(small_tables(&haze(0.5)).model.channels() == 3);
 }

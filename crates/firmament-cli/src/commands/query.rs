@@ -316,9 +316,10 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
         notes.extend(m);
     }
     // What the tables approximate here (with `--method reference` the transmittance and
-    // irradiance still come from them): a sun below their lowest.
+    // irradiance still come from them): a sun below their lowest, optically thick air.
     let mu_s = camera.normalize().dot(sun);
     notes.extend(lut::twilight::note(model.mu_s_min, mu_s).map(|s| json!(s)));
+    notes.extend(lut::thickness::note(model).map(|s| json!(s)));
     let method = match &reference {
         None => "bruneton4d (precomputed tables)",
         Some(_) => {

@@ -69,13 +69,16 @@ pub fn sources_of_scene(model: &Model, scene: &Scene) -> Result<SkySources> {
 }
 
 /// A note when the sun is below the tables' lowest sun (the twilight extrapolated,
-/// `twilight::note`).
+/// `twilight::note`) or the air is optically thick (`thickness::note`).
 fn approximation_notes(model: &Model, scene: &Scene) -> Result<()> {
     let zenith_deg = match scene.astro()? {
         Some(sky) => sky.sun.apparent_zenith_deg,
         None => scene.sun.zenith_deg,
     };
     if let Some(note) = twilight::note(model.mu_s_min, zenith_deg.to_radians().cos()) {
+        eprintln!("note: {note}");
+    }
+    if let Some(note) = firmament::sky::bruneton4d::thickness::note(model) {
         eprintln!("note: {note}");
     }
     Ok(())

@@ -135,6 +135,7 @@ impl Precomputer {
         config: &TableConfig,
     ) -> Result<GpuTables, GpuError> {
         config.validate()?;
+        firmament::sky::bruneton4d::thickness::check(model)?;
         let n = model.channels();
         firmament::spectrum::check_channels(n, "the precomputed tables")?;
         let s = config.sizes;

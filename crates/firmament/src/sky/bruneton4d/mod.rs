@@ -12,6 +12,7 @@ pub mod params;
 pub mod precompute;
 pub mod table;
 mod tables;
+pub mod thickness;
 pub mod twilight;
 pub mod view;
 

@@ -82,6 +82,7 @@ pub fn precompute(
     cancel: Option<&AtomicBool>,
 ) -> Result<Tables> {
     config.validate()?;
+    super::thickness::check(model)?;
     let n = model.channels();
     crate::spectrum::check_channels(n, "the precomputed tables")?;
     let s = config.sizes;
