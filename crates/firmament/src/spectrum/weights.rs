@@ -154,7 +154,7 @@ pub fn fit_xyz_weights(sun: &SolarShape, family: &[TrainingSpectrum]) -> Vec<[f6
     // `FLOOR`·Y: a relative error per component keeps the small Z of a red sunset (and X of a
     // deep blue) from changing sign, and the floor keeps a component near 0 from weighing
     // a member without end.
-    const FLOOR: f64 = 0.005;
+    const FLOOR: f64 = 0.05;
     let sun_member = TrainingSpectrum {
         at_samples: vec![1.0; n],
         on_grid: vec![1.0; GRID_LEN],
