@@ -104,7 +104,10 @@ impl Precomputer {
                     &[(3, Read), (5, Read), (7, Write), (8, Write)],
                 ),
                 order_sums: pass(passes::ORDER_SUMS, &[(5, Read), (6, Read), (7, Write)]),
-                order_tail_factors: pass(passes::ORDER_TAIL_FACTORS, &[(5, Read), (7, Write)]),
+                order_tail_factors: pass(
+                    passes::ORDER_TAIL_FACTORS,
+                    &[(4, Read), (5, Read), (7, Write), (8, Read)],
+                ),
                 order_tail: pass(
                     passes::ORDER_TAIL,
                     &[(4, Read), (5, Read), (6, Read), (7, Write), (8, Write)],
@@ -349,7 +352,7 @@ impl Precomputer {
                     let bg = self.order_tail_factors.bind(
                         device,
                         common(orders),
-                        &[&row_sums, &factors],
+                        &[&delta_irradiance, &row_sums, &factors, &irradiance],
                     );
                     dispatch(
                         &mut cpass,
