@@ -154,7 +154,16 @@ fn main() {
             let methods = [
                 ("piecewise linear", ColourMatrix::piecewise_linear(snm)),
                 ("generic fit", ColourMatrix::new(snm)),
-                ("model fit", sparse_model.colour_matrix()),
+                ("model fit", {
+                    // The first call fits (later ones are cached): its cost, for BENCHMARKS.md.
+                    let start = std::time::Instant::now();
+                    let m = sparse_model.colour_matrix();
+                    eprintln!(
+                        "{preset} {mode}: Model::colour_matrix fitted in {:.1} ms",
+                        1e3 * start.elapsed().as_secs_f64()
+                    );
+                    m
+                }),
             ];
             for (name, matrix) in &methods {
                 let mut errors: [(Vec<f64>, Vec<f64>); 3] = Default::default();
