@@ -119,12 +119,16 @@ fn flags_a_projection_would_ignore_are_refused_and_sizes_follow_the_aspect() {
         &with(&["--ev100", "12", "--auto-exposure"]),
         &["--ev100", "--auto-exposure"],
     );
-    // One size gives the other; --size gives a cube map's faces.
+    // One size gives the other (the image's aspect); --size gives a cube map's faces.
     for (extra, want) in [
         (vec!["--camera", "equirect", "--width", "64"], (64, 32)),
         (vec!["--camera", "equirect", "--height", "20"], (40, 20)),
         (vec!["--camera", "cubemap", "--height", "8"], (48, 8)),
         (vec!["--camera", "cubemap", "--size", "10"], (60, 10)),
+        // A perspective view keeps its aspect (the default 1920×1080), a fisheye is square.
+        (vec!["--width", "64"], (64, 36)),
+        (vec!["--height", "18"], (32, 18)),
+        (vec!["--camera", "fisheye", "--width", "24"], (24, 24)),
         (
             vec![
                 "--camera",

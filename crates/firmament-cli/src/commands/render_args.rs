@@ -215,7 +215,7 @@ fn size_help(which: &str) -> String {
     .collect::<Vec<_>>()
     .join(", ");
     format!(
-        "Image {which} (pixels, 1 to 32768); an equirect map is 2:1 and a cube map 6:1, so either size gives the other [default: {v}; {all_round}]"
+        "Image {which} (pixels, 1 to 32768); given alone it keeps the image's aspect (an equirect map is 2:1 and a cube map 6:1) [default: {v}; {all_round}]"
     )
 }
 
@@ -322,6 +322,16 @@ fn set_size(args: &RenderArgs, scene: &mut Scene) -> Result<()> {
             (scene.image.width, scene.image.height) = (w, w / k);
         }
         (None, Some(h), Some((k, _))) => (scene.image.width, scene.image.height) = (k * h, h),
+        // One size alone keeps the image's aspect (a 1920×1080 view asked 480 wide is
+        // 480×270, not 480×1080).
+        (Some(w), None, None) => {
+            let h = w as f64 * scene.image.height as f64 / scene.image.width as f64;
+            (scene.image.width, scene.image.height) = (w, (h.round() as usize).max(1));
+        }
+        (None, Some(h), None) => {
+            let w = h as f64 * scene.image.width as f64 / scene.image.height as f64;
+            (scene.image.width, scene.image.height) = ((w.round() as usize).max(1), h);
+        }
         _ => {
             if let Some(w) = width {
                 scene.image.width = w;
