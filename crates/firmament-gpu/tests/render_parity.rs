@@ -138,7 +138,7 @@ fn twilight_from_the_ground_itself() {
 
 #[test]
 fn deep_twilight_below_the_tables_lowest_sun() {
-    // The sun 21° below the horizon, under the tables' lowest (−18° for earth), 2 m above the
+    // The sun 21° below the horizon, under the tables' lowest (−12°), 2 m above the
     // ground: the sky and the ground's sky light fall on from the lowest tabulated sun
     // (sky/bruneton4d/twilight.rs and its twin twilight.wgsl), not cut to 0.
     let cam = camera(Projection::Fisheye, 2.0, 0.0, 0.0, 60.0);

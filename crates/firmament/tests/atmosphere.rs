@@ -102,7 +102,7 @@ fn bad_values_are_refused_with_the_field_the_value_and_the_range() {
             "(0, 10)",
         ),
         (
-            "min_sun_elevation_deg = -18.0",
+            "min_sun_elevation_deg = -12.0",
             "min_sun_elevation_deg = 5.0",
             "min_sun_elevation_deg",
             "[-90, 0]",
