@@ -511,14 +511,16 @@ fn table_files_round_trip_and_bad_files_are_refused() {
         .to_string()
         .contains("checksum"));
 
-    // A version 3 file (the same f32 layout, no `encoding` in its header) still reads.
+    // A version 3 file (the same f32 layout, no `encoding` in its header) is refused: its
+    // μ_s texels sit where Bruneton's mapping alone put them.
     let v3 = as_version_3(&bytes);
-    let old = lut::file::from_bytes(&v3, "x").unwrap();
-    assert_eq!(old.multiple, t.multiple);
-    assert_eq!(old.optical_depth, t.optical_depth);
+    assert!(lut::file::from_bytes(&v3, "x")
+        .unwrap_err()
+        .to_string()
+        .contains("format version 3"));
 }
 
-/// A version 4 f32 file's bytes rewritten as version 3 wrote them.
+/// A current f32 file's bytes rewritten as version 3 wrote them.
 fn as_version_3(v4: &[u8]) -> Vec<u8> {
     let hlen = u32::from_le_bytes(v4[12..16].try_into().unwrap()) as usize;
     let header = std::str::from_utf8(&v4[16..16 + hlen]).unwrap();

@@ -26,7 +26,7 @@ pub struct BakeArgs {
     #[arg(long, value_enum, value_name = "cpu|gpu|auto", default_value_t = BackendChoice::Auto)]
     pub backend: BackendChoice,
     /// Store the 4D scattering tables as half floats with a power-of-two scale per texel:
-    /// half the size (101 MB in place of 202 MB for spectral tables at the default sizes),
+    /// half the size (131 MB in place of 253 MB for spectral tables at the default sizes),
     /// each value within 4.9·10⁻⁴ of its f32 (the radiance errors: docs/accuracy.md).
     #[arg(long)]
     pub compact: bool,

@@ -11,6 +11,8 @@ struct Atmosphere {
     h_sq_km2: f32,
     mu_s_min: f32,
     mu_s_big_a: f32,
+    // The sun's zenith angle at the joint of the μ_s mapping (rad; params::MuSMap::theta_joint).
+    mu_s_theta_joint: f32,
     sun_angular_radius: f32,
     channels: u32,
     groups: u32,

@@ -8,7 +8,7 @@ use firmament::atmosphere::groups::{AEROSOLS, MOLECULES};
 use firmament::atmosphere::{Model, ScatteringGroups};
 use firmament::math::sphere::distance_to_top_atmosphere_boundary;
 use firmament::medium::PhaseFunction;
-use firmament::sky::bruneton4d::TableSizes;
+use firmament::sky::bruneton4d::{params, TableSizes};
 
 /// Wavelengths per channel group (one vec4).
 pub const GROUP: usize = 4;
@@ -62,6 +62,12 @@ pub fn pack(model: &Model, sizes: &TableSizes) -> Packed {
     let d_min = top - bottom;
     let big_d = distance_to_top_atmosphere_boundary(bottom, model.mu_s_min, top);
     let big_a = (big_d - d_min) / (h - d_min);
+    let theta_joint = params::MuSMap::new(&params::Radii {
+        bottom,
+        top,
+        mu_s_min: model.mu_s_min,
+    })
+    .theta_joint();
 
     let mut data: Vec<f32> = Vec::new();
     let per_wavelength = |data: &mut Vec<f32>, values: &[f64], scale: f64| {
@@ -125,6 +131,7 @@ pub fn pack(model: &Model, sizes: &TableSizes) -> Packed {
         f(h * km * h * km),
         f(model.mu_s_min),
         f(big_a),
+        f(theta_joint),
         f(model.sun_angular_radius_rad),
         u(n),
         u(n_groups),
@@ -162,8 +169,8 @@ mod tests {
     fn uniform_has_the_shader_struct_size() {
         let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
         let p = pack(&model, &TableSizes::small());
-        // 36 fields of the WGSL `Atmosphere` struct.
-        assert_eq!(p.uniform.len(), 36);
+        // 37 fields of the WGSL `Atmosphere` struct, padded to 16 bytes.
+        assert_eq!(p.uniform.len(), 40);
         assert_eq!(p.data.len() % 4, 0);
         assert!(model.groups.present(MOLECULES));
     }

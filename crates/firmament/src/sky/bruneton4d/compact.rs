@@ -1,6 +1,6 @@
 //! Compact storage of the 4D scattering tables: half floats with a power-of-two scale per
-//! texel, half the bytes of f32 (a spectral table file at the default sizes: 101 MB in place
-//! of 202 MB).
+//! texel, half the bytes of f32 (a spectral table file at the default sizes: 131 MB in place
+//! of 253 MB).
 //!
 //! A plain half float (11 significant bits, normal from 6.1·10⁻⁵ to 65 504) cannot hold the
 //! tables' range: radiances in W·m⁻²·sr⁻¹·nm⁻¹ span about 10⁻¹ under a high sun to 10⁻¹⁵

@@ -1,13 +1,13 @@
-//! The table file format, version 4 (little-endian):
+//! The table file format, version 5 (little-endian):
 //!
 //! | bytes | content |
 //! |---|---|
 //! | 8 | magic `FIRMLUT\0` |
-//! | 4 | format version (u32, = 4; version 3 is read too: the same without `encoding`, always f32; version 1 folded multiple scattering into `scattering`, version 2 stored the transmittance instead of the optical depth; both are refused) |
+//! | 4 | format version (u32, = 5; older versions are refused: 3 and 4 sampled the sun's elevation by Bruneton's μ_s mapping alone (`params::x_mu_s`), version 2 stored the transmittance instead of the optical depth, version 1 folded multiple scattering into `scattering`) |
 //! | 4 | header length L (u32) |
 //! | L | header, UTF-8 JSON: `config` (sizes, orders, mie storage), `wavelengths_nm`, `atmosphere_hash` (hex), `channels`, `order_means`, `mie_ratio`, `encoding` (`f32` or `half`) |
 //! | … | f32 arrays: optical depth to the top (τ = −ln T), irradiance; then single Rayleigh (molecular), single Mie, multiple scattering, as f32 arrays (`f32`) or each as per-texel exponents and half floats ([`compact`], `half`); sizes from the header |
-//! | 8 | checksum of everything before it: FNV-1a 64 over its 8-byte little-endian words, the last one zero-padded, then its length in bytes (version 3: FNV-1a 64 over its bytes, eight times slower to check) |
+//! | 8 | checksum of everything before it: FNV-1a 64 over its 8-byte little-endian words, the last one zero-padded, then its length in bytes |
 //!
 //! A truncated, corrupt, wrong-version or mismatched file is refused, never used.
 
@@ -19,14 +19,12 @@ use serde::{Deserialize, Serialize};
 use super::compact;
 use super::table::{Table2, Table4};
 use super::{MieStorage, TableConfig, Tables};
-use crate::atmosphere::model::fnv1a;
 use crate::{Error, Result};
 
 const MAGIC: &[u8; 8] = b"FIRMLUT\0";
-/// Current format version.
-pub const VERSION: u32 = 4;
-/// The previous version, still read (f32 only, no `encoding` in its header).
-const VERSION_3: u32 = 3;
+/// Current format version (5: the μ_s mapping with samples added above 18°; a version 4
+/// file's texels would be read at the wrong sun elevations).
+pub const VERSION: u32 = 5;
 
 /// How the 4D scattering tables' values are stored (the 2D tables are always f32).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -122,7 +120,7 @@ pub fn to_bytes_encoded(t: &Tables, encoding: Encoding) -> Vec<u8> {
     out
 }
 
-/// The version 4 checksum of `bytes`: FNV-1a 64 over 8-byte little-endian words (the last
+/// The checksum of `bytes`: FNV-1a 64 over 8-byte little-endian words (the last
 /// zero-padded), then the byte count (so that trailing zeros count).
 fn checksum(bytes: &[u8]) -> u64 {
     const PRIME: u64 = 0x0000_0100_0000_01b3;
@@ -150,9 +148,9 @@ fn prefix(bytes: &[u8], path: &str) -> Result<(u32, usize)> {
         ));
     }
     let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
-    if version != VERSION && version != VERSION_3 {
+    if version != VERSION {
         return Err(bad(format!(
-            "format version {version}, this program reads versions {VERSION_3} and {VERSION}; bake the tables again"
+            "format version {version}, this program reads version {VERSION} (older files sample the sun's elevation differently); bake the tables again"
         )));
     }
     let hlen = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
@@ -174,7 +172,7 @@ fn parse_header(bytes: &[u8], path: &str) -> Result<(Header, usize)> {
         path: path.to_string(),
         reason,
     };
-    let (version, hlen) = prefix(bytes, path)?;
+    let (_, hlen) = prefix(bytes, path)?;
     if 16 + hlen > bytes.len() {
         return Err(bad(
             "header length beyond the end of the file: the file is truncated or corrupt".into(),
@@ -182,9 +180,6 @@ fn parse_header(bytes: &[u8], path: &str) -> Result<(Header, usize)> {
     }
     let header: Header = serde_json::from_slice(&bytes[16..16 + hlen])
         .map_err(|e| bad(format!("unreadable header: {e}")))?;
-    if version == VERSION_3 && header.encoding != Encoding::F32 {
-        return Err(bad("a version 3 file with an `encoding`".into()));
-    }
     header
         .config
         .validate()
@@ -209,13 +204,8 @@ pub fn from_bytes(bytes: &[u8], path: &str) -> Result<Tables> {
     }
     let (body, tail) = bytes.split_at(bytes.len() - 8);
     let stored = u64::from_le_bytes(tail.try_into().unwrap());
-    let (version, _) = prefix(body, path)?;
-    let sum = if version == VERSION_3 {
-        fnv1a(body)
-    } else {
-        checksum(body)
-    };
-    if sum != stored {
+    prefix(body, path)?;
+    if checksum(body) != stored {
         return Err(bad(
             "checksum mismatch: the file is truncated or corrupt".into()
         ));

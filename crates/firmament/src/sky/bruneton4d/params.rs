@@ -7,7 +7,8 @@
 use crate::math::sphere::{clamp_cosine, distance_to_top_atmosphere_boundary, safe_sqrt};
 
 /// Table sizes. Defaults from Bruneton 2017 (transmittance 256×64, scattering 32×128×32×8,
-/// irradiance 64×16).
+/// irradiance 64×16), but 40 μ_s samples in place of 32: Bruneton's 32-sample grid up to
+/// 18° sun elevation and 13 more above it (see [`x_mu_s`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TableSizes {
@@ -36,7 +37,7 @@ impl Default for TableSizes {
             transmittance_r: 64,
             scattering_r: 32,
             scattering_mu: 128,
-            scattering_mu_s: 32,
+            scattering_mu_s: 40,
             scattering_nu: 8,
             irradiance_mu_s: 64,
             irradiance_r: 16,
@@ -52,7 +53,7 @@ impl TableSizes {
             transmittance_r: 32,
             scattering_r: 16,
             scattering_mu: 64,
-            scattering_mu_s: 16,
+            scattering_mu_s: 20,
             scattering_nu: 8,
             irradiance_mu_s: 32,
             irradiance_r: 8,
@@ -275,11 +276,18 @@ pub fn ground_x_from_distance_fraction(f: f64) -> f64 {
     f.clamp(0.0, 1.0).sqrt()
 }
 
+/// Bruneton's coordinate of the joint of [`x_mu_s`]: sample 26 of his 32 (sun elevation
+/// 18.0° for μ_s,min = cos 108°, 19.1° for cos 102°).
+pub const MU_S_JOINT_BRUNETON_X: f64 = 26.0 / 31.0;
+/// Where the joint lies in [`x_mu_s`]: sample 26 of 40 (Bruneton's sample 26 of 32).
+pub const MU_S_JOINT_X: f64 = 26.0 / 39.0;
+
 /// [`x_mu_s`] with its constants computed once (hot loops).
 #[derive(Clone, Copy, Debug)]
 pub struct MuSMap {
     top: f64,
     bottom: f64,
+    h: f64,
     d_min: f64,
     inv_range: f64,
     big_a: f64,
@@ -294,10 +302,17 @@ impl MuSMap {
         MuSMap {
             top: radii.top,
             bottom: radii.bottom,
+            h: d_max,
             d_min,
             inv_range: 1.0 / (d_max - d_min),
             big_a: (big_d - d_min) / (d_max - d_min),
         }
+    }
+
+    /// The sun's zenith angle at the joint of [`x_mu_s`] (rad; the GPU's uniform holds it).
+    /// Computed when needed: below the joint (every sunset lookup) it costs nothing.
+    pub fn theta_joint(&self) -> f64 {
+        self.bruneton_mu_s(MU_S_JOINT_BRUNETON_X).acos()
     }
 
     /// Same as [`x_mu_s`].
@@ -305,7 +320,37 @@ impl MuSMap {
     pub fn x(&self, mu_s: f64) -> f64 {
         let d = distance_to_top_atmosphere_boundary(self.bottom, mu_s, self.top);
         let a = (d - self.d_min) * self.inv_range;
-        ((1.0 - a / self.big_a).max(0.0) / (1.0 + a)).clamp(0.0, 1.0)
+        let bruneton = ((1.0 - a / self.big_a).max(0.0) / (1.0 + a)).clamp(0.0, 1.0);
+        if bruneton <= MU_S_JOINT_BRUNETON_X {
+            MU_S_JOINT_X * bruneton / MU_S_JOINT_BRUNETON_X
+        } else {
+            let (theta, theta_joint) = (clamp_cosine(mu_s).acos(), self.theta_joint());
+            let above = (theta_joint - theta) / theta_joint;
+            (MU_S_JOINT_X + (1.0 - MU_S_JOINT_X) * above).clamp(0.0, 1.0)
+        }
+    }
+
+    /// Same as [`mu_s_from_x`].
+    #[inline]
+    pub fn mu_s(&self, x: f64) -> f64 {
+        if x <= MU_S_JOINT_X {
+            self.bruneton_mu_s(x * MU_S_JOINT_BRUNETON_X / MU_S_JOINT_X)
+        } else {
+            let above = ((x - MU_S_JOINT_X) / (1.0 - MU_S_JOINT_X)).min(1.0);
+            (self.theta_joint() * (1.0 - above)).cos()
+        }
+    }
+
+    /// Inverse of Bruneton's mapping (his `GetRMuMuSNuFromScatteringTextureUvwz`).
+    fn bruneton_mu_s(&self, x: f64) -> f64 {
+        let (h, big_a) = (self.h, self.big_a);
+        let a = (big_a - x * big_a) / (1.0 + x * big_a);
+        let d = self.d_min + a.min(big_a) * (h - self.d_min);
+        if d == 0.0 {
+            1.0
+        } else {
+            clamp_cosine((h * h - d * d) / (2.0 * self.bottom * d))
+        }
     }
 }
 
@@ -340,8 +385,16 @@ pub fn nu_from_u_nu(mu: f64, mu_s: f64, u_nu: f64) -> f64 {
     clamp_cosine(mu * mu_s + s * (1.0 - 2.0 * x * x))
 }
 
-/// The non-linear μ_s coordinate in [0, 1] (Bruneton 2017): from the distance to the top
-/// along the sun ray from the ground, with the configurable minimum sun elevation.
+/// The non-linear μ_s coordinate in [0, 1]: Bruneton 2017's (from the distance to the top
+/// along the sun ray from the ground, with the configurable minimum sun elevation) up to a
+/// joint at his coordinate 26/31 (18° elevation for μ_s,min = cos 108°), scaled to [0, 26/39];
+/// above it linear in the sun's zenith angle up to 1 (zenith).
+///
+/// Bruneton's mapping alone puts 5 of 32 samples above 18° and none between 46.4° and 90°:
+/// anti-solar views under a 60° sun read up to +7 % (docs/accuracy.md). At 40 samples the
+/// first 27 are exactly his 32-sample grid's (every sunset and twilight sample stays where
+/// it was) and the other 13 are 5.5° apart up to the zenith. A blend of his mapping with an
+/// angle-linear one (reverted, commit f436594) took samples from the horizon instead.
 #[inline]
 pub fn x_mu_s(radii: &Radii, mu_s: f64) -> f64 {
     MuSMap::new(radii).x(mu_s)
@@ -350,15 +403,7 @@ pub fn x_mu_s(radii: &Radii, mu_s: f64) -> f64 {
 /// Inverse of [`x_mu_s`].
 #[inline]
 pub fn mu_s_from_x(radii: &Radii, x: f64) -> f64 {
-    let MuSMap { d_min, big_a, .. } = MuSMap::new(radii);
-    let h = radii.h();
-    let a = (big_a - x * big_a) / (1.0 + x * big_a);
-    let d = d_min + a.min(big_a) * (h - d_min);
-    if d == 0.0 {
-        1.0
-    } else {
-        clamp_cosine((h * h - d * d) / (2.0 * radii.bottom * d))
-    }
+    MuSMap::new(radii).mu_s(x)
 }
 
 /// Inverse of [`scattering_uvwz`]: (r, μ, μ_s, ν, ray hits ground).
@@ -540,6 +585,19 @@ mod tests {
         }
         // Degenerate range (view or sun at the zenith): every u_ν is the same direction.
         assert_eq!(nu_from_u_nu(1.0, 0.3, 0.2), 0.3);
+    }
+
+    #[test]
+    fn mu_s_samples_below_the_joint_are_brunetons_32() {
+        // Bruneton's mapping alone, inverted at his sample i of 32 (params before the joint).
+        let map = MuSMap::new(&G);
+        for i in 0..=26 {
+            let (mu_s, x) = (map.bruneton_mu_s(i as f64 / 31.0), i as f64 / 39.0);
+            assert!((mu_s_from_x(&G, x) - mu_s).abs() < 1e-12, "sample {i}");
+            assert!((x_mu_s(&G, mu_s) - x).abs() < 1e-10, "sample {i}");
+        }
+        assert_eq!(mu_s_from_x(&G, 1.0), 1.0);
+        assert!((x_mu_s(&G, 1.0) - 1.0).abs() < 1e-12 && x_mu_s(&G, G.mu_s_min).abs() < 1e-9);
     }
 
     #[test]
