@@ -168,13 +168,7 @@ fn single_scattering_skies(
                             }
                         }
                     }
-                    if sparse.iter().all(|v| *v > 0.0) && dense_f.iter().all(|v| *v > 0.0) {
-                        out.push(TrainingSpectrum {
-                            at_samples: sparse,
-                            on_grid: onto_grid(dense.wavelengths.nm(), &dense_f),
-                            weight: 1.0,
-                        });
-                    }
+                    out.extend(training(dense, sparse, &dense_f));
                 }
             }
         }
@@ -200,22 +194,10 @@ fn direct_beams(model: &Model, dense: &Model) -> Vec<TrainingSpectrum> {
             model.columns_along_ray(r, mu_s, to_top, 16, &mut columns);
             let beam = |m: &Model| -> Vec<f64> {
                 (0..m.channels())
-                    .map(|k| {
-                        let tau: f64 = (m.constituents.iter().zip(&columns))
-                            .map(|(c, col)| col * c.extinction[k])
-                            .sum();
-                        (-tau).exp()
-                    })
+                    .map(|k| (-optical_depth(m, k, &[&columns])).exp())
                     .collect()
             };
-            let (sparse, dense_f) = (beam(model), beam(dense));
-            if sparse.iter().all(|v| *v > 0.0) && dense_f.iter().all(|v| *v > 0.0) {
-                out.push(TrainingSpectrum {
-                    at_samples: sparse,
-                    on_grid: onto_grid(dense.wavelengths.nm(), &dense_f),
-                    weight: 1.0,
-                });
-            }
+            out.extend(training(dense, beam(model), &beam(dense)));
         }
     }
     out
@@ -239,12 +221,7 @@ fn add_scattering(
     out: &mut [f64],
 ) {
     for (k, o) in out.iter_mut().enumerate() {
-        let tau: f64 = m
-            .constituents
-            .iter()
-            .zip(columns.iter().zip(to_sun))
-            .map(|(c, (a, b))| (a + b) * c.extinction[k])
-            .sum();
+        let tau = optical_depth(m, k, &[columns, to_sun]);
         let source: f64 = m
             .constituents
             .iter()
@@ -258,14 +235,28 @@ fn add_scattering(
 /// Adds the Lambertian ground's reflection of the direct sun, `a·μ_s·T_sun·T_view/π`.
 fn add_ground(m: &Model, columns: &[f64], to_sun: &[f64], mu_s: f64, out: &mut [f64]) {
     for (k, o) in out.iter_mut().enumerate() {
-        let tau: f64 = m
-            .constituents
-            .iter()
-            .zip(columns.iter().zip(to_sun))
-            .map(|(c, (a, b))| (a + b) * c.extinction[k])
-            .sum();
+        let tau = optical_depth(m, k, &[columns, to_sun]);
         *o += m.ground_albedo[k] * mu_s * (-tau).exp() / std::f64::consts::PI;
     }
+}
+
+/// Optical depth of channel k of `m` along paths given by their constituent columns (m).
+fn optical_depth(m: &Model, k: usize, paths: &[&[f64]]) -> f64 {
+    (m.constituents.iter().enumerate())
+        .map(|(i, c)| paths.iter().map(|p| p[i]).sum::<f64>() * c.extinction[k])
+        .sum()
+}
+
+/// A training spectrum from its samples and its dense values (`dense`'s grid), if both are
+/// positive everywhere (a relative fit needs a target).
+fn training(dense: &Model, sparse: Vec<f64>, dense_f: &[f64]) -> Option<TrainingSpectrum> {
+    (sparse.iter().all(|v| *v > 0.0) && dense_f.iter().all(|v| *v > 0.0)).then(|| {
+        TrainingSpectrum {
+            at_samples: sparse,
+            on_grid: onto_grid(dense.wavelengths.nm(), dense_f),
+            weight: 1.0,
+        }
+    })
 }
 
 /// A spectrum sampled on `nm` (increasing) linearly interpolated onto the 1-nm grid, ends
