@@ -181,13 +181,16 @@ fn single_scattering_matches_direct_quadrature_in_a_thin_homogeneous_atmosphere(
         mu_s_min: model.mu_s_min,
     };
     let mut checked = 0;
-    for &(x, y, z) in &[
-        (5 * 16 + 12, 50, 3),
-        (7 * 16 + 14, 40, 8),
-        (3 * 16 + 10, 60, 1),
-        (6 * 16 + 15, 20, 5),
-        (2 * 16 + 13, 33, 12),
+    // (ν index, μ_s index counted down from the highest sun, μ, r): x = ν·N_μs + μ_s.
+    let n_mu_s = s.scattering_mu_s;
+    for &(i_nu, from_top, y, z) in &[
+        (5, 4, 50, 3),
+        (7, 2, 40, 8),
+        (3, 6, 60, 1),
+        (6, 1, 20, 5),
+        (2, 3, 33, 12),
     ] {
+        let x = i_nu * n_mu_s + n_mu_s - from_top;
         let (r, mu, mu_s, nu, ground) = params::scattering_texel(&radii, &s, x, y, z);
         if mu_s < 0.2 {
             continue;
