@@ -10,7 +10,6 @@ use firmament::render::{render, Frame, RenderSettings};
 use firmament::scene::{sun_direction, Light, Projection, Ray, Scene, Sphere, Surface};
 use firmament::sky::bruneton4d::Bruneton4d;
 use firmament::sky::{Shadow, SkyMethod};
-use firmament::spectrum::ColourMatrix;
 use firmament_gpu::{GpuContext, GpuRenderer, GpuSky, RenderInputs, RenderTarget};
 
 use common::*;

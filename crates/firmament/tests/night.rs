@@ -17,7 +17,6 @@ use firmament::scene::{Camera, Projection};
 use firmament::scene::{Ray, Scene, Sphere};
 use firmament::sky::bruneton4d::Bruneton4d;
 use firmament::sky::SkyMethod;
-use firmament::spectrum::ColourMatrix;
 
 /// The place along latitude `lat` where the moon stands closest to `altitude` degrees at
 /// `time` in astronomical night (the sun below −18°; longitudes in 0.25° steps).
@@ -46,6 +45,7 @@ fn night_scene<'a>(method: &'a Bruneton4d, sky: &Sky) -> Scene<'a> {
         lights: lights_of(model, sky, true, true),
         background: Some(night_sky_background(model)),
         stars: Vec::new(),
+        aerial_volume: None,
     }
 }
 

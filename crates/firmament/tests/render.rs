@@ -10,7 +10,6 @@ use firmament::render::{self, RenderSettings, ShadeScratch, Shader};
 use firmament::scene::camera::orbit_fit_fov_deg;
 use firmament::scene::{sun_direction, Camera, Light, Projection, Ray, Scene};
 use firmament::sky::SkyMethod;
-use firmament::spectrum::ColourMatrix;
 
 /// Linear sRGB (Y in cd/m²) seen from 2 m along (elevation, azimuth) in degrees.
 fn look(sun: (f64, f64), elevation: f64, azimuth: f64) -> [f64; 3] {

@@ -12,7 +12,6 @@ use firmament::reference::{self, ReferenceSettings};
 use firmament::scene::{sun_direction, HomogeneousSphere, Ray, Scene, Volume};
 use firmament::sky::bruneton4d::Bruneton4d;
 use firmament::sky::{Shadow, SkyMethod};
-use firmament::spectrum::ColourMatrix;
 
 /// A ball 1 km across, 1.5 km up, 5 km north of the observer: optical depth 0.2 through its
 /// centre, single-scattering albedo `albedo`, forward-scattering HG phase.

@@ -59,6 +59,54 @@ impl GaussLegendre {
     }
 }
 
+/// A Gauss–Legendre rule of any number of nodes on [−1, 1], its nodes found by Newton's
+/// method on P_n from Tricomi's estimate (Abramowitz & Stegun 1964, 25.4.29 and 22.7.10).
+#[derive(Clone, Debug)]
+pub struct GaussLegendreRule {
+    /// The nodes, descending.
+    pub nodes: Vec<f64>,
+    /// Their weights.
+    pub weights: Vec<f64>,
+}
+
+impl GaussLegendreRule {
+    /// The rule of `n` ≥ 1 nodes.
+    pub fn new(n: usize) -> GaussLegendreRule {
+        let n = n.max(1);
+        let mut nodes = Vec::with_capacity(n);
+        let mut weights = Vec::with_capacity(n);
+        for i in 0..n {
+            let mut x = ((i as f64 + 0.75) / (n as f64 + 0.5) * std::f64::consts::PI).cos();
+            let mut dp = 1.0;
+            for _ in 0..100 {
+                // P_n(x) and P_{n−1}(x) by the three-term recurrence.
+                let (mut p0, mut p1) = (1.0, x);
+                for k in 2..=n {
+                    (p0, p1) = (
+                        p1,
+                        ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64,
+                    );
+                }
+                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+                let dx = p1 / dp;
+                x -= dx;
+                if dx.abs() < 1e-15 {
+                    break;
+                }
+            }
+            nodes.push(x);
+            weights.push(2.0 / ((1.0 - x * x) * dp * dp));
+        }
+        GaussLegendreRule { nodes, weights }
+    }
+
+    /// The (x, w) pairs of the rule mapped onto [a, b].
+    pub fn on(&self, a: f64, b: f64) -> impl Iterator<Item = (f64, f64)> + '_ {
+        let (c, h) = (0.5 * (a + b), 0.5 * (b - a));
+        (self.nodes.iter().zip(&self.weights)).map(move |(x, w)| (c + h * x, h * w))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -72,6 +120,23 @@ mod tests {
             let got = rule.integrate(0.0, 2.0, 1, |x| x.powi(degree));
             let want = 2f64.powi(degree + 1) / (degree + 1) as f64;
             assert!((got / want - 1.0).abs() < 1e-13, "{got} {want}");
+        }
+    }
+
+    #[test]
+    fn rules_of_any_size_match_the_tabulated_ones_and_their_degree() {
+        let eight = GaussLegendreRule::new(8);
+        let mut nodes: Vec<f64> = eight.nodes.iter().filter(|x| **x > 0.0).copied().collect();
+        nodes.reverse();
+        for (a, b) in nodes.iter().zip(GL8.nodes) {
+            assert!((a - b).abs() < 1e-14, "{a} {b}");
+        }
+        for n in [1, 2, 5, 13] {
+            let rule = GaussLegendreRule::new(n);
+            let degree = 2 * n as i32 - 1;
+            let got: f64 = rule.on(0.0, 2.0).map(|(x, w)| w * x.powi(degree)).sum();
+            let want = 2f64.powi(degree + 1) / (degree + 1) as f64;
+            assert!((got / want - 1.0).abs() < 1e-12, "n {n}: {got} {want}");
         }
     }
 

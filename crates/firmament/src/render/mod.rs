@@ -7,6 +7,7 @@
 //! surfaces for the nearest hit and for the shadows they cast, the volumes for their medium,
 //! the lights for their disks. A second surface or light needs no change here.
 
+pub mod aerial_volume;
 pub mod air_volume;
 pub mod cube_layout;
 pub mod disk_edges;
@@ -83,6 +84,8 @@ pub struct Shader<'s> {
     /// The sky's radiance per light for the irradiance of surfaces under a horizon
     /// ([`sky_dome`]); none: their [`crate::scene::Surface::sky_visibility`] alone.
     domes: Option<Arc<Vec<sky_dome::SkyDome>>>,
+    /// The aerial-perspective volume per light ([`aerial_volume`]), when built.
+    aerial: Vec<Option<aerial_volume::AerialVolume>>,
 }
 
 /// Per-thread scratch space of [`Shader::shade`] (no allocation per pixel).
@@ -140,6 +143,35 @@ impl<'s> Shader<'s> {
         self
     }
 
+    /// With an aerial-perspective volume per light for `camera` drawing a `width` ×
+    /// `height` image (from this shader's observer), which surfaces' aerial perspective
+    /// then reads where it can ([`aerial_volume`]).
+    pub fn with_aerial_volumes(
+        mut self,
+        observer: crate::math::Vec3,
+        camera: &crate::scene::PreparedCamera,
+        width: usize,
+        height: usize,
+        config: aerial_volume::AerialVolumeConfig,
+    ) -> Result<Shader<'s>> {
+        config.validate()?;
+        self.aerial = (self.views.iter())
+            .map(|v| {
+                aerial_volume::AerialVolume::new(
+                    v.as_ref(),
+                    observer,
+                    self.scene.sky.model().bottom_radius_m,
+                    camera,
+                    width,
+                    height,
+                    config,
+                    self.channels,
+                )
+            })
+            .collect();
+        Ok(self)
+    }
+
     /// The lights' disks left out of the sky.
     pub fn without_disks(mut self) -> Shader<'s> {
         self.disks.clear();
@@ -149,12 +181,29 @@ impl<'s> Shader<'s> {
     /// [`Shader::new`] without the terrain's change of the air's light: the sky method's
     /// air over a smooth planet, with the surfaces' shadows.
     pub fn plain(scene: &'s Scene<'s>, observer: crate::math::Vec3) -> Result<Shader<'s>> {
+        Shader::with_views(scene, observer, false)
+    }
+
+    /// [`Shader::plain`] for a few rays only (the terrain's air field at points of the
+    /// air): the sky method's probe views ([`crate::sky::SkyMethod::probe`]).
+    pub fn probe(scene: &'s Scene<'s>, observer: crate::math::Vec3) -> Result<Shader<'s>> {
+        Shader::with_views(scene, observer, true)
+    }
+
+    fn with_views(
+        scene: &'s Scene<'s>,
+        observer: crate::math::Vec3,
+        probe: bool,
+    ) -> Result<Shader<'s>> {
         let channels = scene.sky.model().channels();
         crate::spectrum::check_channels(channels, "rendering")?;
         let views = scene
             .lights
             .iter()
-            .map(|light| scene.sky.view(observer, light))
+            .map(|light| match probe {
+                true => scene.sky.probe(observer, light),
+                false => scene.sky.view(observer, light),
+            })
             .collect();
         let disks = (scene.lights.iter().enumerate())
             .filter(|(_, light)| light.visible_disk)
@@ -167,6 +216,7 @@ impl<'s> Shader<'s> {
             channels,
             air: None,
             domes: None,
+            aerial: Vec::new(),
         })
     }
 
@@ -206,7 +256,13 @@ impl<'s> Shader<'s> {
                             sky[k] *= if open > 0.0 { share[k] / open } else { 0.0 };
                         }
                     }
-                    view.sky_radiance_to_point(hit.position, shadow, l, t);
+                    let from_volume = match (shadow, self.aerial.get(j)) {
+                        (Shadow::None, Some(Some(v))) => v.sample(ray.dir, hit.distance_m, l, t),
+                        _ => false,
+                    };
+                    if !from_volume {
+                        view.sky_radiance_to_point(hit.position, shadow, l, t);
+                    }
                     // A specular lobe (the sea's glint) on the direct beam.
                     let to_light = view.light().direction;
                     let glint = scene.surfaces[i].specular(&hit, -ray.dir, to_light);
@@ -296,6 +352,9 @@ pub fn render(
     let observer =
         crate::math::Vec3::new(0.0, 0.0, model.bottom_radius_m + settings.camera.altitude_m);
     let mut shader = Shader::new(scene, observer)?;
+    if let Some(config) = scene.aerial_volume {
+        shader = shader.with_aerial_volumes(observer, &prepared, w, h, config)?;
+    }
     let points = stars::small_disks(&scene.lights, &prepared, w, h);
     shader
         .disks

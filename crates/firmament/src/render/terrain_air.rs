@@ -136,8 +136,8 @@ pub fn scattering_change(
     let model = scene.sky.model();
     let n = model.channels();
     let smooth = smooth_scene(scene);
-    let with = Shader::plain(scene, x)?.without_disks().with_sky_domes();
-    let without = Shader::plain(&smooth, x)?;
+    let with = Shader::probe(scene, x)?.without_disks().with_sky_domes();
+    let without = Shader::probe(&smooth, x)?;
     let directions: Vec<Vec3> = dirs.iter().map(|d| d.0).collect();
     let mut dl = vec![0.0; directions.len() * n];
     radiance_change(&with, &without, x, &directions, &mut dl);
@@ -216,10 +216,10 @@ impl<'a> AirField<'a> {
                 let (column, level) = (p / LEVELS_M.len(), p % LEVELS_M.len());
                 let (u, v) = column_plane(bounds, column % COLUMNS, column / COLUMNS);
                 let x = plane_point(radius, u, v, ground[column] + LEVELS_M[level]);
-                let with = Shader::plain(scene, x)?
+                let with = Shader::probe(scene, x)?
                     .without_disks()
                     .with_domes(domes.clone());
-                let without = Shader::plain(&smooth, x)?;
+                let without = Shader::probe(&smooth, x)?;
                 let mut dl = vec![0.0; per_point];
                 radiance_change(&with, &without, x, &directions, &mut dl);
                 for (o, d) in out.iter_mut().zip(&dl) {

@@ -248,6 +248,11 @@ impl PreparedCamera {
         (self.forward, self.right, self.up)
     }
 
+    /// The projection.
+    pub fn projection(&self) -> Projection {
+        self.camera.projection
+    }
+
     /// tan(fov/2) of the pinhole projections.
     pub fn tan_half_fov(&self) -> f64 {
         self.tan_half_fov

@@ -45,6 +45,9 @@ pub struct Scene<'a> {
     pub background: Option<sky_lights::Background>,
     /// Point lights outside the atmosphere drawn into images (the stars), seen through it.
     pub stars: Vec<sky_lights::PointSource>,
+    /// Surfaces' aerial perspective from a froxel volume per light rather than per pixel
+    /// ([`crate::render::aerial_volume`]); None: per pixel.
+    pub aerial_volume: Option<crate::render::aerial_volume::AerialVolumeConfig>,
 }
 
 impl<'a> Scene<'a> {
@@ -59,6 +62,7 @@ impl<'a> Scene<'a> {
             lights: vec![Light::sun(model, sun_direction, sun_disk)],
             background: None,
             stars: Vec::new(),
+            aerial_volume: None,
         }
     }
 

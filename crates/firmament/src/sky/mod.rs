@@ -14,11 +14,20 @@
 //! other than the one the method was built for (the moon lighting the sun's tables) scales
 //! the results by its own irradiance.
 //!
-//! Methods: [`bruneton4d`] (Bruneton & Neyret 2008, the 4D precomputed tables).
+//! Methods: [`bruneton4d`] (Bruneton & Neyret 2008, the 4D precomputed tables),
+//! [`hillaire2020`] (Hillaire 2020: transmittance, multiple-scattering and sky-view tables
+//! and a ray march), [`elek3d`] (Elek 2009 with Yusov 2013's parameterisation: a 3D table
+//! without the view–sun azimuth, as Frostbite 2016 uses it).
 
 pub mod bruneton4d;
+pub mod elek3d;
+pub mod entry;
+pub mod hillaire2020;
+pub mod surface_irradiance;
 
 pub use bruneton4d::Bruneton4d;
+pub use elek3d::Elek3d;
+pub use hillaire2020::Hillaire2020;
 
 use crate::atmosphere::Model;
 use crate::math::Vec3;
@@ -54,6 +63,14 @@ pub trait SkyMethod: Send + Sync {
     /// A light other than the model's sun scales every answer by its irradiance over the
     /// model's [`Model::solar_irradiance`].
     fn view<'a>(&'a self, observer: Vec3, light: &'a Light) -> Box<dyn SkyView + 'a>;
+
+    /// A view for a few rays only (a few hundred: the terrain's air field at points of the
+    /// air, a probe at a point): a method whose per-view cache costs more than marching
+    /// that many rays (Hillaire's sky-view table) may leave it out. The answers are the
+    /// method's either way; by default the same as [`SkyMethod::view`].
+    fn probe<'a>(&'a self, observer: Vec3, light: &'a Light) -> Box<dyn SkyView + 'a> {
+        self.view(observer, light)
+    }
 }
 
 /// A sky method prepared for one observer and one light. Outputs are per channel of the

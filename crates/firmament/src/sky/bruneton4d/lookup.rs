@@ -10,7 +10,8 @@ use super::params::{self, Radii, TableSizes};
 use super::table::{Table2, MAX_OPTICAL_DEPTH};
 use crate::atmosphere::Model;
 use crate::math::smoothstep;
-use crate::math::sphere::{advance, safe_sqrt};
+use crate::math::sphere::{advance, distance_to_enter_sphere, safe_sqrt};
+use crate::math::Vec3;
 use crate::spectrum::with_channel_buffers;
 
 /// What a lookup needs: the model's radii, the sizes and the transmittance table (as
@@ -105,6 +106,23 @@ impl<'a> Lookup<'a> {
         }
         self.transmittance_to_top(r, mu_s, out);
         out.iter_mut().for_each(|o| *o *= fraction);
+    }
+
+    /// Transmittance from `point` (planet-centred, m; above the atmosphere too) to a light
+    /// in unit direction `light`, with the planet's occlusion of its disk: above the top,
+    /// along the light's ray from where it enters the atmosphere (1 when it misses it).
+    pub fn transmittance_to_light(&self, point: Vec3, light: Vec3, out: &mut [f64]) {
+        let r = point.length();
+        let top = self.radii.top;
+        if r > top {
+            let rmu = point.dot(light);
+            match distance_to_enter_sphere(r, rmu, top) {
+                Some(d) => self.transmittance_to_sun(top, ((rmu + d) / top).clamp(-1.0, 1.0), out),
+                None => out.iter_mut().for_each(|v| *v = 1.0),
+            }
+            return;
+        }
+        self.transmittance_to_sun(r, (point.dot(light) / r).clamp(-1.0, 1.0), out);
     }
 
     /// Visible fraction of the sun's disk above the planet at (r, μ_s), smoothstep in μ_s

@@ -12,9 +12,10 @@
 use super::lookup::Lookup;
 use super::{params, twilight, Bruneton4d, MieStorage};
 use crate::atmosphere::groups::{AEROSOLS, MOLECULES};
-use crate::math::sphere::{advance, distance_to_enter_sphere, ray_intersects_ground};
+use crate::math::sphere::{advance, ray_intersects_ground};
 use crate::math::{smoothstep, Vec3};
 use crate::scene::light::Light;
+use crate::sky::entry::{enter_atmosphere, Entry};
 use crate::sky::{Shadow, SkyView};
 use crate::spectrum::with_channel_buffers;
 
@@ -38,17 +39,6 @@ pub struct Bruneton4dView<'a> {
 struct Slice {
     scattering: Vec<f64>,
     mie: Vec<f64>,
-}
-
-/// Where a view ray starts in the atmosphere.
-struct Start {
-    /// The start point (m).
-    point: Vec3,
-    /// Its radius (m) and r·μ along the ray.
-    r: f64,
-    rmu: f64,
-    /// Whether it is the observer itself (so the slice applies).
-    at_observer: bool,
 }
 
 /// Where a table lookup reads: the slice at (u_ν, u_μ), or the 4D tables at (u_ν, u_μs,
@@ -105,29 +95,16 @@ impl<'a> Bruneton4dView<'a> {
 
     /// Where the ray from the observer along `dir` enters the atmosphere: the observer
     /// itself when inside, else the entry point of the top; None when the ray misses it.
-    fn start(&self, dir: Vec3) -> Option<Start> {
-        let top = self.sky.model.top_radius_m;
-        let camera = self.observer;
-        let r = self.observer_r;
-        let rmu = camera.dot(dir);
-        if r <= top {
-            return Some(Start {
-                point: camera,
-                r,
-                rmu,
-                at_observer: true,
-            });
-        }
-        let d = distance_to_enter_sphere(r, rmu, top)?;
-        Some(Start {
-            point: camera + dir * d,
-            r: top,
-            rmu: rmu + d,
-            at_observer: false,
-        })
+    fn start(&self, dir: Vec3) -> Option<Entry> {
+        enter_atmosphere(
+            self.observer,
+            self.observer_r,
+            dir,
+            self.sky.model.top_radius_m,
+        )
     }
 
-    fn geometry(&self, start: &Start, dir: Vec3) -> RayGeometry {
+    fn geometry(&self, start: &Entry, dir: Vec3) -> RayGeometry {
         let r = start.r;
         let mu = (start.rmu / r).clamp(-1.0, 1.0);
         RayGeometry {
@@ -395,7 +372,7 @@ impl SkyView for Bruneton4dView<'_> {
             }
             Shadow::Lit(intervals) => {
                 // A camera in space starts where the ray enters the top.
-                let offset = (start.point - self.observer).length();
+                let offset = start.offset_m(self.observer);
                 let shifted = intervals.iter().map(|&(a, b)| (a - offset, b - offset));
                 let length = self.boundary_distance(&ray);
                 self.shafted_radiance(&ray, shifted, length, true, &[], 1.0, radiance)
@@ -460,7 +437,7 @@ impl SkyView for Bruneton4dView<'_> {
                 )
             }
             Shadow::Lit(intervals) => {
-                let offset = (start.point - self.observer).length();
+                let offset = start.offset_m(self.observer);
                 let shifted = intervals.iter().map(|&(a, b)| (a - offset, b - offset));
                 self.shafted_radiance(&ray, shifted, d_total, false, t, fade, radiance)
             }
@@ -479,21 +456,8 @@ impl SkyView for Bruneton4dView<'_> {
     }
 
     fn transmittance_to_light(&self, point: Vec3, out: &mut [f64]) {
-        let r = point.length();
-        let light = self.light.direction;
-        let lk = &self.lookup;
-        let top = self.sky.model.top_radius_m;
-        if r > top {
-            // Above the atmosphere: enter it along the light's ray, or see the light
-            // unobstructed.
-            let rmu = point.dot(light);
-            match distance_to_enter_sphere(r, rmu, top) {
-                Some(d) => lk.transmittance_to_sun(top, ((rmu + d) / top).clamp(-1.0, 1.0), out),
-                None => out.iter_mut().for_each(|v| *v = 1.0),
-            }
-            return;
-        }
-        lk.transmittance_to_sun(r, (point.dot(light) / r).clamp(-1.0, 1.0), out);
+        self.lookup
+            .transmittance_to_light(point, self.light.direction, out);
     }
 
     fn sun_and_sky_irradiance(
@@ -503,33 +467,21 @@ impl SkyView for Bruneton4dView<'_> {
         direct: &mut [f64],
         sky: &mut [f64],
     ) {
-        let n = self.channels();
-        let model = &self.sky.model;
-        let lk = &self.lookup;
-        let light = self.light.direction;
-        let length = point.length();
-        let cos = normal.dot(light).max(0.0);
-        if length > model.top_radius_m {
-            // In space: the light's direct beam only (the tables hold the sky's light from
-            // above, and there is no air above).
-            sky[..n].iter_mut().for_each(|v| *v = 0.0);
-            self.transmittance_to_light(point, direct);
-            for k in 0..n {
-                direct[k] *= self.light.irradiance[k] * cos;
-            }
-            return;
-        }
-        let r = length.max(model.bottom_radius_m);
-        let mu_s = (point.dot(light) / length).clamp(-1.0, 1.0);
-        twilight::sky_irradiance(lk, &self.sky.tables.irradiance, r, mu_s, sky);
-        let occlusion = (1.0 + normal.dot(point) / length) * 0.5;
-        for (v, s) in sky[..n].iter_mut().zip(&self.scale) {
-            *v *= occlusion * s;
-        }
-        lk.transmittance_to_sun(r, mu_s, direct);
-        for k in 0..n {
-            direct[k] *= self.light.irradiance[k] * cos;
-        }
+        let irradiance = &self.sky.tables.irradiance;
+        crate::sky::surface_irradiance::sun_and_sky_irradiance(
+            &self.lookup,
+            self.light,
+            point,
+            normal,
+            |r, mu_s, out| {
+                twilight::sky_irradiance(&self.lookup, irradiance, r, mu_s, out);
+                for (v, s) in out.iter_mut().zip(&self.scale) {
+                    *v *= s;
+                }
+            },
+            direct,
+            sky,
+        );
     }
 }
 

@@ -38,7 +38,7 @@ use order_tail::{add_scaled, cap_by_energy, table_mean, table_mean_radiance};
 use phase_kernels::PhaseKernels;
 use scattering_density::compute_scattering_density;
 use single_scattering::compute_single_scattering;
-pub use transmittance::compute_optical_depth;
+pub use transmittance::{compute_optical_depth, compute_optical_depth_in};
 
 use crate::spectrum::MAX_CHANNELS;
 

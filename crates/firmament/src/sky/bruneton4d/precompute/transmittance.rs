@@ -11,6 +11,11 @@ use crate::sky::bruneton4d::table::{Table2, MAX_OPTICAL_DEPTH};
 /// τ(r, μ) to the top, capped at [`MAX_OPTICAL_DEPTH`]: 4-point Gauss–Legendre on the
 /// constituents' columns (exact optical depths per constituent, then the per-wavelength sum).
 pub fn compute_optical_depth(model: &Model, s: &TableSizes) -> Table2 {
+    compute_optical_depth_in(model, s, TRANSMITTANCE_SEGMENTS)
+}
+
+/// [`compute_optical_depth`] with `segments` Gauss–Legendre segments per ray.
+pub fn compute_optical_depth_in(model: &Model, s: &TableSizes, segments: usize) -> Table2 {
     let n = model.channels();
     let radii = Radii {
         bottom: model.bottom_radius_m,
@@ -31,7 +36,7 @@ pub fn compute_optical_depth(model: &Model, s: &TableSizes) -> Table2 {
                 let (r, mu) =
                     params::transmittance_r_mu(&radii, u, v, s.transmittance_mu, s.transmittance_r);
                 let d = crate::math::sphere::distance_to_top_atmosphere_boundary(r, mu, radii.top);
-                model.columns_along_ray(r, mu, d, TRANSMITTANCE_SEGMENTS, &mut columns);
+                model.columns_along_ray(r, mu, d, segments, &mut columns);
                 model.optical_depth_from_columns(&columns, &mut tau);
                 for k in 0..n {
                     row[x * n + k] = tau[k].min(MAX_OPTICAL_DEPTH as f64) as f32;

@@ -1,0 +1,218 @@
+//! The aerial-perspective volume (Hillaire 2016 §2, "Our approach"; Hillaire 2020 §5.4): a
+//! camera-aligned froxel grid holding the in-scattered radiance and the transmittance
+//! between the observer and points along each froxel column's direction, at depth slices
+//! spread quadratically out to a maximum distance, filled once per frame and light from the
+//! sky method's own [`SkyView::sky_radiance_to_point`], so every method can use it. A surface
+//! hit then reads its aerial perspective by one trilinear lookup at its pixel's direction
+//! and distance instead of asking the method (a march for Hillaire 2020, a pair of 4D
+//! lookups for the tables).
+//!
+//! What it leaves to the per-pixel path: rays with light shafts (the volume holds fully lit
+//! rays), points beyond its last slice, directions outside the image (a fisheye's corners),
+//! points within a slice of the planet's ground sphere along their column (the froxels
+//! beyond it would lie under the ground: the sphere's own pixels, not the terrain's), and
+//! cube maps (froxels would straddle faces). Its error against the per-pixel answer is
+//! measured in docs/accuracy.md and `tests/aerial_volume.rs`.
+
+use rayon::prelude::*;
+
+use crate::math::Vec3;
+use crate::scene::{PreparedCamera, Projection};
+use crate::sky::{Shadow, SkyView};
+use crate::spectrum::with_channel_buffers;
+use crate::{Error, Result};
+
+/// The volume's size and reach.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AerialVolumeConfig {
+    /// Froxel columns across the image.
+    pub width: usize,
+    /// Froxel rows down the image.
+    pub height: usize,
+    /// Depth slices (quadratic in distance: denser near the camera).
+    pub slices: usize,
+    /// The last slice's far distance (m); beyond it the per-pixel path answers.
+    pub max_distance_m: f64,
+}
+
+impl Default for AerialVolumeConfig {
+    /// Hillaire 2020's 32³ froxels over 32 km.
+    fn default() -> Self {
+        AerialVolumeConfig {
+            width: 32,
+            height: 32,
+            slices: 32,
+            max_distance_m: 32_000.0,
+        }
+    }
+}
+
+impl AerialVolumeConfig {
+    /// Refuse sizes and distances that cannot work.
+    pub fn validate(&self) -> Result<()> {
+        for (field, v) in [
+            ("aerial_volume.width", self.width),
+            ("aerial_volume.height", self.height),
+            ("aerial_volume.slices", self.slices),
+        ] {
+            if !(2..=512).contains(&v) {
+                return Err(Error::invalid(field, v, "an integer from 2 to 512"));
+            }
+        }
+        if !(self.max_distance_m.is_finite() && self.max_distance_m > 0.0) {
+            return Err(Error::invalid(
+                "aerial_volume.max_distance_m",
+                self.max_distance_m,
+                "a positive number of metres",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// One light's volume for one camera.
+pub struct AerialVolume {
+    config: AerialVolumeConfig,
+    camera: PreparedCamera,
+    /// The image's size (pixels), which the froxel columns divide.
+    image: (f64, f64),
+    channels: usize,
+    /// Per froxel (x, y, slice), radiance then transmittance per channel; NaN where the
+    /// column's direction is outside the projection.
+    data: Vec<f32>,
+}
+
+impl AerialVolume {
+    /// The volume of `view` (from `observer`, planet-centred m, over a ground sphere of
+    /// radius `ground_radius_m`) for the camera `camera` drawing a `width` × `height` image;
+    /// None for a cube map.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        view: &dyn SkyView,
+        observer: Vec3,
+        ground_radius_m: f64,
+        camera: &PreparedCamera,
+        width: usize,
+        height: usize,
+        config: AerialVolumeConfig,
+        channels: usize,
+    ) -> Option<AerialVolume> {
+        if camera.projection() == Projection::Cubemap {
+            return None;
+        }
+        let (w, h, d) = (config.width, config.height, config.slices);
+        let stride = 2 * channels;
+        let mut data = vec![0.0f32; w * h * d * stride];
+        data.par_chunks_mut(d * stride)
+            .enumerate()
+            .for_each(|(column, out)| {
+                let (x, y) = (column % w, column / w);
+                let px = (x as f64 + 0.5) / w as f64 * width as f64;
+                let py = (y as f64 + 0.5) / h as f64 * height as f64;
+                let Some(ray) = camera.ray(px, py) else {
+                    out.iter_mut().for_each(|v| *v = f32::NAN);
+                    return;
+                };
+                with_channel_buffers(channels, |[l, t]| {
+                    for (z, froxel) in out.chunks_mut(stride).enumerate() {
+                        let distance = slice_distance(z, d, config.max_distance_m);
+                        let point = observer + ray.dir * distance;
+                        if point.length() < ground_radius_m {
+                            froxel.iter_mut().for_each(|v| *v = f32::NAN);
+                            continue;
+                        }
+                        view.sky_radiance_to_point(point, Shadow::None, l, t);
+                        for k in 0..channels {
+                            froxel[k] = l[k] as f32;
+                            froxel[channels + k] = t[k] as f32;
+                        }
+                    }
+                });
+            });
+        Some(AerialVolume {
+            config,
+            camera: camera.clone(),
+            image: (width as f64, height as f64),
+            channels,
+            data,
+        })
+    }
+
+    /// The radiance scattered towards the observer before `distance` (m) along unit `dir`
+    /// and the transmittance there, into `radiance` and `transmittance`; false (nothing
+    /// written) where the volume does not answer: beyond its reach, outside the image.
+    pub fn sample(
+        &self,
+        dir: Vec3,
+        distance: f64,
+        radiance: &mut [f64],
+        transmittance: &mut [f64],
+    ) -> bool {
+        let c = &self.config;
+        if distance.is_nan() || distance < 0.0 || distance > c.max_distance_m {
+            return false;
+        }
+        let Some((px, py)) = self.camera.pixel_of(dir) else {
+            return false;
+        };
+        let (x0, x1, tx) = weights(px / self.image.0 * c.width as f64 - 0.5, c.width);
+        let (y0, y1, ty) = weights(py / self.image.1 * c.height as f64 - 0.5, c.height);
+        // The slice coordinate; before the first slice's centre, towards (0, T = 1) at the
+        // observer.
+        let s = (distance / c.max_distance_m).sqrt() * c.slices as f64 - 0.5;
+        let (z0, z1, tz, near) = if s < 0.0 {
+            (0, 0, 0.0, (s + 0.5) / 0.5)
+        } else {
+            let (a, b, t) = weights(s, c.slices);
+            (a, b, t, 1.0)
+        };
+        let n = self.channels;
+        let stride = 2 * n;
+        radiance[..n].iter_mut().for_each(|v| *v = 0.0);
+        transmittance[..n].iter_mut().for_each(|v| *v = 0.0);
+        for (y, wy) in [(y0, 1.0 - ty), (y1, ty)] {
+            for (x, wx) in [(x0, 1.0 - tx), (x1, tx)] {
+                for (z, wz) in [(z0, 1.0 - tz), (z1, tz)] {
+                    let w = wx * wy * wz;
+                    if w == 0.0 {
+                        continue;
+                    }
+                    let i = ((y * c.width + x) * c.slices + z) * stride;
+                    let froxel = &self.data[i..i + stride];
+                    if froxel[0].is_nan() {
+                        return false;
+                    }
+                    for k in 0..n {
+                        radiance[k] += w * froxel[k] as f64;
+                        transmittance[k] += w * froxel[n + k] as f64;
+                    }
+                }
+            }
+        }
+        if near < 1.0 {
+            for k in 0..n {
+                radiance[k] *= near;
+                transmittance[k] = 1.0 - near * (1.0 - transmittance[k]);
+            }
+        }
+        true
+    }
+}
+
+/// The far distance (m) of slice `z` of `slices` out to `max`: quadratic, so the first
+/// slices are close to the camera, where terrain is densest on screen.
+#[inline]
+fn slice_distance(z: usize, slices: usize, max: f64) -> f64 {
+    let f = (z as f64 + 0.5) / slices as f64;
+    max * f * f
+}
+
+/// Linear-filter indices and weight at continuous texel coordinate `x` (texel centres at
+/// integers) over `n` texels, clamped to the edges.
+#[inline]
+fn weights(x: f64, n: usize) -> (usize, usize, f64) {
+    let x = x.clamp(0.0, (n - 1) as f64);
+    let i0 = (x as usize).min(n - 1);
+    let i1 = (i0 + 1).min(n - 1);
+    (i0, i1, x - i0 as f64)
+}

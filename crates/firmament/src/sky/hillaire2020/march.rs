@@ -1,0 +1,309 @@
+//! The ray march of Hillaire 2020 (§4, eq. 1–5 and the released demo's
+//! `IntegrateScatteredLuminance`): along a ray, at samples spread quadratically from its
+//! start, the light scattered once from the sun (its transmittance from the transmittance
+//! table, the planet's shadow included) and the multiple scattering σ_s·Ψ_ms (the
+//! isotropic multiple-scattering table, eq. 10), each step integrated analytically over
+//! its length with the sample's extinction, ∫₀^Δ S·e^{−σ_t t} dt = (S − S·e^{−σ_t Δ})/σ_t
+//! (Hillaire 2015/2016's energy-conserving step), times the throughput so far.
+//!
+//! Everything is per unit irradiance of the light at the top of the atmosphere, per channel
+//! of the model's wavelength grid: radiance W·m⁻²·sr⁻¹·nm⁻¹ per W·m⁻²·nm⁻¹.
+
+use crate::atmosphere::groups::ScatteringGroups;
+use crate::atmosphere::Model;
+use crate::medium::PhaseFunction;
+use crate::sky::bruneton4d::Lookup;
+use crate::spectrum::with_channel_buffers;
+
+use super::harmonics;
+use super::multiple_scattering::MultipleScattering;
+use super::params::altitude_mu_s_uv;
+
+/// The extinction and scattering of the air at an altitude, per constituent: what the
+/// march reads at each sample.
+pub(crate) struct Medium<'a> {
+    pub model: &'a Model,
+    /// Whether each constituent scatters (absorbers do not).
+    scatters: Vec<bool>,
+}
+
+impl<'a> Medium<'a> {
+    pub fn new(model: &'a Model) -> Medium<'a> {
+        let scatters = model
+            .constituents
+            .iter()
+            .map(|c| ScatteringGroups::group_of(c).is_some())
+            .collect();
+        Medium { model, scatters }
+    }
+
+    /// At `altitude_m`: the extinction σ_t (m⁻¹) into `sigma_t`, the scattering σ_s (m⁻¹)
+    /// into `sigma_s`, and Σ_c ρ_c·β_c·p_c into `phased` where `phases[c]` is constituent
+    /// c's phase function at the ray's scattering angle (skipped when `phases` is empty);
+    /// each constituent's density into `densities`.
+    #[inline]
+    pub fn coefficients(
+        &self,
+        altitude_m: f64,
+        phases: &[f64],
+        sigma_t: &mut [f64],
+        sigma_s: &mut [f64],
+        phased: &mut [f64],
+        densities: &mut [f64],
+    ) {
+        sigma_t.iter_mut().for_each(|v| *v = 0.0);
+        sigma_s.iter_mut().for_each(|v| *v = 0.0);
+        phased.iter_mut().for_each(|v| *v = 0.0);
+        let n = sigma_t.len();
+        for (i, c) in self.model.constituents.iter().enumerate() {
+            let rho = c.density.density(altitude_m);
+            densities[i] = rho;
+            if rho <= 0.0 {
+                continue;
+            }
+            for k in 0..n {
+                sigma_t[k] += rho * c.extinction[k];
+            }
+            if self.scatters[i] {
+                for k in 0..n {
+                    sigma_s[k] += rho * c.scattering[k];
+                }
+                if !phases.is_empty() {
+                    let w = rho * phases[i];
+                    for k in 0..n {
+                        phased[k] += w * c.scattering[k];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Whether constituent `i` scatters.
+    #[inline]
+    pub fn scatters(&self, i: usize) -> bool {
+        self.scatters[i]
+    }
+
+    /// Each constituent's phase function at the scattering angle cosine `nu`, into `out`.
+    pub fn phases(&self, nu: f64, out: &mut Vec<f64>) {
+        out.clear();
+        out.extend(self.model.constituents.iter().map(|c| c.phase.eval(nu)));
+    }
+
+    /// The isotropic phase 1/(4π) for every constituent (Hillaire's multiple-scattering
+    /// pass, eq. 6–7).
+    pub fn isotropic_phases(&self, out: &mut Vec<f64>) {
+        out.clear();
+        let p = PhaseFunction::Isotropic.eval(1.0);
+        out.extend(self.model.constituents.iter().map(|_| p));
+    }
+}
+
+/// A ray in the atmosphere: its start's radius r (m), the zenith cosines μ of its direction
+/// and μ_s of the light there, ν = cos(view, light), and its length (m) to the boundary it
+/// ends on (or to the point it is marched to).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct MarchRay {
+    pub r: f64,
+    pub mu: f64,
+    pub mu_s: f64,
+    pub nu: f64,
+    pub length: f64,
+}
+
+impl MarchRay {
+    /// The radius and the light's zenith cosine `t` metres along the ray.
+    #[inline]
+    pub fn at(&self, t: f64) -> (f64, f64) {
+        let r_t = (t * t + 2.0 * self.r * self.mu * t + self.r * self.r)
+            .max(0.0)
+            .sqrt();
+        let mu_s_t = ((self.r * self.mu_s + t * self.nu) / r_t.max(1.0)).clamp(-1.0, 1.0);
+        (r_t, mu_s_t)
+    }
+}
+
+/// Which parts of a ray a term is lit over: all of it, or the given increasing, disjoint
+/// intervals (m from the ray's start).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Lit<'a> {
+    All,
+    Intervals(&'a [(f64, f64)]),
+}
+
+impl Lit<'_> {
+    /// The fraction of [a, b] that is lit.
+    #[inline]
+    fn fraction(&self, a: f64, b: f64) -> f64 {
+        match self {
+            Lit::All => 1.0,
+            Lit::Intervals(list) => {
+                if b <= a {
+                    return 0.0;
+                }
+                let covered: f64 = list
+                    .iter()
+                    .map(|&(s, e)| (e.min(b) - s.max(a)).max(0.0))
+                    .sum();
+                (covered / (b - a)).min(1.0)
+            }
+        }
+    }
+}
+
+/// What lights the march: the single scattering's and the multiple scattering's lit parts.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Lighting<'a> {
+    pub single: Lit<'a>,
+    pub multiple: Lit<'a>,
+}
+
+impl Lighting<'_> {
+    pub const ALL: Lighting<'static> = Lighting {
+        single: Lit::All,
+        multiple: Lit::All,
+    };
+}
+
+/// The tables a march reads: transmittance (through `lookup`) and the multiple-scattering
+/// field (None: no multiple-scattering term, the multiple-scattering pass itself).
+pub(crate) struct Marcher<'a> {
+    pub medium: Medium<'a>,
+    pub lookup: Lookup<'a>,
+    pub multiple: Option<&'a MultipleScattering>,
+}
+
+/// The distance (m) from the start to the far end of step `i` of `steps` over `length`:
+/// quadratic, dense near the start where a view ray from the ground meets its densest air
+/// (Hillaire 2020 §5.3 and the demo's non-linear sample distribution).
+#[inline]
+pub(crate) fn step_end(i: usize, steps: usize, length: f64) -> f64 {
+    let f = i as f64 / steps as f64;
+    length * f * f
+}
+
+impl Marcher<'_> {
+    /// Σ over the ray's steps of the throughput so far times the step's analytic integral,
+    /// into `radiance` (per unit light irradiance), and the ray's throughput into
+    /// `transmittance` (both per channel, overwritten). `phases` holds each constituent's
+    /// phase function at the ray's ν (see [`Medium::phases`]). `scattered`, when not
+    /// empty, receives ∫ T·σ_s dt along the ray (Hillaire's eq. 8 integrand before its
+    /// phase function: what f_ms sums).
+    #[allow(clippy::too_many_arguments)]
+    pub fn march(
+        &self,
+        ray: &MarchRay,
+        steps: usize,
+        phases: &[f64],
+        lighting: &Lighting,
+        radiance: &mut [f64],
+        transmittance: &mut [f64],
+        scattered: &mut [f64],
+    ) {
+        scattered.iter_mut().for_each(|v| *v = 0.0);
+        let n = radiance.len();
+        let model = self.medium.model;
+        let (bottom, top) = (model.bottom_radius_m, model.top_radius_m);
+        radiance.iter_mut().for_each(|v| *v = 0.0);
+        transmittance.iter_mut().for_each(|v| *v = 1.0);
+        if ray.length <= 0.0 {
+            return;
+        }
+        // The multiple-scattering field's coefficients at a step, and its harmonics there.
+        let (coefficients, degree) = match self.multiple {
+            Some(ms) => (harmonics::coefficient_count(ms.degree), ms.degree),
+            None => (0, 0),
+        };
+        let mut field = vec![0.0; coefficients * n];
+        let mut y = vec![0.0; coefficients];
+        let mut densities = vec![0.0; model.constituents.len()];
+        with_channel_buffers(n, |[sigma_t, sigma_s, phased, t_sun, psi, by_degree]| {
+            let mut t0 = 0.0;
+            for i in 1..=steps {
+                let t1 = step_end(i, steps, ray.length);
+                let dt = t1 - t0;
+                let t_mid = 0.5 * (t0 + t1);
+                let (r_t, mu_s_t) = ray.at(t_mid);
+                self.medium.coefficients(
+                    r_t - bottom,
+                    phases,
+                    sigma_t,
+                    sigma_s,
+                    phased,
+                    &mut densities,
+                );
+                let lit_single = lighting.single.fraction(t0, t1);
+                let lit_multiple = lighting.multiple.fraction(t0, t1);
+                if lit_single > 0.0 {
+                    self.lookup.transmittance_to_sun(r_t, mu_s_t, t_sun);
+                } else {
+                    t_sun.iter_mut().for_each(|v| *v = 0.0);
+                }
+                psi.iter_mut().for_each(|v| *v = 0.0);
+                if let Some(ms) = self.multiple.filter(|_| lit_multiple > 0.0) {
+                    let table = &ms.table;
+                    let (u, v) =
+                        altitude_mu_s_uv(r_t, bottom, top, mu_s_t, table.width, table.height);
+                    table.sample_into(u, v, &mut field);
+                    if degree == 0 {
+                        y[0] = harmonics::Y00;
+                    } else {
+                        // The ray's direction in the step's frame (its zenith, its azimuth
+                        // from the light's), where the field's harmonics are expressed.
+                        let mu_v = ((ray.r * ray.mu + t_mid) / r_t.max(1.0)).clamp(-1.0, 1.0);
+                        let sines = ((1.0 - mu_v * mu_v) * (1.0 - mu_s_t * mu_s_t))
+                            .max(0.0)
+                            .sqrt();
+                        let cos_phi = if sines > 1e-12 {
+                            ((ray.nu - mu_v * mu_s_t) / sines).clamp(-1.0, 1.0)
+                        } else {
+                            1.0
+                        };
+                        harmonics::eval(degree, mu_v, cos_phi, &mut y);
+                    }
+                    // Σ_c ρ_c β_c Σ_ℓ k_ℓ^c Σ_m Y_ℓm c_ℓm: each constituent's phase function
+                    // applied to the field degree by degree (Funk–Hecke).
+                    for l in 0..=degree {
+                        by_degree.iter_mut().for_each(|v| *v = 0.0);
+                        for m in 0..=l {
+                            let c = harmonics::index(l, m);
+                            let (yc, row) = (y[c], &field[c * n..(c + 1) * n]);
+                            for k in 0..n {
+                                by_degree[k] += yc * row[k];
+                            }
+                        }
+                        for (ci, con) in model.constituents.iter().enumerate() {
+                            let Some(&k_l) = ms.moments[ci].get(l) else {
+                                continue;
+                            };
+                            let w = densities[ci] * k_l;
+                            if w == 0.0 || !self.medium.scatters(ci) {
+                                continue;
+                            }
+                            for k in 0..n {
+                                psi[k] += w * con.scattering[k] * by_degree[k];
+                            }
+                        }
+                    }
+                }
+                for k in 0..n {
+                    let source = lit_single * phased[k] * t_sun[k] + lit_multiple * psi[k];
+                    let tau = sigma_t[k] * dt;
+                    let step_t = (-tau).exp();
+                    // (S − S·e^{−σ_t Δ})/σ_t, → S·Δ as σ_t → 0.
+                    let length = if tau > 1e-9 {
+                        (1.0 - step_t) / sigma_t[k]
+                    } else {
+                        dt
+                    };
+                    radiance[k] += transmittance[k] * source * length;
+                    if !scattered.is_empty() {
+                        scattered[k] += transmittance[k] * sigma_s[k] * length;
+                    }
+                    transmittance[k] *= step_t;
+                }
+                t0 = t1;
+            }
+        });
+    }
+}

@@ -1,0 +1,303 @@
+//! [`Hillaire2020`] seen from one observer under one light: the sky-view table when the
+//! observer is inside the atmosphere and the view is for a frame ([`Hillaire2020View::new`]),
+//! and the ray march for everything else (views from space, rays with shafts, aerial
+//! perspective to a point, probe views at points of the air; Hillaire 2020 §5.3 marches per
+//! pixel from space as well).
+
+use super::march::{Lighting, Lit, MarchRay, Marcher};
+use super::{sky_view, Hillaire2020};
+use crate::math::sphere::{distance_to_nearest_atmosphere_boundary, ray_intersects_ground};
+use crate::math::Vec3;
+use crate::scene::light::Light;
+use crate::sky::bruneton4d::Table2;
+use crate::sky::entry::{enter_atmosphere, Entry};
+use crate::sky::{Shadow, SkyView};
+use crate::spectrum::with_channel_buffers;
+
+/// Hillaire 2020 prepared for one observer and one light.
+pub struct Hillaire2020View<'a> {
+    sky: &'a Hillaire2020,
+    light: &'a Light,
+    marcher: Marcher<'a>,
+    observer: Vec3,
+    observer_r: f64,
+    /// The observer's unit up.
+    up: Vec3,
+    /// The sky-view table at the observer (None from space and for probe views).
+    table: Option<Table2>,
+}
+
+impl<'a> Hillaire2020View<'a> {
+    /// The view from `observer` under `light`; `with_table`: build the sky-view table
+    /// (a frame's view) or march every ray (a probe of a few rays).
+    pub fn new(
+        sky: &'a Hillaire2020,
+        observer: Vec3,
+        light: &'a Light,
+        with_table: bool,
+    ) -> Hillaire2020View<'a> {
+        let mut marcher = sky.marcher();
+        marcher.lookup.sun_angular_radius = light.angular_radius_rad;
+        let model = &sky.model;
+        let observer_r = observer.length().max(model.bottom_radius_m);
+        let up = observer.normalize_or_zero();
+        let up = if up == Vec3::ZERO { Vec3::Z } else { up };
+        let table = (with_table && observer_r <= model.top_radius_m).then(|| {
+            let mu_s = up.dot(light.direction).clamp(-1.0, 1.0);
+            let (w, h) = sky.config.sky_view;
+            sky_view::compute(&marcher, observer_r, mu_s, w, h, sky.config.sky_view_steps)
+        });
+        Hillaire2020View {
+            sky,
+            light,
+            marcher,
+            observer,
+            observer_r,
+            up,
+            table,
+        }
+    }
+
+    fn channels(&self) -> usize {
+        self.sky.model.channels()
+    }
+
+    fn start(&self, dir: Vec3) -> Option<Entry> {
+        enter_atmosphere(
+            self.observer,
+            self.observer_r,
+            dir,
+            self.sky.model.top_radius_m,
+        )
+    }
+
+    /// The march of `dir` from `start` over `length` (m; to its boundary when None), lit as
+    /// `lighting`, into `radiance` scaled to the light.
+    fn march(
+        &self,
+        start: &Entry,
+        dir: Vec3,
+        length: Option<f64>,
+        lighting: &Lighting,
+        radiance: &mut [f64],
+    ) {
+        let model = &self.sky.model;
+        let n = self.channels();
+        let mu = start.mu();
+        let nu = dir.dot(self.light.direction).clamp(-1.0, 1.0);
+        let length = length.unwrap_or_else(|| {
+            let ground = ray_intersects_ground(start.r, mu, model.bottom_radius_m);
+            distance_to_nearest_atmosphere_boundary(
+                start.r,
+                mu,
+                model.bottom_radius_m,
+                model.top_radius_m,
+                ground,
+            )
+        });
+        let ray = MarchRay {
+            r: start.r,
+            mu,
+            mu_s: (start.point.dot(self.light.direction) / start.r).clamp(-1.0, 1.0),
+            nu,
+            length,
+        };
+        let mut phases = [0.0; 16];
+        let mut spill = Vec::new();
+        let phases: &[f64] = if model.constituents.len() <= phases.len() {
+            for (p, c) in phases.iter_mut().zip(&model.constituents) {
+                *p = c.phase.eval(nu);
+            }
+            &phases[..model.constituents.len()]
+        } else {
+            self.marcher.medium.phases(nu, &mut spill);
+            &spill
+        };
+        with_channel_buffers(n, |[t]| {
+            let steps = self.sky.config.march_steps;
+            self.marcher.march(
+                &ray,
+                steps,
+                phases,
+                lighting,
+                &mut radiance[..n],
+                t,
+                &mut [],
+            );
+        });
+        for (v, e) in radiance[..n].iter_mut().zip(&self.light.irradiance) {
+            *v *= e;
+        }
+    }
+}
+
+/// The lit intervals of `shadow` shifted by `offset` (m: from the observer to the ray's
+/// start), into `buffer`.
+fn shifted<'b>(
+    intervals: &[(f64, f64)],
+    offset: f64,
+    buffer: &'b mut Vec<(f64, f64)>,
+) -> &'b [(f64, f64)] {
+    buffer.clear();
+    buffer.extend(intervals.iter().map(|&(a, b)| (a - offset, b - offset)));
+    buffer
+}
+
+impl SkyView for Hillaire2020View<'_> {
+    fn light(&self) -> &Light {
+        self.light
+    }
+
+    fn sky_radiance(
+        &self,
+        dir: Vec3,
+        shadow: Shadow,
+        radiance: &mut [f64],
+        transmittance: &mut [f64],
+    ) {
+        let n = self.channels();
+        let model = &self.sky.model;
+        let Some(start) = self.start(dir) else {
+            radiance[..n].iter_mut().for_each(|v| *v = 0.0);
+            transmittance.iter_mut().for_each(|v| *v = 1.0);
+            return;
+        };
+        let mu = start.mu();
+        let ground = ray_intersects_ground(start.r, mu, model.bottom_radius_m);
+        if !transmittance.is_empty() {
+            if ground {
+                transmittance[..n].iter_mut().for_each(|v| *v = 0.0);
+            } else {
+                self.marcher
+                    .lookup
+                    .transmittance_to_top(start.r, mu, &mut transmittance[..n]);
+            }
+        }
+        let mut buffer = Vec::new();
+        match (shadow, &self.table) {
+            (Shadow::None, Some(table)) => {
+                // The azimuth from the light in the observer's horizontal plane.
+                let light = self.light.direction;
+                let (d, s) = (dir - self.up * mu, light - self.up * self.up.dot(light));
+                let norm = (d.length_squared() * s.length_squared()).sqrt();
+                let cos_phi = if norm > 1e-24 { d.dot(s) / norm } else { 1.0 };
+                sky_view::sample(
+                    table,
+                    start.r,
+                    model.bottom_radius_m,
+                    mu,
+                    cos_phi,
+                    &mut radiance[..n],
+                );
+                for (v, e) in radiance[..n].iter_mut().zip(&self.light.irradiance) {
+                    *v *= e;
+                }
+            }
+            (Shadow::None, None) => self.march(&start, dir, None, &Lighting::ALL, radiance),
+            (Shadow::Length(l), _) => {
+                // The paper's shadow over the ray's first metres: nothing scattered there.
+                let lit = [(l.max(0.0) - start.offset_m(self.observer), f64::INFINITY)];
+                let lighting = Lighting {
+                    single: Lit::Intervals(&lit),
+                    multiple: Lit::Intervals(&lit),
+                };
+                self.march(&start, dir, None, &lighting, radiance)
+            }
+            (Shadow::Lit(intervals), _) => {
+                let lit = shifted(intervals, start.offset_m(self.observer), &mut buffer);
+                let lighting = Lighting {
+                    single: Lit::Intervals(lit),
+                    multiple: Lit::All,
+                };
+                self.march(&start, dir, None, &lighting, radiance)
+            }
+        }
+    }
+
+    fn sky_radiance_to_point(
+        &self,
+        point: Vec3,
+        shadow: Shadow,
+        radiance: &mut [f64],
+        transmittance: &mut [f64],
+    ) {
+        let n = self.channels();
+        let dir = (point - self.observer).normalize_or_zero();
+        let Some(start) = self.start(dir) else {
+            radiance[..n].iter_mut().for_each(|v| *v = 0.0);
+            transmittance[..n].iter_mut().for_each(|v| *v = 1.0);
+            return;
+        };
+        let d = (point - start.point).length();
+        let mu = start.mu();
+        let ground = ray_intersects_ground(start.r, mu, self.sky.model.bottom_radius_m);
+        self.marcher
+            .lookup
+            .transmittance(start.r, mu, d, ground, &mut transmittance[..n]);
+        let mut buffer = Vec::new();
+        let lit_length;
+        let lighting = match shadow {
+            Shadow::None => Lighting::ALL,
+            Shadow::Length(l) => {
+                // The paper's shadow over the ray's last metres.
+                lit_length = [(0.0, d - l.max(0.0))];
+                Lighting {
+                    single: Lit::Intervals(&lit_length),
+                    multiple: Lit::Intervals(&lit_length),
+                }
+            }
+            Shadow::Lit(intervals) => Lighting {
+                single: Lit::Intervals(shifted(
+                    intervals,
+                    start.offset_m(self.observer),
+                    &mut buffer,
+                )),
+                multiple: Lit::All,
+            },
+        };
+        self.march(&start, dir, Some(d), &lighting, radiance);
+    }
+
+    fn transmittance_to_point(&self, point: Vec3, out: &mut [f64]) {
+        let dir = (point - self.observer).normalize_or_zero();
+        let Some(start) = self.start(dir) else {
+            out.iter_mut().for_each(|v| *v = 1.0);
+            return;
+        };
+        let mu = start.mu();
+        let ground = ray_intersects_ground(start.r, mu, self.sky.model.bottom_radius_m);
+        let d = (point - start.point).length();
+        self.marcher
+            .lookup
+            .transmittance(start.r, mu, d, ground, out);
+    }
+
+    fn transmittance_to_light(&self, point: Vec3, out: &mut [f64]) {
+        self.marcher
+            .lookup
+            .transmittance_to_light(point, self.light.direction, out);
+    }
+
+    fn sun_and_sky_irradiance(
+        &self,
+        point: Vec3,
+        normal: Vec3,
+        direct: &mut [f64],
+        sky: &mut [f64],
+    ) {
+        crate::sky::surface_irradiance::sun_and_sky_irradiance(
+            &self.marcher.lookup,
+            self.light,
+            point,
+            normal,
+            |r, mu_s, out| {
+                self.sky.sky_irradiance(r, mu_s, out);
+                for (v, e) in out.iter_mut().zip(&self.light.irradiance) {
+                    *v *= e;
+                }
+            },
+            direct,
+            sky,
+        );
+    }
+}
