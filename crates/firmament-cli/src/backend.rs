@@ -12,16 +12,19 @@ use anyhow::Result;
 use clap::ValueEnum;
 use firmament::atmosphere::Model;
 use firmament::math::Vec3;
+use firmament::render::aerial_volume::AerialVolumeConfig;
 use firmament::render::{stars, Frame, RenderSettings};
 use firmament::scene::planet::PlanetSurface;
 use firmament::scene::sky_lights::SkySources;
 use firmament::scene::terrain::Heightfield;
 use firmament::scene::{Scene, Surface};
 use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, Tables};
+use firmament::sky::SkyMethod;
 use firmament_gpu::Precomputer;
 use firmament_gpu::{GpuContext, GpuError, GpuRenderer, GpuSky, GpuTerrain, RenderInputs};
 
 use crate::common::{cancel_flag, print_tables_time, progress_bar, spinner, AtmosphereArgs};
+use crate::method::{CpuSky, Method};
 
 /// The `--backend` flag of render, bake, query and gallery.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
@@ -252,7 +255,8 @@ impl AtmosphereArgs {
 
 /// A sky ready to render on a backend.
 pub enum RenderSky<'a> {
-    Cpu(Box<Bruneton4d>),
+    /// A CPU sky, and the aerial-perspective volume its frames use (None: per pixel).
+    Cpu(Box<CpuSky>, Option<AerialVolumeConfig>),
     Gpu {
         gpu: &'a Gpu,
         sky: Box<GpuSky>,
@@ -268,12 +272,26 @@ pub enum RenderSky<'a> {
 }
 
 impl<'a> RenderSky<'a> {
-    /// Tables from --tables (uploaded to the GPU for `gpu`) or precomputed on the backend
-    /// (kept on the device for `gpu`).
-    pub fn new(backend: &'a Backend, atmosphere: &AtmosphereArgs, quiet: bool) -> Result<Self> {
-        let gpu = match backend {
-            Backend::Cpu => return Ok(RenderSky::Cpu(Box::new(atmosphere.sky(quiet)?))),
-            Backend::Gpu(gpu) => gpu,
+    /// The sky of `method`: for the 4D tables, from --tables (uploaded to the GPU for
+    /// `gpu`) or precomputed on the backend (kept on the device for `gpu`); the other
+    /// methods on the CPU only so far (refused on a GPU backend).
+    pub fn new(
+        backend: &'a Backend,
+        atmosphere: &AtmosphereArgs,
+        method: Method,
+        quiet: bool,
+    ) -> Result<Self> {
+        let gpu = match (backend, method) {
+            (Backend::Cpu, _) => {
+                return Ok(RenderSky::Cpu(
+                    Box::new(atmosphere.cpu_sky(method, quiet)?),
+                    None,
+                ))
+            }
+            (Backend::Gpu(gpu), Method::Bruneton4d) => gpu,
+            (Backend::Gpu(_), other) => {
+                anyhow::bail!("`--method {}` renders on the CPU only so far", other.name())
+            }
         };
         let cpu_sky = Box::new(OnceLock::new());
         let (sky, sky_model, config) = match &atmosphere.tables {
@@ -303,10 +321,21 @@ impl<'a> RenderSky<'a> {
         })
     }
 
+    /// Frames whose surfaces read their aerial perspective from a froxel volume
+    /// (`render::aerial_volume`); the CPU renderer only so far.
+    pub fn with_aerial_volume(self, config: AerialVolumeConfig) -> Result<Self> {
+        match self {
+            RenderSky::Cpu(sky, _) => Ok(RenderSky::Cpu(sky, Some(config))),
+            RenderSky::Gpu { .. } => anyhow::bail!(
+                "`--aerial-volume` is built by the CPU renderer only so far: use `--backend cpu`"
+            ),
+        }
+    }
+
     /// " on the GPU" or "", for messages.
     pub fn on(&self) -> &'static str {
         match self {
-            RenderSky::Cpu(_) => "",
+            RenderSky::Cpu(..) => "",
             RenderSky::Gpu { .. } => " on the GPU",
         }
     }
@@ -328,10 +357,11 @@ impl<'a> RenderSky<'a> {
             );
         }
         match self {
-            RenderSky::Cpu(sky) => {
+            RenderSky::Cpu(sky, aerial) => {
                 let bar = progress_bar(1000, quiet);
                 bar.set_message("rendering");
-                let scene = cpu_scene(sky.as_ref(), sources, terrain, planet);
+                let mut scene = cpu_scene(sky.method(), sources, terrain, planet);
+                scene.aerial_volume = *aerial;
                 let frame = firmament::render::render(
                     &scene,
                     settings,
@@ -430,18 +460,31 @@ impl<'a> RenderSky<'a> {
         uploaded
     }
 
-    /// The tables' configuration (sizes, orders, Mie storage).
-    pub fn config(&self) -> TableConfig {
+    /// The method's tables as JSON (the 4D tables' configuration: sizes, orders, Mie
+    /// storage; Hillaire's sizes and counts).
+    pub fn tables_json(&self) -> serde_json::Value {
         match self {
-            RenderSky::Cpu(sky) => sky.tables.config,
-            RenderSky::Gpu { config, .. } => *config,
+            RenderSky::Cpu(sky, _) => sky.tables_json(),
+            RenderSky::Gpu { config, .. } => {
+                serde_json::to_value(config).unwrap_or(serde_json::Value::Null)
+            }
+        }
+    }
+
+    /// The method in words, for provenance.
+    pub fn describe(&self) -> &'static str {
+        match self {
+            RenderSky::Cpu(sky, _) if sky.bruneton4d().is_none() => {
+                "hillaire2020 (transmittance, multiple-scattering and sky-view tables; ray march)"
+            }
+            _ => "bruneton4d (precomputed tables)",
         }
     }
 
     /// The model the sky's tables hold (lights are built from it).
     pub fn model(&self) -> &Model {
         match self {
-            RenderSky::Cpu(sky) => &sky.model,
+            RenderSky::Cpu(sky, _) => sky.model(),
             RenderSky::Gpu { sky_model, .. } => sky_model,
         }
     }
@@ -450,7 +493,7 @@ impl<'a> RenderSky<'a> {
 /// The CPU scene of a frame: the sky's tables, the sources' lights, glow and stars, over the
 /// terrain and the planet's surface when given.
 fn cpu_scene<'s>(
-    sky: &'s Bruneton4d,
+    sky: &'s dyn SkyMethod,
     sources: &SkySources,
     terrain: Option<&'s Heightfield>,
     planet: Option<&'s PlanetSurface>,

@@ -7,6 +7,7 @@
 mod backend;
 mod commands;
 mod common;
+mod method;
 
 use std::process::ExitCode;
 

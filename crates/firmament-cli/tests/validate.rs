@@ -6,7 +6,7 @@ mod common;
 
 use serde_json::Value;
 
-use common::{run, stderr, tmp_subdir};
+use common::{run, stderr, tables_arg, tmp_subdir};
 
 /// The reduced validation runs, passes the daylight thresholds and writes the documented
 /// JSON fields.
@@ -157,7 +157,8 @@ fn unknown_method_is_a_clear_error() {
     assert!(!out.status.success());
     let e = stderr(&out);
     assert!(
-        e.contains("invalid value for `--method`: magic (accepted: lut, reference)"),
+        e.contains("invalid value 'magic' for '--method")
+            && e.contains("bruneton4d, hillaire2020, reference"),
         "{e}"
     );
     let dir = tmp_subdir("method");
@@ -170,8 +171,17 @@ fn unknown_method_is_a_clear_error() {
         png.to_str().unwrap(),
     ]);
     assert!(!out.status.success());
-    assert!(stderr(&out).contains("invalid value for `--method`: magic"));
+    assert!(stderr(&out).contains("invalid value 'magic' for '--method"));
     assert!(!png.exists());
+    // validate takes a list and refuses the reference (it is what the methods are
+    // measured against).
+    let out = run(&["validate", "--quick", "--method", "hillaire2020,reference"]);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("invalid value for `--method`: \"reference\""),
+        "{}",
+        stderr(&out)
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -208,5 +218,86 @@ fn render_method_reference_writes_the_same_formats() {
     let bytes = std::fs::read(&png).unwrap();
     assert_eq!(&bytes[1..4], b"PNG");
     assert!(std::fs::metadata(&exr).unwrap().len() > 0);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn hillaire2020_answers_query_render_and_validate() {
+    // query: the method named in the JSON and its provenance, the views positive.
+    let out = run(&[
+        "query",
+        "--method",
+        "hillaire2020",
+        "--wavelengths",
+        "rgb",
+        "--altitude-m",
+        "100",
+        "--sun-zenith-deg",
+        "50",
+        "--view",
+        "0,0",
+        "--view",
+        "85,90",
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["method"], "hillaire2020");
+    assert!(v["provenance"]["tables"]["sky_view"][0].as_u64() == Some(192));
+    for view in v["views"].as_array().unwrap() {
+        assert!(view["luminance_cd_m2"].as_f64().unwrap() > 100.0, "{view}");
+    }
+    // `lut` is still the 4D tables.
+    let out = run(&[
+        "query",
+        "--method",
+        "lut",
+        "--tables",
+        tables_arg(),
+        "--altitude-m",
+        "100",
+        "--sun-zenith-deg",
+        "50",
+        "--view",
+        "0,0",
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["method"], "bruneton4d");
+    // render on the CPU, with the aerial-perspective volume; refused with 4D tables.
+    let dir = tmp_subdir("hillaire");
+    let png = dir.join("h.png");
+    let out = run(&[
+        "render",
+        "--method",
+        "hillaire2020",
+        "--aerial-volume",
+        "--no-terrain",
+        "--wavelengths",
+        "rgb",
+        "--width",
+        "64",
+        "--height",
+        "36",
+        "--backend",
+        "cpu",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(png.exists());
+    let out = run(&[
+        "render",
+        "--method",
+        "hillaire2020",
+        "--tables",
+        tables_arg(),
+        "--out",
+        dir.join("refused.png").to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("holds 4D tables"), "{}", stderr(&out));
+    assert!(!dir.join("refused.png").exists());
     std::fs::remove_dir_all(&dir).ok();
 }

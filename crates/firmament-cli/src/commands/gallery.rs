@@ -15,6 +15,7 @@ use firmament::scene::{Camera, Projection, SceneFile as Scene};
 use crate::backend::{Backend, BackendChoice, RenderSky};
 use crate::commands::outputs::{write_outputs, FileNotes, FileOptions};
 use crate::commands::render::{atmosphere_args, render_scene, terrain_and_atmosphere};
+use crate::method::Method;
 
 /// Arguments of `firmament gallery`.
 #[derive(Args, Debug)]
@@ -145,7 +146,7 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
         eprintln!("wavelengths: {}", wavelengths.describe());
     }
     let t = Instant::now();
-    let sky = RenderSky::new(&backend, &atmosphere, args.quiet)?;
+    let sky = RenderSky::new(&backend, &atmosphere, Method::Bruneton4d, args.quiet)?;
     if !args.quiet {
         eprintln!("tables ready in {:.2} s", t.elapsed().as_secs_f64());
     }
@@ -167,7 +168,12 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
             )?;
             let terrain_sky = match args.tables {
                 Some(_) => None,
-                None => Some(RenderSky::new(&backend, &atmosphere, args.quiet)?),
+                None => Some(RenderSky::new(
+                    &backend,
+                    &atmosphere,
+                    Method::Bruneton4d,
+                    args.quiet,
+                )?),
             };
             (terrain, terrain_sky)
         }
@@ -196,7 +202,7 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
             _ => &sky,
         };
         // The surface map renders on the CPU only so far.
-        scene.surface = (v.surface && matches!(sky, RenderSky::Cpu(_)))
+        scene.surface = (v.surface && matches!(sky, RenderSky::Cpu(..)))
             .then(firmament::scene::planet_config::SurfaceConfig::default);
         scene.camera = v.camera.clone();
         scene.sun.zenith_deg = v.sun.0;

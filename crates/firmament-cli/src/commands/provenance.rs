@@ -4,11 +4,11 @@
 //! text attributes in EXR headers.
 
 use firmament::atmosphere::Model;
-use firmament::sky::bruneton4d::TableConfig;
 use serde_json::{json, Map, Value};
 
-/// The program, the atmosphere, the method and its tables, the wavelengths.
-pub fn provenance(model: &Model, method: &str, tables: Option<&TableConfig>) -> Value {
+/// The program, the atmosphere, the method and its tables (their configuration as JSON),
+/// the wavelengths.
+pub fn provenance(model: &Model, method: &str, tables: Option<Value>) -> Value {
     let mut p = json!({
         "program": "firmament",
         "version": env!("CARGO_PKG_VERSION"),
@@ -20,7 +20,7 @@ pub fn provenance(model: &Model, method: &str, tables: Option<&TableConfig>) -> 
         "wavelengths_nm": model.wavelengths.nm(),
     });
     if let Some(c) = tables {
-        p["tables"] = serde_json::to_value(c).unwrap_or(Value::Null);
+        p["tables"] = c;
     }
     p
 }

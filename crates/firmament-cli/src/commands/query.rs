@@ -8,7 +8,7 @@ use firmament::reference::{self, ReferenceSettings};
 use firmament::scene::sky_lights::{sources_of, SkySources};
 use firmament::scene::sun_direction;
 use firmament::sky::bruneton4d as lut;
-use firmament::sky::{Shadow, SkyMethod, SkyView};
+use firmament::sky::{Shadow, SkyView};
 use firmament::spectrum::{xyz_to_linear_srgb, ColourMatrix};
 use serde::Serialize;
 use serde_json::json;
@@ -18,6 +18,7 @@ use super::provenance::provenance;
 use crate::backend::{Backend, BackendChoice};
 use crate::commands::astro::AstroArgs;
 use crate::common::{check_range, check_reference_samples, print_wavelengths, AtmosphereArgs};
+use crate::method::{CpuSky, Method};
 
 /// Arguments of `firmament query`.
 #[derive(Args, Debug)]
@@ -51,10 +52,11 @@ pub struct QueryArgs {
         allow_hyphen_values = true
     )]
     pub views: Vec<String>,
-    /// Method for the views: `lut` (precomputed tables) or `reference` (Monte Carlo path
+    /// Method for the views: `bruneton4d` (or `lut`: the precomputed 4D tables),
+    /// `hillaire2020` (Hillaire 2020's tables and march) or `reference` (Monte Carlo path
     /// tracer; adds `radiance_stderr` and `samples` to each view).
-    #[arg(long, default_value = "lut", value_name = "lut|reference")]
-    pub method: String,
+    #[arg(long, value_enum, default_value_t = Method::Bruneton4d, value_name = "bruneton4d|lut|hillaire2020|reference")]
+    pub method: Method,
     /// Paths per wavelength and view for `--method reference`.
     #[arg(long, default_value_t = 10_000)]
     pub samples: usize,
@@ -170,9 +172,9 @@ fn moon_json(
 
 /// Run the query and return the JSON.
 pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
-    let reference = match args.method.as_str() {
-        "lut" => None,
-        "reference" => {
+    let reference = match args.method {
+        Method::Bruneton4d | Method::Hillaire2020 => None,
+        Method::Reference => {
             let settings = ReferenceSettings {
                 samples: args.samples,
                 seed: args.seed,
@@ -182,7 +184,6 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
             check_reference_samples(settings.samples)?;
             Some(settings)
         }
-        other => anyhow::bail!("invalid value for `--method`: {other} (accepted: lut, reference)"),
     };
     if args.scene.is_some() {
         return super::query_scene::run(args, reference);
@@ -217,22 +218,29 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
         .map(|v| parse_view(v))
         .collect::<Result<_>>()?;
     print_wavelengths(&args.atmosphere.model()?, args.quiet);
-    let sky = match &args.atmosphere.tables {
+    let sky = match (&args.atmosphere.tables, args.method) {
+        (_, Method::Hillaire2020) => {
+            if !args.quiet {
+                eprintln!("backend: cpu (hillaire2020's tables take milliseconds on the CPU)");
+            }
+            args.atmosphere.cpu_sky(Method::Hillaire2020, args.quiet)?
+        }
         // Nothing to compute: no adapter to open.
-        Some(path) => {
+        (Some(path), _) => {
             if !args.quiet {
                 eprintln!(
                     "backend: cpu (tables read from {}; the views are CPU lookups)",
                     path.display()
                 );
             }
-            args.atmosphere.sky(true)?
+            CpuSky::Bruneton4d(Box::new(args.atmosphere.sky(true)?))
         }
-        None => args
-            .atmosphere
-            .sky_on(&Backend::open(args.backend, args.quiet)?, args.quiet)?,
+        (None, _) => CpuSky::Bruneton4d(Box::new(
+            args.atmosphere
+                .sky_on(&Backend::open(args.backend, args.quiet)?, args.quiet)?,
+        )),
     };
-    let model = &sky.model;
+    let model = sky.model();
     let nm = model.wavelengths.nm().to_vec();
     let n = nm.len();
 
@@ -258,7 +266,7 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
     let optical_depths = model.optical_depths_vertical(altitude_m);
     let mut sun_transmittance = vec![0.0; n];
     let views_of_lights: Vec<_> = (sources.lights.iter())
-        .map(|l| sky.view(camera, l))
+        .map(|l| sky.method().view(camera, l))
         .collect();
     let sky_view = &views_of_lights[0];
     sky_view.transmittance_to_light(camera, &mut sun_transmittance);
@@ -309,7 +317,7 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
                 "views: spectral Monte Carlo reference path tracer, {} paths per wavelength and view, seed {} (view i uses stream key i); sky only: the sun disk seen directly and the ground's own radiance are excluded, as for `lut`",
                 s.samples, s.seed
             ),
-            "transmittance (per view), sun_transmittance, irradiance and optical depths: from the precomputed tables and the model, as for `lut`",
+            "transmittance (per view), sun_transmittance, irradiance and optical depths: from the 4D tables and the model, as for `bruneton4d`",
         ]),
     };
     if let serde_json::Value::Array(m) = method_notes {
@@ -318,16 +326,21 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
     // What the tables approximate here (with `--method reference` the transmittance and
     // irradiance still come from them): a sun below their lowest, optically thick air.
     let mu_s = camera.normalize().dot(sun);
-    notes.extend(lut::twilight::note(model.mu_s_min, mu_s).map(|s| json!(s)));
-    notes.extend(lut::thickness::note(model).map(|s| json!(s)));
-    let method = match &reference {
-        None => "bruneton4d (precomputed tables)",
-        Some(_) => {
+    if sky.bruneton4d().is_some() {
+        notes.extend(lut::twilight::note(model.mu_s_min, mu_s).map(|s| json!(s)));
+        notes.extend(lut::thickness::note(model).map(|s| json!(s)));
+    }
+    let method = match (&reference, args.method) {
+        (Some(_), _) => {
             "reference (Monte Carlo path tracer) for the views, bruneton4d tables for the rest"
         }
+        (None, Method::Hillaire2020) => {
+            "hillaire2020 (transmittance, multiple-scattering and sky-view tables; ray march)"
+        }
+        (None, _) => "bruneton4d (precomputed tables)",
     };
     Ok(json!({
-        "method": args.method,
+        "method": args.method.name(),
         "wavelengths_nm": nm,
         "units": {
             "radiance": "W m-2 sr-1 nm-1",
@@ -349,6 +362,6 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
         },
         "views": answers,
         "notes": notes,
-        "provenance": provenance(model, method, Some(&sky.tables.config)),
+        "provenance": provenance(model, method, Some(sky.tables_json())),
     }))
 }

@@ -9,7 +9,6 @@ use firmament::math::direction_from_zenith_azimuth;
 use firmament::reference::{self, ReferenceSettings};
 use firmament::render::{ShadeScratch, Shader};
 use firmament::scene::{Ray, Scene as RenderScene, SceneFile, Surface};
-use firmament::sky::SkyMethod;
 use serde_json::json;
 
 use super::provenance::provenance;
@@ -17,6 +16,7 @@ use super::provenance::provenance;
 use super::query::{parse_view, QueryArgs, ViewAnswer};
 use super::render::{sources_of_scene, terrain_and_atmosphere};
 use crate::common::print_wavelengths;
+use crate::method::Method;
 
 /// Run `query --scene`.
 pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<serde_json::Value> {
@@ -45,8 +45,13 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
         anyhow::bail!("`--method reference` traces the sun's light only so far: a [time] with the moon up or the sun down is not supported with it");
     }
     print_wavelengths(&model, args.quiet);
-    let sky = atmosphere.sky(args.quiet)?;
-    let model = &sky.model;
+    // The reference's transmittances come from the 4D tables.
+    let table_method = match args.method {
+        Method::Reference => Method::Bruneton4d,
+        m => m,
+    };
+    let sky = atmosphere.cpu_sky(table_method, args.quiet)?;
+    let model = sky.model();
     let nm = model.wavelengths.nm().to_vec();
     let colour = model.colour_matrix();
     let camera = scene.camera_over(terrain.as_ref(), model.bottom_radius_m);
@@ -55,7 +60,7 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
         .as_ref()
         .map_or(model.bottom_radius_m, |t| t.radius_m);
     let planet = scene.build_surface(radius, &nm)?;
-    let mut render_scene = RenderScene::clear_sky(&sky, sources.lights[0].direction, false);
+    let mut render_scene = RenderScene::clear_sky(sky.method(), sources.lights[0].direction, false);
     render_scene.lights = sources.lights.clone();
     render_scene
         .lights
@@ -69,7 +74,7 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
         render_scene.set_ground(p);
     }
     let shader = Shader::new(&render_scene, observer)?;
-    let first_view = sky.view(observer, &render_scene.lights[0]);
+    let first_view = sky.method().view(observer, &render_scene.lights[0]);
     // The reference meets the terrain and the planet's map as Lambertian surfaces (the map's
     // sphere lies on its ground sphere and wins the tie).
     let mut surfaces: Vec<Box<dyn Surface + '_>> =
@@ -128,14 +133,14 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
     let sun = &render_scene.lights[0];
     let up = sun.direction.z.clamp(-1.0, 1.0);
     let method = match &settings {
-        None => "views: the renderer's shading of the scene from the tables (terrain, shadows, light shafts, ground, aerial perspective; the sun's disk excluded)".to_string(),
+        None => format!("views: the renderer's shading of the scene with {} (terrain, shadows, light shafts, ground, aerial perspective; the sun's disk excluded)", sky.name()),
         Some(s) => format!(
             "views: spectral Monte Carlo reference path tracer through the same scene (the terrain intersected as a Lambertian surface), {} paths per wavelength and view, seed {} (view i uses stream key i); the sun's disk excluded",
             s.samples, s.seed
         ),
     };
     Ok(json!({
-        "method": args.method,
+        "method": args.method.name(),
         "scene": path.display().to_string(),
         "wavelengths_nm": nm,
         "units": {
@@ -155,9 +160,9 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
         "views": answers,
         "notes": [method, "transmittance (per view): the air's, from the tables, to the first surface the view meets or out of the atmosphere"],
         "provenance": provenance(
-            &sky.model,
-            if settings.is_none() { "bruneton4d (precomputed tables)" } else { "reference (Monte Carlo path tracer)" },
-            Some(&sky.tables.config),
+            model,
+            if settings.is_none() { sky.name() } else { "reference (Monte Carlo path tracer)" },
+            Some(sky.tables_json()),
         ),
     }))
 }

@@ -19,6 +19,8 @@ use crate::commands::provenance::{exr_attributes, merged, provenance};
 use crate::commands::render_args::{scene_from_args, RenderArgs};
 use crate::commands::timelapse;
 use crate::common::{check_output_dir, print_wavelengths, AtmosphereArgs};
+use crate::method::Method;
+use firmament::render::aerial_volume::AerialVolumeConfig;
 
 /// Atmosphere arguments equivalent to the scene's.
 pub fn atmosphere_args(
@@ -198,21 +200,23 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             None
         }
     };
-    if times.is_some() && args.method == "reference" {
+    if times.is_some() && args.method == Method::Reference {
         anyhow::bail!(
             "a time-lapse (--until) uses the tables: `--method reference` is not supported with it"
         );
     }
-    match args.method.as_str() {
-        // An empty `--method` is taken as the default.
-        "lut" | "" => {}
-        "reference" => {
+    match args.method {
+        Method::Bruneton4d | Method::Hillaire2020 => {}
+        Method::Reference => {
+            if args.aerial_volume {
+                anyhow::bail!("`--aerial-volume` is for the tabulated methods: `--method reference` traces every path");
+            }
             if args.tables.is_some() {
                 anyhow::bail!("`--method reference` uses no tables: --tables makes no sense here");
             }
             if args.backend == BackendChoice::Gpu {
                 anyhow::bail!(
-                    "`--method reference` runs on the CPU only: `--backend gpu` is not supported with it (use `--backend cpu` or `auto`, or `--method lut` for the GPU)"
+                    "`--method reference` runs on the CPU only: `--backend gpu` is not supported with it (use `--backend cpu` or `auto`, or `--method bruneton4d` for the GPU)"
                 );
             }
             if !args.quiet {
@@ -244,9 +248,25 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             let notes = notes_of(&model, &scene, terrain.as_ref(), &files, ev100, provenance)?;
             return write_outputs(&frame, &scene, ev100, files, &notes, args.quiet);
         }
-        other => anyhow::bail!("invalid value for `--method`: {other} (accepted: lut, reference)"),
+    }
+    if args.method == Method::Hillaire2020 {
+        if args.backend == BackendChoice::Gpu {
+            anyhow::bail!("`--method hillaire2020` renders on the CPU only so far: use `--backend cpu` or `auto`");
+        }
+        if args.tables.is_some() {
+            anyhow::bail!("`--tables` holds 4D tables: `--method hillaire2020` builds its own (in milliseconds)");
+        }
     }
     let backend = match Backend::open(args.backend, args.quiet)? {
+        Backend::Gpu(_)
+            if args.backend == BackendChoice::Auto
+                && (args.method == Method::Hillaire2020 || args.aerial_volume) =>
+        {
+            if !args.quiet {
+                eprintln!("note: hillaire2020 and --aerial-volume render on the CPU only so far: using the CPU");
+            }
+            Backend::Cpu
+        }
         Backend::Gpu(_) if scene.surface.is_some() && args.backend == BackendChoice::Gpu => {
             anyhow::bail!(
                 "the planet's surface map ([surface]) renders on the CPU only so far: `--backend cpu` or `auto` render it"
@@ -272,7 +292,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     atmosphere.order_args = args.order_args;
     print_wavelengths(&atmosphere.model()?, args.quiet);
     let t = Instant::now();
-    let sky = RenderSky::new(&backend, &atmosphere, args.quiet)?;
+    let mut sky = RenderSky::new(&backend, &atmosphere, args.method, args.quiet)?;
+    if args.aerial_volume {
+        sky = sky.with_aerial_volume(AerialVolumeConfig::default())?;
+    }
     if !args.quiet && args.tables.is_some() {
         eprintln!(
             "tables: loaded{} in {:.2} s",
@@ -284,7 +307,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             t.elapsed().as_secs_f64()
         );
     }
-    if !args.quiet && times.is_none() {
+    if !args.quiet && times.is_none() && args.method == Method::Bruneton4d {
         approximation_notes(sky.model(), &scene)?;
     }
     if let Some(times) = times {
@@ -336,8 +359,8 @@ pub fn file_notes(
     files: &FileOptions,
     ev100: f64,
 ) -> Result<FileNotes> {
-    let method = format!("bruneton4d (precomputed tables{})", sky.on());
-    let provenance = provenance(sky.model(), &method, Some(&sky.config()));
+    let method = format!("{}{}", sky.describe(), sky.on());
+    let provenance = provenance(sky.model(), &method, Some(sky.tables_json()));
     notes_of(sky.model(), scene, terrain, files, ev100, provenance)
 }
 

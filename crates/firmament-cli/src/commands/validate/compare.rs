@@ -1,16 +1,16 @@
-//! One configuration (observer, sun, views): the tables' radiance against the reference's,
+//! One configuration (observer, sun, views): a method's radiance against the reference's,
 //! view by view, as relative errors and as the records of the JSON file.
 
 use firmament::math::Vec3;
 use firmament::reference::RadianceEstimate;
 use firmament::scene::Light;
-use firmament::sky::bruneton4d::Bruneton4d;
 use firmament::sky::{Shadow, SkyMethod};
 use firmament::spectrum::ColourMatrix;
 use serde::Serialize;
 
 use super::summary::RelativeErrors;
 use super::views::View;
+use super::Candidate;
 
 /// A view in the JSON file: where it points, the reference, each table configuration.
 #[derive(Debug, Serialize)]
@@ -31,10 +31,12 @@ pub struct ReferenceRecord {
     pub luminance_stderr: f64,
 }
 
-/// One table configuration's answer for a view.
+/// One method's answer for a view.
 #[derive(Debug, Serialize)]
 pub struct TableRecord {
-    pub orders: usize,
+    pub method: &'static str,
+    /// The 4D tables' orders (null for other methods).
+    pub orders: Option<usize>,
     pub radiance: Vec<f64>,
     pub luminance_cd_m2: f64,
     /// `null` where the reference luminance is 0.
@@ -62,22 +64,22 @@ impl ViewRecord {
     }
 }
 
-/// The tables of `sky` (computed with `orders`) seen from `camera` with the sun in `sun`,
-/// against the reference of each view in `records` (in the order of `views`): the relative
-/// errors, and a [`TableRecord`] added to each record.
-pub fn compare_tables(
-    sky: &Bruneton4d,
-    orders: usize,
+/// `sky` (the method of `candidate`) seen from `camera` with the sun in `sun`, against the
+/// reference of each view in `records` (in the order of `views`): the relative errors, and
+/// a [`TableRecord`] added to each record.
+pub fn compare_method(
+    sky: &dyn SkyMethod,
+    candidate: &Candidate,
     colour: &ColourMatrix,
     camera: Vec3,
     sun: Vec3,
     views: &[View],
     records: &mut [ViewRecord],
 ) -> RelativeErrors {
-    let channels = sky.model.channels();
+    let channels = sky.model().channels();
     let mut errors = RelativeErrors::new(channels);
     let (mut radiance, mut transmittance) = (vec![0.0; channels], vec![0.0; channels]);
-    let light = Light::sun(&sky.model, sun, false);
+    let light = Light::sun(sky.model(), sun, false);
     let sky_view = sky.view(camera, &light);
     for (view, record) in views.iter().zip(records.iter_mut()) {
         sky_view.sky_radiance(view.dir, Shadow::None, &mut radiance, &mut transmittance);
@@ -100,7 +102,8 @@ pub fn compare_tables(
             }
         }
         record.tables.push(TableRecord {
-            orders,
+            method: candidate.method.name(),
+            orders: candidate.orders,
             radiance: radiance.clone(),
             luminance_cd_m2: y_table,
             relative_error_luminance: (y_ref > 0.0).then(|| y_table / y_ref - 1.0),

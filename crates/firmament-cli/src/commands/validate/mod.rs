@@ -1,4 +1,5 @@
-//! `firmament validate`: the table method measured against the Monte Carlo reference.
+//! `firmament validate`: a sky method (the 4D tables, Hillaire 2020) measured against the
+//! Monte Carlo reference.
 //!
 //! For each configuration (preset × observer altitude × sun elevation) a documented set of
 //! view directions is traced by the reference path tracer (sky only, sun disk excluded:
@@ -34,16 +35,16 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use clap::Args;
+use clap::{Args, ValueEnum};
 use firmament::math::Vec3;
-use firmament::sky::bruneton4d::Bruneton4d;
 use firmament::spectrum::ColourMatrix;
 use serde_json::{json, Value};
 
 use crate::common::{
     check_output_dir, check_range, check_reference_samples, progress_bar, AtmosphereArgs, OrderArgs,
 };
-use compare::{compare_tables, ViewRecord};
+use crate::method::{CpuSky, Method};
+use compare::{compare_method, ViewRecord};
 use sampling::{trace_views, SamplePlan, PILOT_SAMPLES};
 use summary::{RelativeErrors, Summaries};
 use views::{direction_from_elevation_deg, views};
@@ -80,7 +81,12 @@ pub struct ValidateArgs {
     /// Cap of the adaptive paths per wavelength and view.
     #[arg(long, default_value_t = 65_536)]
     pub max_samples: usize,
-    /// Scattering orders of the tables; a list `4,8` compares several against the same
+    /// Sky methods to validate, comma-separated: bruneton4d (or lut), hillaire2020; several
+    /// are compared against the same reference (the first is checked against the
+    /// thresholds).
+    #[arg(long, default_value = "bruneton4d", value_name = "METHOD,...")]
+    pub method: String,
+    /// Scattering orders of the 4D tables; a list `4,8` compares several against the same
     /// reference (the first is the one checked against the thresholds).
     #[arg(long, default_value = "4", value_name = "N,...")]
     pub orders: String,
@@ -123,7 +129,9 @@ struct Selection {
     presets: Vec<String>,
     altitudes_m: Vec<f64>,
     sun_elevations_deg: Vec<f64>,
-    /// Scattering orders of each table configuration; the first is checked.
+    /// The methods, each 4D one with each of `orders`; the first is checked.
+    methods: Vec<Method>,
+    /// Scattering orders of each 4D table configuration.
     orders: Vec<usize>,
     table_size: String,
     wavelengths: String,
@@ -162,6 +170,16 @@ impl Selection {
         }
         let orders: Vec<usize> =
             parse_list("--orders", &args.orders, "integers separated by commas")?;
+        let methods: Vec<Method> = args
+            .method
+            .split(',')
+            .map(|m| match Method::from_str(m.trim(), true) {
+                Ok(Method::Reference) | Err(_) => anyhow::bail!(
+                    "invalid value for `--method`: {m:?} (accepted: bruneton4d (or lut), hillaire2020, separated by commas)"
+                ),
+                Ok(m) => Ok(m),
+            })
+            .collect::<Result<_>>()?;
         let table_size = args
             .table_size
             .clone()
@@ -190,6 +208,7 @@ impl Selection {
             presets,
             altitudes_m,
             sun_elevations_deg,
+            methods,
             orders,
             table_size,
             wavelengths: args.wavelengths.clone(),
@@ -203,6 +222,27 @@ impl Selection {
             selection.atmosphere(p, selection.orders[0]).model()?;
         }
         Ok(selection)
+    }
+
+    /// What is compared with the reference: each method, a 4D one once per `orders`.
+    fn candidates(&self) -> Vec<Candidate> {
+        self.methods
+            .iter()
+            .flat_map(|&method| match method {
+                Method::Bruneton4d => self
+                    .orders
+                    .iter()
+                    .map(|&o| Candidate {
+                        method,
+                        orders: Some(o),
+                    })
+                    .collect::<Vec<_>>(),
+                _ => vec![Candidate {
+                    method,
+                    orders: None,
+                }],
+            })
+            .collect()
     }
 
     /// The atmosphere and tables of `preset` with `orders`.
@@ -222,9 +262,10 @@ impl Selection {
     /// The first line printed.
     fn headline(&self) -> String {
         format!(
-            "firmament validate: table method vs Monte Carlo reference; relative errors over views \
-             (sun disk excluded), reference's median relative standard error in brackets; tables \
+            "firmament validate: {} vs Monte Carlo reference; relative errors over views \
+             (sun disk excluded), reference's median relative standard error in brackets; 4D tables \
              {}, orders {:?}{}, reference {}",
+            self.candidates().iter().map(Candidate::label).collect::<Vec<_>>().join(", "),
             self.table_size,
             self.orders,
             if self.order_tail {
@@ -251,24 +292,24 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
         check_output_dir(path, "--json")?;
     }
     let selection = Selection::from_args(args)?;
-    let orders = &selection.orders;
+    let candidates = selection.candidates();
     let mut configurations_json = Vec::new();
     let mut wavelengths_nm: Vec<f64> = Vec::new();
-    // Earth daylight aggregates, one per table configuration (orders).
-    let mut daylight: Vec<Option<RelativeErrors>> = orders.iter().map(|_| None).collect();
+    // Earth daylight aggregates, one per candidate.
+    let mut daylight: Vec<Option<RelativeErrors>> = candidates.iter().map(|_| None).collect();
     let mut configuration_index = 0u64;
     println!("{}", selection.headline());
     for preset in &selection.presets {
-        let skies: Vec<Bruneton4d> = orders
+        let skies: Vec<CpuSky> = candidates
             .iter()
-            .map(|&o| {
+            .map(|c| {
                 selection
-                    .atmosphere(preset, o)
-                    .sky(args.quiet)
-                    .with_context(|| format!("tables for {preset}, {o} orders"))
+                    .atmosphere(preset, c.orders.unwrap_or(selection.orders[0]))
+                    .cpu_sky(c.method, args.quiet)
+                    .with_context(|| format!("{} for {preset}", c.label()))
             })
             .collect::<Result<_>>()?;
-        let model = &skies[0].model;
+        let model = skies[0].model();
         wavelengths_nm = model.wavelengths.nm().to_vec();
         let colour = ColourMatrix::new(&wavelengths_nm);
         let configurations: Vec<(f64, f64)> = selection
@@ -308,8 +349,10 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
                 .collect();
             let errors: Vec<RelativeErrors> = skies
                 .iter()
-                .zip(orders)
-                .map(|(sky, &o)| compare_tables(sky, o, &colour, camera, sun, views, &mut records))
+                .zip(&candidates)
+                .map(|(sky, c)| {
+                    compare_method(sky.method(), c, &colour, camera, sun, views, &mut records)
+                })
                 .collect();
             let summaries: Vec<Summaries> = errors
                 .iter()
@@ -324,9 +367,9 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
                     samples.iter().max().unwrap_or(&0),
                     reference_seconds
                 );
-                for (o, s) in orders.iter().zip(&summaries) {
-                    if orders.len() > 1 {
-                        println!("  orders {o}:");
+                for (c, s) in candidates.iter().zip(&summaries) {
+                    if candidates.len() > 1 {
+                        println!("  {}:", c.label());
                     }
                     s.print();
                 }
@@ -344,8 +387,9 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
                 "sun_elevation_deg": elevation,
                 "views_skipped": skipped,
                 "reference_seconds": reference_seconds,
-                "tables": orders.iter().zip(&summaries).map(|(o, s)| json!({
-                    "orders": o,
+                "tables": candidates.iter().zip(&summaries).map(|(c, s)| json!({
+                    "method": c.method.name(),
+                    "orders": c.orders,
                     "summary": s,
                 })).collect::<Vec<_>>(),
                 "views": records,
@@ -362,15 +406,16 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
         let y = &summaries.luminance;
         let pass = y.median <= MEDIAN_LIMIT && y.p95 <= P95_LIMIT;
         println!(
-            "earth daylight (sun elevation ≥ {DAYLIGHT_DEG}°), all altitudes, orders {}: {} views{}",
-            orders[oi],
+            "earth daylight (sun elevation ≥ {DAYLIGHT_DEG}°), all altitudes, {}: {} views{}",
+            candidates[oi].label(),
             y.count,
             if pass { "" } else { "  THRESHOLDS BROKEN" }
         );
         summaries.print();
         if oi == 0 && !pass {
             broken = Some(format!(
-                "earth daylight luminance error: median {:.2}% (limit {:.0}%), p95 {:.2}% (limit {:.0}%)",
+                "{}: earth daylight luminance error: median {:.2}% (limit {:.0}%), p95 {:.2}% (limit {:.0}%)",
+                candidates[oi].label(),
                 100.0 * y.median,
                 100.0 * MEDIAN_LIMIT,
                 100.0 * y.p95,
@@ -380,7 +425,8 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
         aggregates.push(json!({
             "preset": "earth",
             "selection": format!("sun elevation >= {DAYLIGHT_DEG} deg, all altitudes of this run"),
-            "orders": orders[oi],
+            "method": candidates[oi].method.name(),
+            "orders": candidates[oi].orders,
             "summary": summaries,
             "pass": pass,
         }));
@@ -394,7 +440,8 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
             "presets": selection.presets,
             "altitudes_m": selection.altitudes_m,
             "sun_elevations_deg": selection.sun_elevations_deg,
-            "orders": orders,
+            "methods": selection.methods.iter().map(|m| m.name()).collect::<Vec<_>>(),
+            "orders": selection.orders,
             "order_tail": selection.order_tail,
             "table_size": selection.table_size,
             "wavelengths_nm": wavelengths_nm,
@@ -432,6 +479,22 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
         anyhow::bail!("daylight thresholds broken: {msg}");
     }
     Ok(())
+}
+
+/// One sky method compared with the reference: a method, and the orders of 4D tables.
+pub struct Candidate {
+    pub method: Method,
+    pub orders: Option<usize>,
+}
+
+impl Candidate {
+    /// "bruneton4d, 4 orders" or "hillaire2020".
+    pub fn label(&self) -> String {
+        match self.orders {
+            Some(o) => format!("{}, {o} orders", self.method.name()),
+            None => self.method.name().to_string(),
+        }
+    }
 }
 
 /// Write `value` to `path`, atomically.

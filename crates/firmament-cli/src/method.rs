@@ -1,0 +1,138 @@
+//! `--method`: which sky method answers (render, query, validate, bench), and the CPU sky a
+//! method builds from the atmosphere flags.
+
+use std::time::Instant;
+
+use anyhow::Result;
+use clap::ValueEnum;
+use firmament::atmosphere::Model;
+use firmament::sky::bruneton4d::Bruneton4d;
+use firmament::sky::hillaire2020::{Hillaire2020, HillaireConfig};
+use firmament::sky::SkyMethod;
+use serde_json::{json, Value};
+
+use crate::common::AtmosphereArgs;
+
+/// The `--method` flag.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum Method {
+    /// Bruneton & Neyret 2008's precomputed 4D tables (`lut` is the same).
+    #[default]
+    #[value(alias = "lut")]
+    Bruneton4d,
+    /// Hillaire 2020: transmittance and multiple-scattering tables, a sky-view table per
+    /// view, a ray march for the rest (cheap to rebuild: for atmospheres that change).
+    Hillaire2020,
+    /// The spectral Monte Carlo reference path tracer.
+    Reference,
+}
+
+impl Method {
+    /// Its name on the command line and in JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Bruneton4d => "bruneton4d",
+            Method::Hillaire2020 => "hillaire2020",
+            Method::Reference => "reference",
+        }
+    }
+}
+
+/// A sky method built on the CPU.
+pub enum CpuSky {
+    Bruneton4d(Box<Bruneton4d>),
+    Hillaire2020(Box<Hillaire2020>),
+}
+
+impl CpuSky {
+    /// The method behind the seam.
+    pub fn method(&self) -> &dyn SkyMethod {
+        match self {
+            CpuSky::Bruneton4d(s) => s.as_ref(),
+            CpuSky::Hillaire2020(s) => s.as_ref(),
+        }
+    }
+
+    /// The atmosphere it evaluates.
+    pub fn model(&self) -> &Model {
+        self.method().model()
+    }
+
+    /// The 4D tables, when that is the method.
+    pub fn bruneton4d(&self) -> Option<&Bruneton4d> {
+        match self {
+            CpuSky::Bruneton4d(s) => Some(s),
+            CpuSky::Hillaire2020(_) => None,
+        }
+    }
+
+    /// The method's name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            CpuSky::Bruneton4d(_) => Method::Bruneton4d.name(),
+            CpuSky::Hillaire2020(_) => Method::Hillaire2020.name(),
+        }
+    }
+
+    /// What the method's tables are, for provenance: the 4D tables' configuration, or
+    /// Hillaire's sizes and sample counts.
+    pub fn tables_json(&self) -> Value {
+        match self {
+            CpuSky::Bruneton4d(s) => serde_json::to_value(s.tables.config).unwrap_or(Value::Null),
+            CpuSky::Hillaire2020(s) => hillaire_json(&s.config, s.max_f_ms),
+        }
+    }
+}
+
+/// Hillaire's sizes and counts as JSON.
+fn hillaire_json(c: &HillaireConfig, max_f_ms: f64) -> Value {
+    json!({
+        "transmittance": [c.transmittance.0, c.transmittance.1],
+        "multiple_scattering": [c.multiple_scattering.0, c.multiple_scattering.1],
+        "multiple_scattering_directions": c.multiple_scattering_directions,
+        "multiple_scattering_steps": c.multiple_scattering_steps,
+        "sky_view": [c.sky_view.0, c.sky_view.1],
+        "sky_view_steps": c.sky_view_steps,
+        "irradiance": [c.irradiance.0, c.irradiance.1],
+        "march_steps": c.march_steps,
+        "max_f_ms": max_f_ms,
+    })
+}
+
+impl AtmosphereArgs {
+    /// The sky of `method` on the CPU (the 4D tables through [`AtmosphereArgs::sky`]: file,
+    /// cache or precomputed); `reference` is not a tabulated method and is refused here.
+    pub fn cpu_sky(&self, method: Method, quiet: bool) -> Result<CpuSky> {
+        match method {
+            Method::Bruneton4d => Ok(CpuSky::Bruneton4d(Box::new(self.sky(quiet)?))),
+            Method::Hillaire2020 => {
+                if let Some(path) = &self.tables {
+                    anyhow::bail!(
+                        "`--tables {}` holds 4D tables: `--method hillaire2020` builds its own (in milliseconds)",
+                        path.display()
+                    );
+                }
+                let model = self.model()?;
+                Ok(CpuSky::Hillaire2020(Box::new(hillaire(model, quiet)?)))
+            }
+            Method::Reference => {
+                anyhow::bail!("`--method reference` has no tables: it is the path tracer")
+            }
+        }
+    }
+}
+
+/// Hillaire 2020's tables for `model`, with a `tables:` line on stderr unless `quiet`.
+pub fn hillaire(model: Model, quiet: bool) -> Result<Hillaire2020> {
+    let started = Instant::now();
+    let channels = model.channels();
+    let sky = Hillaire2020::compute(model, &HillaireConfig::default())?;
+    if !quiet {
+        eprintln!(
+            "tables: {:.1} ms (hillaire2020: transmittance, multiple scattering (f_ms ≤ {:.2}), sky irradiance; {channels} wavelengths)",
+            started.elapsed().as_secs_f64() * 1e3,
+            sky.max_f_ms
+        );
+    }
+    Ok(sky)
+}
