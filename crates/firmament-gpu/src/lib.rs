@@ -1,7 +1,10 @@
-//! firmament's wgpu backend: the precomputed tables of Bruneton & Neyret 2008 (as refined in
-//! Bruneton 2017) computed by compute shaders, in the same sizes and texel layout as the CPU
-//! path ([`firmament::sky::bruneton4d`]), so the two compare texel by texel and share the
-//! table file format; and frames of the clear sky rendered from them.
+//! firmament's wgpu backend, two sky methods computed by compute shaders in the same sizes
+//! and texel layout as their CPU paths, so that the two compare texel by texel: the
+//! precomputed tables of Bruneton & Neyret 2008 (as refined in Bruneton 2017;
+//! [`firmament::sky::bruneton4d`], sharing its table file format) and the small tables of
+//! Hillaire 2020 with their per-frame sky view ([`firmament::sky::hillaire2020`];
+//! [`hillaire2020`]); and frames of the clear sky rendered from either (over a terrain from
+//! the 4D tables only).
 //!
 //! ```no_run
 //! use firmament::atmosphere::Atmosphere;
@@ -19,11 +22,16 @@
 //! ([`GpuSky::precompute`], [`GpuSky::tables`]: buffers with documented bindings), renders
 //! into its own buffer or texture ([`GpuRenderer::encode`]) or samples the tables in its
 //! own shaders with the sky method's WGSL module ([`shader::sky_module`]); readback is a
-//! separate step ([`GpuTables::read_back`], [`GpuRenderer::read_frame`]).
+//! separate step ([`GpuTables::read_back`], [`GpuRenderer::read_frame`]). Hillaire 2020
+//! goes the same way: [`GpuHillaire::compute`] (refusing what `Hillaire2020::compute`
+//! refuses), [`GpuHillaire::tables`], [`GpuHillaireRenderer::encode`],
+//! [`shader::hillaire2020_sky_module`], [`GpuHillaireTables::read_back`], with per-pass GPU
+//! times ([`HillairePrecomputer::time_passes`], [`GpuHillaireRenderer::time_render`]).
 //!
 //! Shaders are WGSL under `shaders/`: `common/` (types, bindings, profiles, phase functions,
 //! geometry), `bruneton4d/` (parameterisations, filters, lookups, `view.wgsl` for rendering,
-//! and `precompute/` one file per pass) and `render/` (lights, cameras, the frame), each named
+//! and `precompute/` one file per pass), `hillaire2020/` (its parameterisations, harmonics,
+//! ray march, passes and `view.wgsl`) and `render/` (lights, cameras, the frame), each named
 //! like the Rust file it mirrors, composed with a prelude of the Rust constants
 //! ([`shader`]). The atmosphere travels in uniform and storage buffers; changing it compiles
 //! nothing.
@@ -31,6 +39,7 @@
 pub mod bruneton4d;
 mod device;
 mod error;
+pub mod hillaire2020;
 pub mod passes;
 pub mod render;
 pub mod shader;
@@ -39,6 +48,10 @@ pub mod terrain;
 pub use bruneton4d::{GpuSky, GpuTables, Precomputer};
 pub use device::{test_context, GpuContext};
 pub use error::GpuError;
+pub use hillaire2020::{
+    GpuHillaire, GpuHillaireRenderer, GpuHillaireTables, HillaireFrameTiming, HillairePassTiming,
+    HillairePrecomputer, HillaireTables,
+};
 pub use render::{GpuRenderer, RenderInputs, RenderTarget, RenderTiming, PIXEL_BYTES};
 pub use terrain::GpuTerrain;
 

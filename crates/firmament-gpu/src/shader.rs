@@ -1,6 +1,7 @@
 //! WGSL composition. Every constant the shaders share with the CPU code is defined once, in
 //! Rust, and handed to WGSL in a generated prelude; every pipeline's source is the prelude
-//! followed by the modules it needs, in the order of [`Module`]s given. Each WGSL file has a
+//! followed by the modules it needs, in the order of [`Module`]s given (Hillaire 2020's
+//! shaders add their own constants after it). Each WGSL file has a
 //! Rust twin with the same name and function names (see `docs/architecture.md`).
 
 use firmament::math::quadrature::GL4;
@@ -132,6 +133,42 @@ pub const RENDER: [Module; 7] = [
     module!("render/air_volume.wgsl"),
     module!("render/sky_dome.wgsl"),
     module!("render/scene.wgsl"),
+    module!("render/render.wgsl"),
+];
+
+/// Hillaire 2020's shared modules (after [`COMMON`] and [`BRUNETON4D`], whose lookups read
+/// its optical depth): its sizes and data, parameterisations, harmonics and the ray march.
+pub const HILLAIRE2020: [Module; 4] = [
+    module!("hillaire2020/config.wgsl"),
+    module!("hillaire2020/params.wgsl"),
+    module!("hillaire2020/harmonics.wgsl"),
+    module!("hillaire2020/march.wgsl"),
+];
+
+/// Hillaire 2020's atmosphere-wide passes besides the transmittance (the 4D tables' pass,
+/// [`hillaire2020_transmittance_source`]), one file each.
+pub mod hillaire2020_passes {
+    use super::Module;
+    /// multiple_scattering.wgsl (entry points `gather` and `main`)
+    pub const MULTIPLE_SCATTERING: Module = module!("hillaire2020/multiple_scattering.wgsl");
+    /// irradiance.wgsl
+    pub const IRRADIANCE: Module = module!("hillaire2020/irradiance.wgsl");
+}
+
+/// Hillaire 2020's render-time modules: the per-frame sky-view tables (entry point
+/// `sky_view`) and the view.
+pub const HILLAIRE2020_VIEW: [Module; 2] = [
+    module!("hillaire2020/sky_view.wgsl"),
+    module!("hillaire2020/view.wgsl"),
+];
+
+/// What a Hillaire 2020 frame takes of the renderer's modules (no terrain: its scene is the
+/// clear sky, `hillaire2020/scene.wgsl`): lights, cameras, the disks' edges, the frame.
+pub const HILLAIRE2020_RENDER: [Module; 5] = [
+    module!("hillaire2020/scene.wgsl"),
+    module!("render/light.wgsl"),
+    module!("render/camera.wgsl"),
+    module!("render/disk_edges.wgsl"),
     module!("render/render.wgsl"),
 ];
 
@@ -284,13 +321,87 @@ pub fn render_source(output_format: Option<&str>) -> String {
     compose(&modules, output_format)
 }
 
+/// The constants Hillaire 2020's shaders add to the prelude.
+fn hillaire2020_prelude() -> String {
+    format!(
+        "// Hillaire 2020 (firmament_gpu::hillaire2020).\nconst F_MS_GUARD: f32 = {:?};\n",
+        crate::hillaire2020::F_MS_GUARD as f32
+    )
+}
+
+/// [`compose`] with Hillaire 2020's constants after the prelude.
+fn compose_hillaire2020(modules: &[Module], output_format: Option<&str>) -> String {
+    let mut s = compose(modules, output_format);
+    s.insert_str(prelude().len(), &hillaire2020_prelude());
+    s
+}
+
+/// The 4D tables' transmittance pass with `segments` Gauss–Legendre segments per ray in
+/// place of [`TRANSMITTANCE_SEGMENTS`] (Hillaire 2020's `transmittance_segments`).
+pub fn hillaire2020_transmittance_source(segments: usize) -> String {
+    let line = |n: usize| format!("const TRANSMITTANCE_SEGMENTS: u32 = {n}u;\n");
+    let source = precompute_source(passes::TRANSMITTANCE);
+    assert!(source.contains(&line(TRANSMITTANCE_SEGMENTS)));
+    source.replacen(&line(TRANSMITTANCE_SEGMENTS), &line(segments), 1)
+}
+
+/// The source of Hillaire 2020's pass `pass` ([`hillaire2020_passes`]).
+pub fn hillaire2020_pass_source(pass: Module) -> String {
+    let modules: Vec<Module> = COMMON
+        .iter()
+        .chain(&BRUNETON4D)
+        .chain(&HILLAIRE2020)
+        .copied()
+        .chain([pass])
+        .collect();
+    compose_hillaire2020(&modules, None)
+}
+
+/// Hillaire 2020's WGSL for an engine's own shader: the prelude, the common modules, the
+/// optical-depth lookups, the march, the sky-view tables and the view functions (the names
+/// of [`sky_module`]'s `sky_ray`/`sky_radiance`, `ground_ray`/`sky_radiance_to_point`,
+/// `ground_light`/`sun_and_sky_irradiance`, and the `sky_view` entry point that fills the
+/// per-frame tables). The bindings are listed in `shaders/hillaire2020/view.wgsl` and on
+/// [`crate::GpuHillaire`]. One sky method per shader: it defines the same names as
+/// [`sky_module`].
+pub fn hillaire2020_sky_module() -> String {
+    let modules: Vec<Module> = COMMON
+        .iter()
+        .chain(&BRUNETON4D)
+        .chain(&HILLAIRE2020)
+        .chain(&HILLAIRE2020_VIEW)
+        .copied()
+        .collect();
+    compose_hillaire2020(&modules, None)
+}
+
+/// The render shader of a Hillaire 2020 frame ([`render_source`] with Hillaire's view in
+/// place of the 4D tables' and no terrain), to a buffer or a storage texture.
+pub fn hillaire2020_render_source(output_format: Option<&str>) -> String {
+    let output = if output_format.is_some() {
+        OUTPUT_TEXTURE
+    } else {
+        OUTPUT_BUFFER
+    };
+    let modules: Vec<Module> = COMMON
+        .iter()
+        .chain(&BRUNETON4D)
+        .chain(&HILLAIRE2020)
+        .chain(&HILLAIRE2020_VIEW)
+        .chain(&HILLAIRE2020_RENDER)
+        .copied()
+        .chain([output])
+        .collect();
+    compose_hillaire2020(&modules, output_format)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn prelude_holds_the_rust_constants() {
-        let p = prelude();
+        let p = prelude() + &hillaire2020_prelude();
         assert!(p.contains(&format!("const RAY_INTERVALS: u32 = {RAY_INTERVALS}u;")));
         assert!(p.contains("const MAX_CHANNEL_GROUPS: u32 = 16u;"));
         let node = format!("{:?}", GL4.nodes[0] as f32);
@@ -303,6 +414,13 @@ mod tests {
             .chain(&RENDER)
             .chain(&BRUNETON4D_VIEW)
             .chain(&TERRAIN)
+            .chain(&HILLAIRE2020)
+            .chain(&HILLAIRE2020_VIEW)
+            .chain(&HILLAIRE2020_RENDER)
+            .chain(&[
+                hillaire2020_passes::MULTIPLE_SCATTERING,
+                hillaire2020_passes::IRRADIANCE,
+            ])
             .chain(&[OUTPUT_BUFFER, OUTPUT_TEXTURE])
         {
             for line in p.lines().filter(|l| l.starts_with("const ")) {
@@ -328,7 +446,29 @@ mod tests {
                 render_source(Some("rgba16float")),
             ),
             ("sky module".to_string(), sky_module()),
+            (
+                "hillaire2020 render (buffer)".to_string(),
+                hillaire2020_render_source(None),
+            ),
+            (
+                "hillaire2020 render (rgba32float)".to_string(),
+                hillaire2020_render_source(Some("rgba32float")),
+            ),
+            (
+                "hillaire2020 sky module".to_string(),
+                hillaire2020_sky_module(),
+            ),
+            (
+                "hillaire2020 transmittance (16 segments)".to_string(),
+                hillaire2020_transmittance_source(16),
+            ),
         ];
+        for pass in [
+            hillaire2020_passes::MULTIPLE_SCATTERING,
+            hillaire2020_passes::IRRADIANCE,
+        ] {
+            sources.push((pass.path.to_string(), hillaire2020_pass_source(pass)));
+        }
         for pass in [
             TRANSMITTANCE,
             DIRECT_IRRADIANCE,

@@ -1,7 +1,8 @@
 //! The render shader's per-frame uniforms, computed in f64 and rounded once: the `Frame`
 //! of `shaders/render/render.wgsl`, the `Lights` of `shaders/render/light.wgsl` and the
 //! `SliceCoordinates` of `shaders/bruneton4d/view.wgsl`, with the layout constants the
-//! prelude hands to WGSL.
+//! prelude hands to WGSL. The first two serve every sky method on the device
+//! ([`FrameSky`]: the 4D tables' [`GpuSky`], Hillaire 2020's `GpuHillaire`).
 
 use firmament::math::sphere::safe_sqrt;
 use firmament::math::Vec3;
@@ -37,6 +38,39 @@ pub const LIGHTS_DATA_VEC4: usize = MAX_LIGHTS * (MAX_CHANNELS / GROUP) * LIGHT_
 /// Tables in a slice entry: single Rayleigh, multiple, single Mie.
 pub const SLICE_TABLES: usize = 3;
 
+/// What the `Frame` and `Lights` uniforms read of a sky method on the device.
+pub(crate) trait FrameSky {
+    /// The ground's and the top's radii (m).
+    fn radii_m(&self) -> (f64, f64);
+    /// `View.mie_layout` of the 4D tables (0 for a method without one).
+    fn mie_layout(&self) -> u32;
+    /// Number of wavelengths.
+    fn channel_count(&self) -> usize;
+    /// The solar irradiance the method's tables were computed with (each light scales
+    /// against it).
+    fn solar_irradiance(&self) -> &[f64];
+    /// White-balance factors (ColourMatrix::white_balance with the option on).
+    fn balance(&self) -> [f64; 3];
+}
+
+impl FrameSky for GpuSky {
+    fn radii_m(&self) -> (f64, f64) {
+        (self.radii.bottom, self.radii.top)
+    }
+    fn mie_layout(&self) -> u32 {
+        self.mie_layout
+    }
+    fn channel_count(&self) -> usize {
+        self.channels
+    }
+    fn solar_irradiance(&self) -> &[f64] {
+        &self.solar_irradiance
+    }
+    fn balance(&self) -> [f64; 3] {
+        self.balance
+    }
+}
+
 fn bits(x: f64) -> u32 {
     (x as f32).to_bits()
 }
@@ -68,13 +102,13 @@ pub(crate) struct FrameConstants {
 
 impl FrameConstants {
     pub(crate) fn new(
-        sky: &GpuSky,
+        sky: &impl FrameSky,
         lights: usize,
         shadow_input: bool,
         settings: &RenderSettings,
     ) -> FrameConstants {
         let camera = settings.camera;
-        let (bottom, top) = (sky.radii.bottom, sky.radii.top);
+        let (bottom, top) = sky.radii_m();
         let r = bottom + camera.altitude_m;
         let prepared = camera.prepare(bottom, settings.width, settings.height);
         let (forward, right, up) = prepared.basis();
@@ -90,12 +124,12 @@ impl FrameConstants {
             },
             lights: lights as u32,
             shadow_input: u32::from(shadow_input),
-            mie_layout: sky.mie_layout,
+            mie_layout: sky.mie_layout(),
             forward,
             right,
             up,
             balance: if settings.white_balance {
-                sky.balance
+                sky.balance()
             } else {
                 [1.0; 3]
             },
@@ -145,7 +179,7 @@ impl FrameConstants {
 /// The `Lights` uniform: directions, disks and per-group data of up to [`MAX_LIGHTS`]
 /// lights, scaled against the tables' solar irradiance, and the background glow.
 pub(crate) fn light_words(
-    sky: &GpuSky,
+    sky: &impl FrameSky,
     lights: &[Light],
     background: Option<&Background>,
 ) -> Vec<u32> {
@@ -158,8 +192,8 @@ pub(crate) fn light_words(
         disk[l * 4] = u32::from(light.visible_disk);
         disk[l * 4 + 1] = bits(light.angular_radius_rad.sin());
         disk[l * 4 + 2] = u32::from(matches!(light.disk, DiskProfile::Lunar(_)));
-        let scale = light.scale_against(&sky.solar_irradiance);
-        for k in 0..sky.channels {
+        let scale = light.scale_against(sky.solar_irradiance());
+        for k in 0..sky.channel_count() {
             let (group, lane) = (k / GROUP, k % GROUP);
             let mut set = |row: usize, v: f64| {
                 data[((l * groups + group) * LIGHT_STRIDE + row) * 4 + lane] = v as f32;
@@ -195,7 +229,12 @@ pub(crate) fn light_words(
         glow[0] = 1.0;
         glow[1] = b.layer_fraction as f32;
         glow[2] = (b.layer_radius_m * 1e-3) as f32;
-        for (k, v) in b.zenith_radiance.iter().enumerate().take(sky.channels) {
+        for (k, v) in b
+            .zenith_radiance
+            .iter()
+            .enumerate()
+            .take(sky.channel_count())
+        {
             glow[4 + k] = *v as f32;
         }
     }

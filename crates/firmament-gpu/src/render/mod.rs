@@ -67,7 +67,7 @@ use frame::{light_words, slice_words, FrameConstants, MAX_LIGHTS};
 pub const PIXEL_BYTES: u64 = 16;
 /// Rows of a band are a multiple of this, so that every band's offset in the output buffer
 /// (rows × width × 16 bytes) is a multiple of 256, the largest storage-offset alignment.
-const BAND_ROW_ALIGN: usize = 16;
+pub(crate) const BAND_ROW_ALIGN: usize = 16;
 /// Storage buffers the render pass binds: data, five tables, output, slice, terrain.
 const STORAGE_BUFFERS_NEEDED: u32 = 9;
 
@@ -559,7 +559,7 @@ impl GpuRenderer {
 }
 
 /// A [`Frame`] from the frame buffer's pixels (4 floats each).
-fn frame_from_pixels(values: &[f32], width: usize, height: usize) -> Frame {
+pub(crate) fn frame_from_pixels(values: &[f32], width: usize, height: usize) -> Frame {
     let mut image = ImageRgbF32::new(width, height);
     let mut mask = vec![false; width * height];
     for ((p, m), v) in image

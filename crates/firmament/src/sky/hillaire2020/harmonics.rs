@@ -11,6 +11,9 @@ use crate::math::quadrature::GL8;
 use crate::medium::PhaseFunction;
 use std::f64::consts::PI;
 
+/// The largest degree of the multiple-scattering field's harmonics.
+pub const MAX_DEGREE: usize = 8;
+
 /// Y₀₀ = 1/√(4π).
 pub const Y00: f64 = 0.282_094_791_773_878_14;
 
@@ -33,7 +36,7 @@ pub fn eval(degree: usize, mu: f64, cos_phi: f64, out: &mut [f64]) {
     let sin_theta = (1.0 - mu * mu).max(0.0).sqrt();
     let cos_phi = cos_phi.clamp(-1.0, 1.0);
     // cos mφ by the Chebyshev recurrence.
-    let mut cos_m = [0.0; 16];
+    let mut cos_m = [0.0; MAX_DEGREE + 1];
     cos_m[0] = 1.0;
     if degree >= 1 {
         cos_m[1] = cos_phi;

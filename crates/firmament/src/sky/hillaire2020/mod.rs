@@ -134,11 +134,11 @@ impl HillaireConfig {
             }
         }
         if let MultipleScatteringModel::Harmonics(d) = self.multiple_scattering_model {
-            if !(1..=8).contains(&d) {
+            if !(1..=harmonics::MAX_DEGREE).contains(&d) {
                 return Err(Error::invalid(
                     "hillaire.multiple_scattering_model.degree",
                     d,
-                    "an integer from 1 to 8",
+                    format!("an integer from 1 to {}", harmonics::MAX_DEGREE),
                 ));
             }
         }
@@ -175,10 +175,23 @@ pub struct Hillaire2020 {
 impl Hillaire2020 {
     /// Build the tables for `model` (refused where f_ms passes [`F_MS_LIMIT`]).
     pub fn compute(model: Model, config: &HillaireConfig) -> Result<Hillaire2020> {
+        Hillaire2020::compute_reporting(model, config, &|_| {})
+    }
+
+    /// [`Hillaire2020::compute`], calling `stage` with the name of each pass as it starts
+    /// ("transmittance", "multiple scattering", "irradiance") and "done" at the end (for
+    /// timings).
+    pub fn compute_reporting(
+        model: Model,
+        config: &HillaireConfig,
+        stage: &dyn Fn(&str),
+    ) -> Result<Hillaire2020> {
         config.validate()?;
         crate::spectrum::check_channels(model.channels(), "Hillaire 2020")?;
         let sizes = config.table_sizes();
+        stage("transmittance");
         let optical_depth = compute_optical_depth_in(&model, &sizes, config.transmittance_segments);
+        stage("multiple scattering");
         let ms = {
             let marcher = Marcher {
                 medium: Medium::new(&model),
@@ -218,6 +231,7 @@ impl Hillaire2020 {
             multiple_scattering: ms,
             irradiance: Table2::new(1, 1, 1),
         };
+        stage("irradiance");
         let (w, h) = config.irradiance;
         sky.irradiance = irradiance::compute(
             &sky.marcher(),
@@ -226,6 +240,7 @@ impl Hillaire2020 {
             config.irradiance_directions,
             config.irradiance_steps,
         );
+        stage("done");
         Ok(sky)
     }
 

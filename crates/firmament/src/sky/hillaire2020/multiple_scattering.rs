@@ -36,6 +36,10 @@ use crate::sky::bruneton4d::Table2;
 /// The largest f_ms the method accepts (see the module's notes and docs/accuracy.md).
 pub const F_MS_LIMIT: f64 = 0.8;
 
+/// The guard on f_ms in 1/(1 − f_ms) while the pass runs (the atmospheres that reach it are
+/// refused after the pass, by [`F_MS_LIMIT`]).
+pub const F_MS_GUARD: f64 = 0.999;
+
 /// How the second order's field is represented (see the module's notes).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MultipleScatteringModel {
@@ -197,7 +201,7 @@ pub(crate) fn compute(
                 // Degree 0 carries the second order's mean and the isotropic series of the
                 // higher orders: ×1/(1 − f_ms) (guarded here; compute() refuses f ≥ the
                 // limit).
-                field[k] /= 1.0 - f_ms[k].min(0.999);
+                field[k] /= 1.0 - f_ms[k].min(F_MS_GUARD);
             }
             for (o, v) in out.iter_mut().zip(&field) {
                 *o = *v as f32;
