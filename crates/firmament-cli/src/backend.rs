@@ -20,8 +20,13 @@ use firmament::scene::terrain::Heightfield;
 use firmament::scene::{Scene, Surface};
 use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, Tables};
 use firmament::sky::SkyMethod;
+use firmament_gpu::hillaire2020::{GpuHillaire, GpuHillaireRenderer, HillairePrecomputer};
 use firmament_gpu::Precomputer;
 use firmament_gpu::{GpuContext, GpuError, GpuRenderer, GpuSky, GpuTerrain, RenderInputs};
+
+/// Hillaire 2020 in words, for provenance.
+const HILLAIRE_IN_WORDS: &str =
+    "hillaire2020 (transmittance, multiple-scattering and sky-view tables; ray march)";
 
 use crate::common::{cancel_flag, print_tables_time, progress_bar, spinner, AtmosphereArgs};
 use crate::method::{CpuSky, Method};
@@ -269,6 +274,13 @@ pub enum RenderSky<'a> {
         /// The tables' configuration (to read them back).
         config: TableConfig,
     },
+    /// Hillaire 2020 on the GPU (the clear sky: no terrain there yet).
+    GpuHillaire {
+        gpu: &'a Gpu,
+        sky: Box<GpuHillaire>,
+        sky_model: Box<Model>,
+        renderer: Box<GpuHillaireRenderer>,
+    },
 }
 
 impl<'a> RenderSky<'a> {
@@ -289,8 +301,39 @@ impl<'a> RenderSky<'a> {
                 ))
             }
             (Backend::Gpu(gpu), Method::Bruneton4d) => gpu,
-            (Backend::Gpu(_), other) => {
-                anyhow::bail!("`--method {}` renders on the CPU only so far", other.name())
+            (Backend::Gpu(gpu), Method::Hillaire2020) => {
+                let model = atmosphere.model()?;
+                let config = crate::method::hillaire_config(atmosphere.hillaire_harmonics);
+                let started = Instant::now();
+                let sky = on_gpu("Hillaire 2020's tables on the GPU", quiet, || {
+                    let precomputer = HillairePrecomputer::new(&gpu.ctx)
+                        .map_err(|e| gpu_failure("compiling Hillaire 2020's passes", e))?;
+                    let sky = GpuHillaire::compute(&gpu.ctx, &precomputer, &model, &config)
+                        .map_err(|e| gpu_failure("Hillaire 2020's tables", e))?;
+                    gpu.wait_idle("Hillaire 2020's tables")?;
+                    Ok(sky)
+                })?;
+                if !quiet {
+                    eprintln!(
+                        "tables: {:.2} s on the GPU (hillaire2020, f_ms ≤ {:.2}; shader compilation included; kept on the device)",
+                        started.elapsed().as_secs_f64(),
+                        sky.max_f_ms()
+                    );
+                }
+                let renderer = GpuHillaireRenderer::new(&gpu.ctx)
+                    .map_err(|e| gpu_failure("compiling the render shader", e))?;
+                return Ok(RenderSky::GpuHillaire {
+                    gpu,
+                    sky: Box::new(sky),
+                    sky_model: Box::new(model),
+                    renderer: Box::new(renderer),
+                });
+            }
+            (Backend::Gpu(_), Method::Reference | Method::Elek3d) => {
+                anyhow::bail!(
+                    "`--method {}` renders on the CPU only so far",
+                    method.name()
+                )
             }
         };
         let cpu_sky = Box::new(OnceLock::new());
@@ -326,7 +369,7 @@ impl<'a> RenderSky<'a> {
     pub fn with_aerial_volume(self, config: AerialVolumeConfig) -> Result<Self> {
         match self {
             RenderSky::Cpu(sky, _) => Ok(RenderSky::Cpu(sky, Some(config))),
-            RenderSky::Gpu { .. } => anyhow::bail!(
+            RenderSky::Gpu { .. } | RenderSky::GpuHillaire { .. } => anyhow::bail!(
                 "`--aerial-volume` is built by the CPU renderer only so far: use `--backend cpu`"
             ),
         }
@@ -336,6 +379,7 @@ impl<'a> RenderSky<'a> {
     pub fn on(&self) -> &'static str {
         match self {
             RenderSky::Cpu(..) => "",
+            RenderSky::GpuHillaire { .. } => " on the GPU",
             RenderSky::Gpu { .. } => " on the GPU",
         }
     }
@@ -351,7 +395,12 @@ impl<'a> RenderSky<'a> {
         planet: Option<&PlanetSurface>,
         quiet: bool,
     ) -> Result<Frame> {
-        if planet.is_some() && matches!(self, RenderSky::Gpu { .. }) {
+        if terrain.is_some() && matches!(self, RenderSky::GpuHillaire { .. }) {
+            anyhow::bail!(
+                "`--method hillaire2020` draws terrain on the CPU only so far: use `--backend cpu` (or `auto`)"
+            );
+        }
+        if planet.is_some() && !matches!(self, RenderSky::Cpu(..)) {
             anyhow::bail!(
                 "the planet's surface map ([surface]) renders on the CPU only so far: use `--backend cpu` (or `auto`)"
             );
@@ -387,27 +436,32 @@ impl<'a> RenderSky<'a> {
                     terrain: gpu_terrain.as_ref(),
                     ..RenderInputs::default()
                 };
-                // Disks smaller than four pixels are points, as on the CPU.
-                let (w, h) = (settings.width, settings.height);
-                let prepared = settings.camera.prepare(sky_model.bottom_radius_m, w, h);
-                let small = stars::small_disks(&sources.lights, &prepared, w, h);
-                let mut lights = sources.lights.clone();
-                for (i, _) in &small {
-                    lights[*i].visible_disk = false;
-                }
+                let (lights, small) = gpu_lights(sources, settings, sky_model);
                 let mut frame = on_gpu("rendering on the GPU", quiet, || {
                     renderer
                         .render_with(&gpu.ctx, sky, &lights, settings, inputs)
                         .map_err(|e| gpu_failure("rendering", e))
                 })?;
-                // The stars and the small disks are points: splatted on the CPU into the
-                // frame read back, hidden by the terrain.
-                let occluders: Vec<&dyn Surface> =
-                    terrain.iter().map(|t| *t as &dyn Surface).collect();
-                let points: Vec<_> = (sources.stars.iter().cloned())
-                    .chain(small.into_iter().map(|(_, p)| p))
-                    .collect();
-                stars::draw_points_into(&mut frame, &points, sky_model, settings, &occluders);
+                draw_points(&mut frame, sources, small, sky_model, settings, terrain);
+                Ok(frame)
+            }
+            RenderSky::GpuHillaire {
+                gpu,
+                sky,
+                sky_model,
+                renderer,
+            } => {
+                let inputs = RenderInputs {
+                    background: sources.background.as_ref(),
+                    ..RenderInputs::default()
+                };
+                let (lights, small) = gpu_lights(sources, settings, sky_model);
+                let mut frame = on_gpu("rendering on the GPU", quiet, || {
+                    renderer
+                        .render_with(&gpu.ctx, sky, &lights, settings, inputs)
+                        .map_err(|e| gpu_failure("rendering", e))
+                })?;
+                draw_points(&mut frame, sources, small, sky_model, settings, None);
                 Ok(frame)
             }
         }
@@ -468,15 +522,20 @@ impl<'a> RenderSky<'a> {
             RenderSky::Gpu { config, .. } => {
                 serde_json::to_value(config).unwrap_or(serde_json::Value::Null)
             }
+            RenderSky::GpuHillaire { sky, .. } => {
+                crate::method::hillaire_json(sky.config(), sky.max_f_ms())
+            }
         }
     }
 
     /// The method in words, for provenance.
     pub fn describe(&self) -> &'static str {
         match self {
-            RenderSky::Cpu(sky, _) if sky.bruneton4d().is_none() => {
-                "hillaire2020 (transmittance, multiple-scattering and sky-view tables; ray march)"
+            RenderSky::Cpu(sky, _) if sky.name() == "elek3d" => {
+                "elek3d (3D scattering tables without the view-sun azimuth)"
             }
+            RenderSky::Cpu(sky, _) if sky.bruneton4d().is_none() => HILLAIRE_IN_WORDS,
+            RenderSky::GpuHillaire { .. } => HILLAIRE_IN_WORDS,
             _ => "bruneton4d (precomputed tables)",
         }
     }
@@ -486,8 +545,46 @@ impl<'a> RenderSky<'a> {
         match self {
             RenderSky::Cpu(sky, _) => sky.model(),
             RenderSky::Gpu { sky_model, .. } => sky_model,
+            RenderSky::GpuHillaire { sky_model, .. } => sky_model,
         }
     }
+}
+
+/// The lights a GPU frame draws, and the disks smaller than four pixels, which are points
+/// (as on the CPU) left out of its lights.
+fn gpu_lights(
+    sources: &SkySources,
+    settings: &RenderSettings,
+    model: &Model,
+) -> (
+    Vec<firmament::scene::Light>,
+    Vec<(usize, firmament::scene::sky_lights::PointSource)>,
+) {
+    let (w, h) = (settings.width, settings.height);
+    let prepared = settings.camera.prepare(model.bottom_radius_m, w, h);
+    let small = stars::small_disks(&sources.lights, &prepared, w, h);
+    let mut lights = sources.lights.clone();
+    for (i, _) in &small {
+        lights[*i].visible_disk = false;
+    }
+    (lights, small)
+}
+
+/// The stars and the small disks of a GPU frame, splatted on the CPU into the frame read
+/// back, hidden by the terrain.
+fn draw_points(
+    frame: &mut Frame,
+    sources: &SkySources,
+    small: Vec<(usize, firmament::scene::sky_lights::PointSource)>,
+    model: &Model,
+    settings: &RenderSettings,
+    terrain: Option<&Heightfield>,
+) {
+    let occluders: Vec<&dyn Surface> = terrain.iter().map(|t| *t as &dyn Surface).collect();
+    let points: Vec<_> = (sources.stars.iter().cloned())
+        .chain(small.into_iter().map(|(_, p)| p))
+        .collect();
+    stars::draw_points_into(frame, &points, model, settings, &occluders);
 }
 
 /// The CPU scene of a frame: the sky's tables, the sources' lights, glow and stars, over the

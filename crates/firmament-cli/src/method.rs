@@ -7,7 +7,8 @@ use anyhow::Result;
 use clap::ValueEnum;
 use firmament::atmosphere::Model;
 use firmament::sky::bruneton4d::Bruneton4d;
-use firmament::sky::hillaire2020::{Hillaire2020, HillaireConfig};
+use firmament::sky::elek3d::{Elek3d, Elek3dConfig};
+use firmament::sky::hillaire2020::{Hillaire2020, HillaireConfig, MultipleScatteringModel};
 use firmament::sky::SkyMethod;
 use serde_json::{json, Value};
 
@@ -23,6 +24,10 @@ pub enum Method {
     /// Hillaire 2020: transmittance and multiple-scattering tables, a sky-view table per
     /// view, a ray march for the rest (cheap to rebuild: for atmospheres that change).
     Hillaire2020,
+    /// Elek 2009 with Yusov 2013's parameterisation: the 4D tables without the view–sun
+    /// azimuth, a 3D table (Frostbite 2016; no Earth's shadow, the multiple scattering's
+    /// aureole spread over every azimuth: docs/accuracy.md).
+    Elek3d,
     /// The spectral Monte Carlo reference path tracer.
     Reference,
 }
@@ -33,6 +38,7 @@ impl Method {
         match self {
             Method::Bruneton4d => "bruneton4d",
             Method::Hillaire2020 => "hillaire2020",
+            Method::Elek3d => "elek3d",
             Method::Reference => "reference",
         }
     }
@@ -42,6 +48,7 @@ impl Method {
 pub enum CpuSky {
     Bruneton4d(Box<Bruneton4d>),
     Hillaire2020(Box<Hillaire2020>),
+    Elek3d(Box<Elek3d>),
 }
 
 impl CpuSky {
@@ -50,6 +57,7 @@ impl CpuSky {
         match self {
             CpuSky::Bruneton4d(s) => s.as_ref(),
             CpuSky::Hillaire2020(s) => s.as_ref(),
+            CpuSky::Elek3d(s) => s.as_ref(),
         }
     }
 
@@ -62,7 +70,7 @@ impl CpuSky {
     pub fn bruneton4d(&self) -> Option<&Bruneton4d> {
         match self {
             CpuSky::Bruneton4d(s) => Some(s),
-            CpuSky::Hillaire2020(_) => None,
+            _ => None,
         }
     }
 
@@ -71,6 +79,7 @@ impl CpuSky {
         match self {
             CpuSky::Bruneton4d(_) => Method::Bruneton4d.name(),
             CpuSky::Hillaire2020(_) => Method::Hillaire2020.name(),
+            CpuSky::Elek3d(_) => Method::Elek3d.name(),
         }
     }
 
@@ -80,13 +89,18 @@ impl CpuSky {
         match self {
             CpuSky::Bruneton4d(s) => serde_json::to_value(s.tables.config).unwrap_or(Value::Null),
             CpuSky::Hillaire2020(s) => hillaire_json(&s.config, s.max_f_ms),
+            CpuSky::Elek3d(s) => serde_json::json!({ "elek3d": format!("{:?}", s.config) }),
         }
     }
 }
 
 /// Hillaire's sizes and counts as JSON.
-fn hillaire_json(c: &HillaireConfig, max_f_ms: f64) -> Value {
+pub fn hillaire_json(c: &HillaireConfig, max_f_ms: f64) -> Value {
     json!({
+        "multiple_scattering_model": match c.multiple_scattering_model {
+            MultipleScatteringModel::Isotropic => "isotropic (Hillaire 2020)".to_string(),
+            MultipleScatteringModel::Harmonics(d) => format!("harmonics of degree {d} (firmament)"),
+        },
         "transmittance": [c.transmittance.0, c.transmittance.1],
         "multiple_scattering": [c.multiple_scattering.0, c.multiple_scattering.1],
         "multiple_scattering_directions": c.multiple_scattering_directions,
@@ -113,7 +127,35 @@ impl AtmosphereArgs {
                     );
                 }
                 let model = self.model()?;
-                Ok(CpuSky::Hillaire2020(Box::new(hillaire(model, quiet)?)))
+                let config = hillaire_config(self.hillaire_harmonics);
+                Ok(CpuSky::Hillaire2020(Box::new(hillaire(
+                    model, &config, quiet,
+                )?)))
+            }
+            Method::Elek3d => {
+                if let Some(path) = &self.tables {
+                    anyhow::bail!(
+                        "`--tables {}` holds 4D tables: `--method elek3d` builds its own 3D ones",
+                        path.display()
+                    );
+                }
+                let model = self.model()?;
+                let started = Instant::now();
+                let channels = model.channels();
+                let config = Elek3dConfig {
+                    orders: self.order_args.orders,
+                    order_tail: self.order_args.order_tail,
+                    ..Elek3dConfig::default()
+                };
+                let sky = Elek3d::compute(model, &config)?;
+                if !quiet {
+                    eprintln!(
+                        "tables: {:.2} s (elek3d: 3D tables, {} orders; {channels} wavelengths)",
+                        started.elapsed().as_secs_f64(),
+                        config.orders
+                    );
+                }
+                Ok(CpuSky::Elek3d(Box::new(sky)))
             }
             Method::Reference => {
                 anyhow::bail!("`--method reference` has no tables: it is the path tracer")
@@ -122,11 +164,25 @@ impl AtmosphereArgs {
     }
 }
 
+/// Hillaire's configuration with the second order in harmonics of `degree` (0: Hillaire's
+/// isotropic field).
+pub fn hillaire_config(degree: usize) -> HillaireConfig {
+    match degree {
+        0 => HillaireConfig::default(),
+        d => HillaireConfig {
+            multiple_scattering_model: MultipleScatteringModel::Harmonics(d),
+            // The harmonics need more gather directions than the isotropic mean.
+            multiple_scattering_directions: (24, 12),
+            ..HillaireConfig::default()
+        },
+    }
+}
+
 /// Hillaire 2020's tables for `model`, with a `tables:` line on stderr unless `quiet`.
-pub fn hillaire(model: Model, quiet: bool) -> Result<Hillaire2020> {
+pub fn hillaire(model: Model, config: &HillaireConfig, quiet: bool) -> Result<Hillaire2020> {
     let started = Instant::now();
     let channels = model.channels();
-    let sky = Hillaire2020::compute(model, &HillaireConfig::default())?;
+    let sky = Hillaire2020::compute(model, config)?;
     if !quiet {
         eprintln!(
             "tables: {:.1} ms (hillaire2020: transmittance, multiple scattering (f_ms ≤ {:.2}), sky irradiance; {channels} wavelengths)",

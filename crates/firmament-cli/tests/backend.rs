@@ -301,6 +301,46 @@ fn gpu_precompute_and_render_matches_cpu() {
     assert!(rel <= 0.01, "mean relative luminance difference {rel}");
 }
 
+#[test]
+fn gpu_hillaire2020_render_matches_cpu() {
+    let Some(_lock) = gpu() else { return };
+    // Hillaire 2020 on each backend: its tables and the sky-view table on the device.
+    let [(cpu_png, cpu_exr), (gpu_png, gpu_exr)] = render_both(
+        "hillaire2020",
+        &[
+            "--method",
+            "hillaire2020",
+            "--wavelengths",
+            "rgb",
+            "--width",
+            "48",
+            "--height",
+            "27",
+            "--sun-zenith-deg",
+            "70",
+        ],
+    );
+    let d8 = png_mean_abs_diff(&gpu_png, &cpu_png);
+    assert!(d8 <= 1.0, "mean |Δ| of 8-bit values {d8}");
+    let rel = exr_mean_rel_diff(&gpu_exr, &cpu_exr);
+    assert!(rel <= 0.01, "mean relative luminance difference {rel}");
+    // The terrain is the CPU's only so far: refused on `--backend gpu`.
+    let png = tmp().join("hillaire-terrain.png");
+    let o = run(&[
+        "render",
+        "--method",
+        "hillaire2020",
+        "--backend",
+        "gpu",
+        "--width",
+        "32",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    fails_with(&o, &["hillaire2020", "terrain", "--backend cpu"]);
+    assert!(!png.exists());
+}
+
 /// The default scene's valley (coarse) at golden hour, its tables precomputed on each
 /// backend with the ground lifted to the valley's floor: the GPU walks the same terrain,
 /// shadow fields and light shafts, with the air light computed on the CPU from the tables

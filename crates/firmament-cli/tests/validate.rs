@@ -158,7 +158,7 @@ fn unknown_method_is_a_clear_error() {
     let e = stderr(&out);
     assert!(
         e.contains("invalid value 'magic' for '--method")
-            && e.contains("bruneton4d, hillaire2020, reference"),
+            && e.contains("bruneton4d, hillaire2020, elek3d, reference"),
         "{e}"
     );
     let dir = tmp_subdir("method");
@@ -247,6 +247,25 @@ fn hillaire2020_answers_query_render_and_validate() {
     for view in v["views"].as_array().unwrap() {
         assert!(view["luminance_cd_m2"].as_f64().unwrap() > 100.0, "{view}");
     }
+    // The 3D table answers too.
+    let out = run(&[
+        "query",
+        "--method",
+        "elek3d",
+        "--wavelengths",
+        "rgb",
+        "--altitude-m",
+        "100",
+        "--sun-zenith-deg",
+        "50",
+        "--view",
+        "0,0",
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["method"], "elek3d");
+    assert!(v["views"][0]["luminance_cd_m2"].as_f64().unwrap() > 100.0);
     // `lut` is still the 4D tables.
     let out = run(&[
         "query",

@@ -55,7 +55,7 @@ pub struct QueryArgs {
     /// Method for the views: `bruneton4d` (or `lut`: the precomputed 4D tables),
     /// `hillaire2020` (Hillaire 2020's tables and march) or `reference` (Monte Carlo path
     /// tracer; adds `radiance_stderr` and `samples` to each view).
-    #[arg(long, value_enum, default_value_t = Method::Bruneton4d, value_name = "bruneton4d|lut|hillaire2020|reference")]
+    #[arg(long, value_enum, default_value_t = Method::Bruneton4d, value_name = "bruneton4d|lut|hillaire2020|elek3d|reference")]
     pub method: Method,
     /// Paths per wavelength and view for `--method reference`.
     #[arg(long, default_value_t = 10_000)]
@@ -173,7 +173,7 @@ fn moon_json(
 /// Run the query and return the JSON.
 pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
     let reference = match args.method {
-        Method::Bruneton4d | Method::Hillaire2020 => None,
+        Method::Bruneton4d | Method::Hillaire2020 | Method::Elek3d => None,
         Method::Reference => {
             let settings = ReferenceSettings {
                 samples: args.samples,
@@ -185,6 +185,9 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
             Some(settings)
         }
     };
+    if args.atmosphere.hillaire_harmonics != 0 && args.method != Method::Hillaire2020 {
+        anyhow::bail!("`--hillaire-harmonics` is for `--method hillaire2020`");
+    }
     if args.scene.is_some() {
         return super::query_scene::run(args, reference);
     }
@@ -219,11 +222,11 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
         .collect::<Result<_>>()?;
     print_wavelengths(&args.atmosphere.model()?, args.quiet);
     let sky = match (&args.atmosphere.tables, args.method) {
-        (_, Method::Hillaire2020) => {
+        (_, m @ (Method::Hillaire2020 | Method::Elek3d)) => {
             if !args.quiet {
-                eprintln!("backend: cpu (hillaire2020's tables take milliseconds on the CPU)");
+                eprintln!("backend: cpu ({} builds its tables on the CPU)", m.name());
             }
-            args.atmosphere.cpu_sky(Method::Hillaire2020, args.quiet)?
+            args.atmosphere.cpu_sky(m, args.quiet)?
         }
         // Nothing to compute: no adapter to open.
         (Some(path), _) => {
@@ -337,6 +340,7 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
         (None, Method::Hillaire2020) => {
             "hillaire2020 (transmittance, multiple-scattering and sky-view tables; ray march)"
         }
+        (None, Method::Elek3d) => "elek3d (3D scattering tables without the view-sun azimuth)",
         (None, _) => "bruneton4d (precomputed tables)",
     };
     Ok(json!({

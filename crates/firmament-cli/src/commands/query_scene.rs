@@ -28,13 +28,14 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
     let views: Vec<(f64, f64)> = (args.views.iter())
         .map(|v| parse_view(v))
         .collect::<Result<_>>()?;
-    let (terrain, atmosphere) = terrain_and_atmosphere(
+    let (terrain, mut atmosphere) = terrain_and_atmosphere(
         &scene,
         args.atmosphere.tables.clone(),
         &args.atmosphere.table_size,
         args.atmosphere.no_cache,
         args.quiet,
     )?;
+    atmosphere.hillaire_harmonics = args.atmosphere.hillaire_harmonics;
     // What the reference cannot trace is refused before the tables are computed.
     if reference.is_some() && scene.surface.as_ref().is_some_and(|s| s.glint) {
         anyhow::bail!("`--method reference` traces Lambertian surfaces only: the sun's glint on the sea is not in it (set `glint = false` in [surface] to compare the map)");

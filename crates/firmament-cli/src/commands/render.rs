@@ -206,7 +206,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
     }
     match args.method {
-        Method::Bruneton4d | Method::Hillaire2020 => {}
+        Method::Bruneton4d | Method::Hillaire2020 | Method::Elek3d => {}
         Method::Reference => {
             if args.aerial_volume {
                 anyhow::bail!("`--aerial-volume` is for the tabulated methods: `--method reference` traces every path");
@@ -249,9 +249,23 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             return write_outputs(&frame, &scene, ev100, files, &notes, args.quiet);
         }
     }
-    if args.method == Method::Hillaire2020 {
+    if args.hillaire_harmonics != 0 && args.method != Method::Hillaire2020 {
+        anyhow::bail!("`--hillaire-harmonics` is for `--method hillaire2020`");
+    }
+    let terrain_wanted = scene.terrain.is_some();
+    if args.method == Method::Elek3d {
         if args.backend == BackendChoice::Gpu {
-            anyhow::bail!("`--method hillaire2020` renders on the CPU only so far: use `--backend cpu` or `auto`");
+            anyhow::bail!(
+                "`--method elek3d` renders on the CPU only so far: use `--backend cpu` or `auto`"
+            );
+        }
+        if args.tables.is_some() {
+            anyhow::bail!("`--tables` holds 4D tables: `--method elek3d` builds its own 3D ones");
+        }
+    }
+    if args.method == Method::Hillaire2020 {
+        if args.backend == BackendChoice::Gpu && terrain_wanted {
+            anyhow::bail!("`--method hillaire2020` draws terrain on the CPU only so far: use `--backend cpu` or `auto`, or `--no-terrain`");
         }
         if args.tables.is_some() {
             anyhow::bail!("`--tables` holds 4D tables: `--method hillaire2020` builds its own (in milliseconds)");
@@ -260,10 +274,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let backend = match Backend::open(args.backend, args.quiet)? {
         Backend::Gpu(_)
             if args.backend == BackendChoice::Auto
-                && (args.method == Method::Hillaire2020 || args.aerial_volume) =>
+                && ((args.method == Method::Hillaire2020 && terrain_wanted)
+                    || args.method == Method::Elek3d
+                    || args.aerial_volume) =>
         {
             if !args.quiet {
-                eprintln!("note: hillaire2020 and --aerial-volume render on the CPU only so far: using the CPU");
+                eprintln!("note: elek3d, hillaire2020's terrain and --aerial-volume render on the CPU only so far: using the CPU");
             }
             Backend::Cpu
         }
@@ -290,6 +306,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         args.quiet,
     )?;
     atmosphere.order_args = args.order_args;
+    atmosphere.hillaire_harmonics = args.hillaire_harmonics;
     print_wavelengths(&atmosphere.model()?, args.quiet);
     let t = Instant::now();
     let mut sky = RenderSky::new(&backend, &atmosphere, args.method, args.quiet)?;

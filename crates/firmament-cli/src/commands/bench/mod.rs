@@ -7,6 +7,7 @@
 
 mod cpu;
 mod gpu;
+mod methods;
 mod report;
 mod scenes;
 mod timing;
@@ -16,6 +17,7 @@ use clap::{Args, ValueEnum};
 
 use crate::backend::{Gpu, Probe};
 use crate::common::AtmosphereArgs;
+use crate::method::Method;
 use report::{BenchReport, Machine};
 
 /// What `firmament bench` measures.
@@ -55,6 +57,14 @@ pub struct BenchArgs {
     /// a quick look).
     #[arg(long, value_enum, value_name = "auto|all|cpu|gpu", default_value_t = BenchBackend::Auto)]
     pub backend: BenchBackend,
+    /// Sky methods whose costs are measured, comma-separated (bruneton4d, hillaire2020,
+    /// elek3d); the 4D tables' figures are always there (the others are compared with them).
+    #[arg(
+        long,
+        default_value = "bruneton4d,hillaire2020,elek3d",
+        value_name = "METHOD,..."
+    )]
+    pub method: String,
     /// Repetitions per GPU measurement (default: --runs).
     #[arg(long, value_name = "N")]
     pub gpu_runs: Option<usize>,
@@ -72,6 +82,15 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         atmosphere,
         ..args.clone()
     };
+    let mut wanted = Vec::new();
+    for m in args.method.split(',') {
+        match Method::from_str(m.trim(), true) {
+            Ok(Method::Reference) | Err(_) => anyhow::bail!(
+                "invalid value for `--method`: {m:?} (accepted: bruneton4d (or lut), hillaire2020, elek3d, separated by commas)"
+            ),
+            Ok(m) => wanted.push(m),
+        }
+    }
     let model = args.atmosphere.model()?;
     let config = args.atmosphere.table_config()?;
     let spectral_model = if args.spectral {
@@ -115,14 +134,22 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         cpu_precompute: Default::default(),
         cpu_frames: Default::default(),
         cpu_reference: Default::default(),
+        cpu_methods: Default::default(),
         gpu_skipped,
         gpu: Default::default(),
     };
     if measure_cpu {
         report.cpu_precompute =
             cpu::precompute_timings(&model, &config, args.runs, spectral_model.as_ref())?;
-        report.cpu_frames = cpu::frame_timings(&args.atmosphere.sky(true)?, args.runs)?;
+        let tables = args.atmosphere.sky(true)?;
+        report.cpu_frames = cpu::frame_timings(&tables, args.runs)?;
         report.cpu_reference = cpu::reference_timings(&model, args.runs)?;
+        if wanted.contains(&Method::Hillaire2020) {
+            methods::hillaire_timings(&model, &tables, args.runs, &mut report.cpu_methods)?;
+        }
+        if wanted.contains(&Method::Elek3d) {
+            methods::elek3d_timings(&model, args.runs, &mut report.cpu_methods)?;
+        }
     }
     if let Some(gpu) = &gpu {
         let runs = args.gpu_runs.unwrap_or(args.runs).max(1);

@@ -20,6 +20,8 @@ pub struct BenchReport {
     pub cpu_frames: CpuFrames,
     #[serde(flatten)]
     pub cpu_reference: CpuReference,
+    #[serde(flatten)]
+    pub cpu_methods: CpuMethods,
     /// Why the GPU was not measured; `null` when it was.
     pub gpu_skipped: Option<String>,
     #[serde(flatten)]
@@ -58,6 +60,29 @@ pub struct CpuFrames {
     /// The default scene (the valley at golden hour, light shafts), 1920×1080: the shadow
     /// field of the sun and the frame; the terrain built once beforehand.
     pub cpu_frame_1080p_terrain_s: Option<f64>,
+}
+
+/// The fast methods on the CPU (seconds, medians): Hillaire 2020's tables (all of them, and
+/// each pass of one build), one sky-view table, the aerial-perspective volume (32³ froxels
+/// for the 1080p benchmark camera) of Hillaire's march and of the 4D tables, "the four
+/// LUTs" (transmittance, multiple scattering, sky view, aerial perspective: what a frame
+/// whose atmosphere changed pays), and the 1080p benchmark frame with Hillaire's method,
+/// per pixel and through the volume.
+#[derive(Serialize, Debug, Default)]
+pub struct CpuMethods {
+    pub cpu_hillaire_tables_s: Option<f64>,
+    pub cpu_hillaire_transmittance_s: Option<f64>,
+    pub cpu_hillaire_multiple_scattering_s: Option<f64>,
+    pub cpu_hillaire_irradiance_s: Option<f64>,
+    pub cpu_hillaire_sky_view_s: Option<f64>,
+    pub cpu_hillaire_aerial_volume_s: Option<f64>,
+    pub cpu_hillaire_four_luts_s: Option<f64>,
+    pub cpu_hillaire_frame_1080p_perspective_s: Option<f64>,
+    pub cpu_hillaire_frame_1080p_perspective_aerial_volume_s: Option<f64>,
+    pub cpu_bruneton4d_aerial_volume_s: Option<f64>,
+    /// The 3D table (Elek 2009 / Yusov 2013): its precomputation and the 1080p frame.
+    pub cpu_elek3d_tables_s: Option<f64>,
+    pub cpu_elek3d_frame_1080p_perspective_s: Option<f64>,
 }
 
 /// The reference path tracer's throughput: one earth RGB pixel (the zenith from 1 m, the

@@ -81,7 +81,7 @@ pub struct ValidateArgs {
     /// Cap of the adaptive paths per wavelength and view.
     #[arg(long, default_value_t = 65_536)]
     pub max_samples: usize,
-    /// Sky methods to validate, comma-separated: bruneton4d (or lut), hillaire2020; several
+    /// Sky methods to validate, comma-separated: bruneton4d (or lut), hillaire2020, elek3d; several
     /// are compared against the same reference (the first is checked against the
     /// thresholds).
     #[arg(long, default_value = "bruneton4d", value_name = "METHOD,...")]
@@ -90,6 +90,10 @@ pub struct ValidateArgs {
     /// reference (the first is the one checked against the thresholds).
     #[arg(long, default_value = "4", value_name = "N,...")]
     pub orders: String,
+    /// hillaire2020's second order in spherical harmonics of this degree (0: Hillaire's
+    /// isotropic field), as `render --hillaire-harmonics`.
+    #[arg(long, default_value_t = 0, value_name = "DEGREE")]
+    pub hillaire_harmonics: usize,
     /// Tables without the geometric tail of the orders beyond --orders.
     #[arg(long)]
     pub no_order_tail: bool,
@@ -136,6 +140,7 @@ struct Selection {
     table_size: String,
     wavelengths: String,
     order_tail: bool,
+    hillaire_harmonics: usize,
     samples: SamplePlan,
 }
 
@@ -175,7 +180,7 @@ impl Selection {
             .split(',')
             .map(|m| match Method::from_str(m.trim(), true) {
                 Ok(Method::Reference) | Err(_) => anyhow::bail!(
-                    "invalid value for `--method`: {m:?} (accepted: bruneton4d (or lut), hillaire2020, separated by commas)"
+                    "invalid value for `--method`: {m:?} (accepted: bruneton4d (or lut), hillaire2020, elek3d, separated by commas)"
                 ),
                 Ok(m) => Ok(m),
             })
@@ -213,6 +218,7 @@ impl Selection {
             table_size,
             wavelengths: args.wavelengths.clone(),
             order_tail: !args.no_order_tail,
+            hillaire_harmonics: args.hillaire_harmonics,
             samples,
         };
         for p in &selection.presets {
@@ -255,6 +261,7 @@ impl Selection {
                 order_tail: self.order_tail,
             },
             table_size: self.table_size.clone(),
+            hillaire_harmonics: self.hillaire_harmonics,
             ..AtmosphereArgs::default()
         }
     }
