@@ -85,7 +85,7 @@ fn volume_errors(sky: &dyn SkyMethod, sun_elevation_deg: f64) -> (f64, f64) {
                 }
                 view.sky_radiance_to_point(point, Shadow::None, &mut l, &mut t);
                 if !volume.sample(ray.dir, distance, &mut lv, &mut tv) {
-                    continue; // within a slice of the ground sphere: per pixel
+                    continue; // the horizon's band of ground: per pixel
                 }
                 let y = |v: &[f64]| colour.to_xyz(v)[1];
                 let seen: Vec<f64> = (0..n).map(|k| surface[k] * t[k] + l[k]).collect();
@@ -135,8 +135,8 @@ fn a_frame_through_the_volume_matches_the_per_pixel_frame() {
     let (mean, worst) = frame_difference(&hillaire);
     assert!(mean < 0.005 && worst < 0.03, "mean {mean}, worst {worst}");
     // The 4D tables' aerial perspective jumps across the horizon (the ground and sky
-    // halves of u_μ, Bruneton's own artefact), which the volume's rows blend over distant
-    // hills on the horizon's row.
+    // halves of u_μ, Bruneton's own artefact), which the volume's rows blend: a larger
+    // worst pixel (measured 3.5 %, Hillaire's 2.6 %).
     let tables = Bruneton4d::compute(
         earth(),
         &TableConfig {
@@ -147,11 +147,11 @@ fn a_frame_through_the_volume_matches_the_per_pixel_frame() {
     )
     .unwrap();
     let (mean, worst) = frame_difference(&tables);
-    assert!(mean < 0.01 && worst < 0.12, "mean {mean}, worst {worst}");
+    assert!(mean < 0.01 && worst < 0.06, "mean {mean}, worst {worst}");
 }
 
-/// Mean and worst |relative luminance difference| of the pixels a frame of hills draws
-/// through the volume against the same frame per pixel.
+/// Mean and worst |relative luminance difference| of the pixels a frame of hills and
+/// ground draws through the volume against the same frame per pixel.
 fn frame_difference(sky: &dyn SkyMethod) -> (f64, f64) {
     let model = sky.model();
     let e = 12f64.to_radians();

@@ -9,13 +9,14 @@
 //!
 //! What it leaves to the per-pixel path: rays with light shafts (the volume holds fully lit
 //! rays), points beyond its last slice, directions outside the image (a fisheye's corners),
-//! points within a slice of the planet's ground sphere along their column (the froxels
-//! beyond it would lie under the ground: the sphere's own pixels, not the terrain's), and
-//! cube maps (froxels would straddle faces). Its error against the per-pixel answer is
+//! and cube maps (froxels would straddle faces). A column that meets the planet's ground
+//! sphere holds the aerial perspective to the ground in its slices beyond it, so the
+//! ground's own pixels read the ground's value rather than a blend with air below it. Its error against the per-pixel answer is
 //! measured in docs/accuracy.md and `tests/aerial_volume.rs`.
 
 use rayon::prelude::*;
 
+use crate::math::sphere::ray_sphere;
 use crate::math::Vec3;
 use crate::scene::{PreparedCamera, Projection};
 use crate::sky::{Shadow, SkyView};
@@ -80,6 +81,8 @@ pub struct AerialVolume {
     /// Per froxel (x, y, slice), radiance then transmittance per channel; NaN where the
     /// column's direction is outside the projection.
     data: Vec<f32>,
+    /// Per column, the distance (m) to the planet's ground sphere (∞ when it misses it).
+    ground: Vec<f64>,
 }
 
 impl AerialVolume {
@@ -103,24 +106,30 @@ impl AerialVolume {
         let (w, h, d) = (config.width, config.height, config.slices);
         let stride = 2 * channels;
         let mut data = vec![0.0f32; w * h * d * stride];
+        let mut ground = vec![f64::INFINITY; w * h];
         data.par_chunks_mut(d * stride)
+            .zip(ground.par_iter_mut())
             .enumerate()
-            .for_each(|(column, out)| {
+            .for_each(|(column, (out, ground_m))| {
                 let (x, y) = (column % w, column / w);
-                let px = (x as f64 + 0.5) / w as f64 * width as f64;
-                let py = (y as f64 + 0.5) / h as f64 * height as f64;
+                // Columns from edge to edge of the image (no clamped border on lookup).
+                let px = x as f64 / (w - 1) as f64 * width as f64;
+                let py = y as f64 / (h - 1) as f64 * height as f64;
                 let Some(ray) = camera.ray(px, py) else {
                     out.iter_mut().for_each(|v| *v = f32::NAN);
                     return;
                 };
+                // Where the column meets the planet's ground sphere: the slices beyond hold
+                // the aerial perspective to the ground there.
+                if let Some((near, _)) = ray_sphere(observer, ray.dir, ground_radius_m) {
+                    if near > 0.0 {
+                        *ground_m = near;
+                    }
+                }
                 with_channel_buffers(channels, |[l, t]| {
                     for (z, froxel) in out.chunks_mut(stride).enumerate() {
-                        let distance = slice_distance(z, d, config.max_distance_m);
+                        let distance = slice_distance(z, d, config.max_distance_m).min(*ground_m);
                         let point = observer + ray.dir * distance;
-                        if point.length() < ground_radius_m {
-                            froxel.iter_mut().for_each(|v| *v = f32::NAN);
-                            continue;
-                        }
                         view.sky_radiance_to_point(point, Shadow::None, l, t);
                         for k in 0..channels {
                             froxel[k] = l[k] as f32;
@@ -135,6 +144,7 @@ impl AerialVolume {
             image: (width as f64, height as f64),
             channels,
             data,
+            ground,
         })
     }
 
@@ -155,49 +165,93 @@ impl AerialVolume {
         let Some((px, py)) = self.camera.pixel_of(dir) else {
             return false;
         };
-        let (x0, x1, tx) = weights(px / self.image.0 * c.width as f64 - 0.5, c.width);
-        let (y0, y1, ty) = weights(py / self.image.1 * c.height as f64 - 0.5, c.height);
-        // The slice coordinate; before the first slice's centre, towards (0, T = 1) at the
-        // observer.
-        let s = (distance / c.max_distance_m).sqrt() * c.slices as f64 - 0.5;
-        let (z0, z1, tz, near) = if s < 0.0 {
-            (0, 0, 0.0, (s + 0.5) / 0.5)
-        } else {
-            let (a, b, t) = weights(s, c.slices);
-            (a, b, t, 1.0)
-        };
+        let (x0, x1, tx) = weights(px / self.image.0 * (c.width - 1) as f64, c.width);
+        let (y0, y1, ty) = weights(py / self.image.1 * (c.height - 1) as f64, c.height);
         let n = self.channels;
-        let stride = 2 * n;
         radiance[..n].iter_mut().for_each(|v| *v = 0.0);
         transmittance[..n].iter_mut().for_each(|v| *v = 0.0);
-        for (y, wy) in [(y0, 1.0 - ty), (y1, ty)] {
-            for (x, wx) in [(x0, 1.0 - tx), (x1, tx)] {
-                for (z, wz) in [(z0, 1.0 - tz), (z1, tz)] {
-                    let w = wx * wy * wz;
-                    if w == 0.0 {
-                        continue;
-                    }
-                    let i = ((y * c.width + x) * c.slices + z) * stride;
-                    let froxel = &self.data[i..i + stride];
-                    if froxel[0].is_nan() {
-                        return false;
-                    }
-                    for k in 0..n {
-                        radiance[k] += w * froxel[k] as f64;
-                        transmittance[k] += w * froxel[n + k] as f64;
-                    }
-                }
-            }
+        let columns = [
+            (y0 * c.width + x0, (1.0 - tx) * (1.0 - ty)),
+            (y0 * c.width + x1, tx * (1.0 - ty)),
+            (y1 * c.width + x0, (1.0 - tx) * ty),
+            (y1 * c.width + x1, tx * ty),
+        ];
+        // Near the horizon the columns' distances to the ground differ widely: one column's
+        // slices stop at a ground nearer than the point while another's still hold air.
+        // There the per-pixel path answers.
+        let nearest = columns
+            .iter()
+            .map(|&(i, _)| self.ground[i])
+            .fold(f64::INFINITY, f64::min);
+        let farthest = columns
+            .iter()
+            .map(|&(i, _)| self.ground[i])
+            .fold(0.0, f64::max);
+        if distance > nearest && farthest > GROUND_SPREAD * nearest {
+            return false;
         }
-        if near < 1.0 {
-            for k in 0..n {
-                radiance[k] *= near;
-                transmittance[k] = 1.0 - near * (1.0 - transmittance[k]);
+        for (column, w) in columns {
+            if w > 0.0 && !self.add_column(column, distance, w, radiance, transmittance) {
+                return false;
             }
         }
         true
     }
+
+    /// Adds `weight` × column `column`'s aerial perspective at `distance` (m), linear in
+    /// the slice coordinate, to `radiance` and `transmittance`: towards (0, T = 1) before
+    /// the first slice's centre, and up to the column's ground, whose slices beyond hold the
+    /// ground's value (so a point on the ground reads the ground's, not a mix with air
+    /// under it). False where the column has no direction (outside the projection).
+    fn add_column(
+        &self,
+        column: usize,
+        distance: f64,
+        weight: f64,
+        radiance: &mut [f64],
+        transmittance: &mut [f64],
+    ) -> bool {
+        let c = &self.config;
+        let (n, stride) = (self.channels, 2 * self.channels);
+        let ground = self.ground[column];
+        let slice = |d: f64| (d / c.max_distance_m).sqrt() * c.slices as f64 - 0.5;
+        let d = distance.min(ground);
+        let s = slice(d);
+        let froxel = |z: usize| {
+            let i = (column * c.slices + z) * stride;
+            &self.data[i..i + stride]
+        };
+        if froxel(0)[0].is_nan() {
+            return false;
+        }
+        let (z0, z1, t, near) = if s < 0.0 {
+            (0, 0, 0.0, (s + 0.5) / 0.5)
+        } else {
+            let z0 = (s as usize).min(c.slices - 1);
+            let z1 = (z0 + 1).min(c.slices - 1);
+            // Slice z1's value is the ground's when the ground lies before its centre.
+            let s1 = (z1 as f64).min(slice(ground));
+            let t = if s1 > z0 as f64 {
+                ((s - z0 as f64) / (s1 - z0 as f64)).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            (z0, z1, t, 1.0)
+        };
+        let (a, b) = (froxel(z0), froxel(z1));
+        for k in 0..n {
+            let l = (1.0 - t) * a[k] as f64 + t * b[k] as f64;
+            let tr = (1.0 - t) * a[n + k] as f64 + t * b[n + k] as f64;
+            radiance[k] += weight * near * l;
+            transmittance[k] += weight * (1.0 - near * (1.0 - tr));
+        }
+        true
+    }
 }
+
+/// The largest ratio of the four columns' distances to the ground at which a point beyond
+/// the nearest of them is read from the volume (see [`AerialVolume::sample`]).
+const GROUND_SPREAD: f64 = 1.25;
 
 /// The far distance (m) of slice `z` of `slices` out to `max`: quadratic, so the first
 /// slices are close to the camera, where terrain is densest on screen.
