@@ -4,6 +4,7 @@
 //! ([`table`]), lookups ([`lookup`]), the versioned file format ([`file`](mod@file)), and the
 //! evaluation of the paper's eq. 16 pieces from them ([`view`]).
 
+pub mod amortised;
 pub mod cache;
 pub mod compact;
 pub mod file;
@@ -16,6 +17,7 @@ pub mod thickness;
 pub mod twilight;
 pub mod view;
 
+pub use amortised::AmortisedTables;
 pub use lookup::Lookup;
 pub use params::TableSizes;
 pub use table::{Table2, Table4};

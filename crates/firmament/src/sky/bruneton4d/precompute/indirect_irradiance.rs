@@ -2,6 +2,7 @@
 //! over the upper hemisphere.
 
 use std::f64::consts::PI;
+use std::ops::Range;
 
 use rayon::prelude::*;
 
@@ -9,21 +10,26 @@ use super::{Previous, IRRADIANCE_PHI, IRRADIANCE_THETA};
 use crate::atmosphere::Model;
 use crate::sky::bruneton4d::lookup::Lookup;
 use crate::sky::bruneton4d::params;
-use crate::sky::bruneton4d::table::Table2;
 
 /// Indirect ground irradiance ΔE from the previous order (paper eq. 15 / Bruneton 2017
-/// `ComputeIndirectIrradiance`), by midpoint quadrature over the upper hemisphere.
-pub(super) fn compute_indirect_irradiance(
+/// `ComputeIndirectIrradiance`), by midpoint quadrature over the upper hemisphere, for the
+/// r rows `rows` into `out` (those rows' part of the table's data; texel by texel, so rows
+/// computed apart equal the whole pass).
+pub(super) fn indirect_irradiance_rows(
     model: &Model,
     lookup: &Lookup,
     previous: &Previous,
-) -> Table2 {
+    rows: Range<usize>,
+    out: &mut [f32],
+) {
     let s = lookup.sizes;
     let n = model.channels();
-    let mut e = Table2::new(s.irradiance_mu_s, s.irradiance_r, n);
+    debug_assert_eq!(out.len(), rows.len() * s.irradiance_mu_s * n);
+    let first = rows.start * s.irradiance_mu_s;
     let dtheta = PI / 2.0 / IRRADIANCE_THETA as f64;
     let dphi = 2.0 * PI / IRRADIANCE_PHI as f64;
-    e.data.par_chunks_mut(n).enumerate().for_each(|(i, out)| {
+    out.par_chunks_mut(n).enumerate().for_each(|(i, out)| {
+        let i = first + i;
         let (x, y) = (i % s.irradiance_mu_s, i / s.irradiance_mu_s);
         let (r, mu_s) = params::irradiance_texel(&lookup.radii, &s, x, y);
         let sin_s = (1.0 - mu_s * mu_s).max(0.0).sqrt();
@@ -48,5 +54,4 @@ pub(super) fn compute_indirect_irradiance(
             out[k] = acc[k] as f32;
         }
     });
-    e
 }

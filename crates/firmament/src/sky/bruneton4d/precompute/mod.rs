@@ -9,13 +9,20 @@
 //! (θ, φ) grid in the sun's frame, expanded as a cosine series in azimuth, and convolved
 //! with the phase functions' azimuthal harmonics (exact for the band-limited field), which
 //! are independent of the order and computed once.
+//!
+//! The passes run as the units of a [`PrecomputeJob`] ([`plan`](Unit): the 4D passes by r
+//! slices, the 2D ones by rows of r, each with an estimated cost), which [`precompute`]
+//! runs in one go and [`AmortisedTables`](super::AmortisedTables) a share per frame
+//! (Hillaire 2016 §2 "Our approach"); every texel is computed the same way either way.
 
 mod direct_irradiance;
 mod grid;
 mod indirect_irradiance;
+mod job;
 mod multiple_scattering;
 mod order_tail;
 mod phase_kernels;
+mod plan;
 mod ray;
 mod scattering_density;
 mod single_scattering;
@@ -25,19 +32,14 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use super::lookup::Lookup;
 use super::params;
-use super::table::{Table2, Table4};
-use super::{MieStorage, TableConfig, Tables};
+use super::table::Table4;
+use super::{TableConfig, Tables};
 use crate::atmosphere::{Model, ScatteringGroups};
 use crate::{Error, Result};
-use direct_irradiance::compute_direct_irradiance;
 pub(crate) use grid::{MuSPositions, ScatteringGrid};
-use indirect_irradiance::compute_indirect_irradiance;
-use multiple_scattering::compute_multiple_scattering;
+pub use job::PrecomputeJob;
 pub use order_tail::order_tail_factors;
-use order_tail::{add_scaled, cap_by_energy, table_mean, table_mean_radiance};
-use phase_kernels::PhaseKernels;
-use scattering_density::compute_scattering_density;
-use single_scattering::compute_single_scattering;
+pub use plan::{frame_schedule, Pass, Unit};
 pub use transmittance::{compute_optical_depth, compute_optical_depth_in};
 
 use crate::spectrum::MAX_CHANNELS;
@@ -74,121 +76,24 @@ fn check_cancel(cancel: Option<&AtomicBool>) -> Result<()> {
     }
 }
 
-/// Run the whole precomputation.
+/// Run the whole precomputation: the units of a [`PrecomputeJob`] one after the other,
+/// reporting each stage with the share of the cost done, and stopping with
+/// [`Error::Interrupted`] between units once `cancel` is set.
 pub fn precompute(
     model: &Model,
     config: &TableConfig,
     progress: Progress,
     cancel: Option<&AtomicBool>,
 ) -> Result<Tables> {
-    config.validate()?;
-    super::thickness::check(model)?;
-    let n = model.channels();
-    crate::spectrum::check_channels(n, "the precomputed tables")?;
-    let s = config.sizes;
-    let orders = config.orders;
-    let total_steps = 3.0 + 3.0 * (orders.saturating_sub(1)) as f64;
-    let mut step = 0.0;
-    let mut report = |what: &str| {
-        progress(what, step / total_steps);
-        step += 1.0;
-    };
-
-    report("transmittance");
-    let optical_depth = compute_optical_depth(model, &s);
-    let transmittance = optical_depth.transmittance_of_optical_depth();
-    check_cancel(cancel)?;
-    let lookup = Lookup::new(model, s, &optical_depth);
-    let grid = ScatteringGrid::new(&lookup.radii, &s);
-    let groups = &model.groups;
-
-    report("direct irradiance");
-    let mut delta_irradiance = compute_direct_irradiance(model, &lookup);
-    let mut irradiance = Table2::new(s.irradiance_mu_s, s.irradiance_r, n);
-
-    report("single scattering");
-    let (delta_rayleigh, delta_mie) = compute_single_scattering(model, &lookup, &grid, groups);
-    check_cancel(cancel)?;
-    let mut order_means = vec![table_mean_radiance(
-        &delta_rayleigh,
-        &delta_mie,
-        groups,
-        &grid,
-    )];
-    let mut multiple = Table4::for_sizes(&s, n);
-
-    if orders >= 2 {
-        let kernels = PhaseKernels::new(&lookup, &grid, groups);
-        let mut delta_multiple = Table4::for_sizes(&s, n);
-        for order in 2..=orders {
-            report(&format!("scattering density, order {order}"));
-            // The radiance of the previous order feeds both ΔJ and ΔE.
-            let previous = if order == 2 {
-                Previous::Single {
-                    rayleigh: &delta_rayleigh,
-                    mie: &delta_mie,
-                    groups,
-                }
-            } else {
-                Previous::Multiple(&delta_multiple)
-            };
-            let density = compute_scattering_density(
-                model,
-                &lookup,
-                &grid,
-                groups,
-                &kernels,
-                &previous,
-                &delta_irradiance,
-            );
-            check_cancel(cancel)?;
-            report(&format!("indirect irradiance, order {}", order - 1));
-            delta_irradiance = compute_indirect_irradiance(model, &lookup, &previous);
-            irradiance.add_assign(&delta_irradiance);
-            report(&format!("multiple scattering, order {order}"));
-            delta_multiple = compute_multiple_scattering(model, &lookup, &grid, &density);
-            check_cancel(cancel)?;
-            order_means.push(table_mean(&delta_multiple));
-            multiple.add_assign(&delta_multiple);
-        }
-        if config.order_tail {
-            if let Some(mut f) = order_tail_factors(&order_means) {
-                cap_by_energy(
-                    &mut f,
-                    &irradiance,
-                    &delta_irradiance,
-                    &model.solar_irradiance,
-                );
-                add_scaled(&mut multiple.data, &delta_multiple.data, &f);
-                add_scaled(&mut irradiance.data, &delta_irradiance.data, &f);
-            }
-        }
+    let mut job = PrecomputeJob::new(model.clone(), config)?;
+    while let Some(unit) = job.next_unit() {
+        progress(&unit.pass.label(), job.fraction());
+        check_cancel(cancel)?;
+        job.run_unit();
     }
+    check_cancel(cancel)?;
     progress("done", 1.0);
-
-    let single_mie = match config.mie {
-        MieStorage::Separate => delta_mie,
-        MieStorage::RedOnly => {
-            let mut red = Table4::for_sizes(&s, 1);
-            for (i, v) in red.data.iter_mut().enumerate() {
-                *v = delta_mie.data[i * n];
-            }
-            red
-        }
-    };
-    Ok(Tables {
-        config: *config,
-        wavelengths_nm: model.wavelengths.nm().to_vec(),
-        atmosphere_hash: model.hash,
-        transmittance,
-        optical_depth,
-        irradiance,
-        single_rayleigh: delta_rayleigh,
-        single_mie,
-        order_means,
-        mie_ratio: groups.mie_ratio(),
-        multiple,
-    })
+    Ok(job.finish().1)
 }
 
 /// The radiance field of the previous scattering order.

@@ -2,6 +2,8 @@
 //! the GPU), the geometric tail's factors (`order_tail_factors`) and their application
 //! (`order_tail`).
 
+use std::ops::Range;
+
 use super::ScatteringGrid;
 use crate::atmosphere::ScatteringGroups;
 use crate::sky::bruneton4d::table::{Table2, Table4};
@@ -70,17 +72,19 @@ pub(super) fn add_scaled(a: &mut [f32], b: &[f32], f: &[f64]) {
     }
 }
 
-/// Mean radiance of the single-scattering tables with phase functions at ν (per channel,
-/// over texels): used to check that orders decrease.
-pub(super) fn table_mean_radiance(
+/// Adds the radiance of the single-scattering tables with phase functions at ν over the r
+/// slices `slices` to `sum` (per channel, texels in table order): the order-1 mean, to see
+/// that orders decrease. Slices added in order give the sum of the whole table.
+pub(super) fn add_radiance_sums(
     rayleigh: &Table4,
     mie: &Table4,
     groups: &ScatteringGroups,
     grid: &ScatteringGrid,
-) -> Vec<f64> {
+    slices: Range<usize>,
+    sum: &mut [f64],
+) {
     let n = rayleigh.channels;
-    let mut sum = vec![0.0; n];
-    for z in 0..rayleigh.nr {
+    for z in slices {
         for y in 0..rayleigh.nmu {
             for x in 0..rayleigh.width() {
                 let (_, _, _, nu, _) = grid.texel(x, y, z);
@@ -92,19 +96,24 @@ pub(super) fn table_mean_radiance(
             }
         }
     }
-    let count = (rayleigh.data.len() / n) as f64;
-    sum.iter().map(|v| v / count).collect()
 }
 
-pub(super) fn table_mean(t: &Table4) -> Vec<f64> {
+/// Adds the values of `t` over the r slices `slices` to `sum` (per channel, texels in table
+/// order). Slices added in order give the sum of the whole table.
+pub(super) fn add_sums(t: &Table4, slices: Range<usize>, sum: &mut [f64]) {
     let n = t.channels;
-    let mut sum = vec![0.0; n];
-    for chunk in t.data.chunks(n) {
+    let slab = t.nmu * t.row_len();
+    for chunk in t.data[slices.start * slab..slices.end * slab].chunks(n) {
         for k in 0..n {
             sum[k] += chunk[k] as f64;
         }
     }
-    let count = (t.data.len() / n) as f64;
+}
+
+/// The per-channel mean of a table of `t`'s shape from its [`add_sums`] (or
+/// [`add_radiance_sums`]) over every slice.
+pub(super) fn mean_of_sums(t: &Table4, sum: &[f64]) -> Vec<f64> {
+    let count = (t.data.len() / t.channels) as f64;
     sum.iter().map(|v| v / count).collect()
 }
 

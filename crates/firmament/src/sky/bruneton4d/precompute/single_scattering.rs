@@ -1,6 +1,8 @@
 //! The single-scattering pass (paper eq. 7): molecular and aerosol single scattering
 //! integrated apart, without their phase functions.
 
+use std::ops::Range;
+
 use rayon::prelude::*;
 
 use super::ray::RaySamples;
@@ -9,7 +11,7 @@ use super::MAX_CHANNELS;
 use crate::atmosphere::{Model, ScatteringGroups};
 use crate::sky::bruneton4d::lookup::Lookup;
 use crate::sky::bruneton4d::params;
-use crate::sky::bruneton4d::table::{lerp_weights, Table4};
+use crate::sky::bruneton4d::table::lerp_weights;
 
 /// The optical-depth table filtered to one radius, for lookups towards the sun from one
 /// ray sample at many μ_s.
@@ -86,25 +88,30 @@ struct SunFilter {
 }
 
 /// Single scattering (paper eq. 7; Bruneton 2017 `ComputeSingleScattering`): Rayleigh and
-/// Mie integrated separately without phase functions.
-pub(super) fn compute_single_scattering(
+/// Mie integrated separately without phase functions, for the r slices `slices` into
+/// `out_rayleigh` and `out_mie` (those slices' part of the tables' data). Each (r, μ) row
+/// is computed on its own, so slices computed apart equal the whole pass.
+pub(super) fn single_scattering_slices(
     model: &Model,
     lookup: &Lookup,
     grid: &ScatteringGrid,
     groups: &ScatteringGroups,
-) -> (Table4, Table4) {
+    slices: Range<usize>,
+    out_rayleigh: &mut [f32],
+    out_mie: &mut [f32],
+) {
     let s = lookup.sizes;
     let n = model.channels();
-    let mut rayleigh = Table4::for_sizes(&s, n);
-    let mut mie = rayleigh.clone();
-    let row_len = rayleigh.row_len();
-    let width = rayleigh.width();
-    rayleigh
-        .data
+    let width = s.scattering_nu * s.scattering_mu_s;
+    let row_len = width * n;
+    debug_assert_eq!(out_rayleigh.len(), slices.len() * s.scattering_mu * row_len);
+    let first_row = slices.start * s.scattering_mu;
+    out_rayleigh
         .par_chunks_mut(row_len)
-        .zip(mie.data.par_chunks_mut(row_len))
+        .zip(out_mie.par_chunks_mut(row_len))
         .enumerate()
-        .for_each(|(row, (out_r, out_m))| {
+        .for_each(|(i, (out_r, out_m))| {
+            let row = first_row + i;
             let (z, y) = (row / s.scattering_mu, row % s.scattering_mu);
             let (r, mu, _, _, ground) = grid.texel(0, y, z);
             let rays = RaySamples::new(lookup, r, mu, ground, n);
@@ -167,5 +174,4 @@ pub(super) fn compute_single_scattering(
                 }
             }
         });
-    (rayleigh, mie)
 }

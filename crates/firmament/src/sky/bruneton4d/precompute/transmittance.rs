@@ -1,6 +1,8 @@
 //! The transmittance pass: the optical depth τ(r, μ) to the top of the atmosphere, stored
 //! instead of the transmittance (see [`Table2::transmittance_of_optical_depth`]).
 
+use std::ops::Range;
+
 use rayon::prelude::*;
 
 use super::TRANSMITTANCE_SEGMENTS;
@@ -16,18 +18,32 @@ pub fn compute_optical_depth(model: &Model, s: &TableSizes) -> Table2 {
 
 /// [`compute_optical_depth`] with `segments` Gauss–Legendre segments per ray.
 pub fn compute_optical_depth_in(model: &Model, s: &TableSizes, segments: usize) -> Table2 {
+    let mut t = Table2::new(s.transmittance_mu, s.transmittance_r, model.channels());
+    optical_depth_rows(model, s, segments, 0..s.transmittance_r, &mut t.data);
+    t
+}
+
+/// The rows `rows` (r texels) of [`compute_optical_depth_in`] into `out`, their part of the
+/// table's data: a unit of the resumable precomputation ([`super::PrecomputeJob`]).
+pub(super) fn optical_depth_rows(
+    model: &Model,
+    s: &TableSizes,
+    segments: usize,
+    rows: Range<usize>,
+    out: &mut [f32],
+) {
     let n = model.channels();
     let radii = Radii {
         bottom: model.bottom_radius_m,
         top: model.top_radius_m,
         mu_s_min: model.mu_s_min,
     };
-    let mut t = Table2::new(s.transmittance_mu, s.transmittance_r, n);
     let width = s.transmittance_mu;
-    t.data
-        .par_chunks_mut(width * n)
+    debug_assert_eq!(out.len(), rows.len() * width * n);
+    out.par_chunks_mut(width * n)
         .enumerate()
-        .for_each(|(y, row)| {
+        .for_each(|(i, row)| {
+            let y = rows.start + i;
             let mut columns = vec![0.0; model.constituents.len()];
             let mut tau = vec![0.0; n];
             for x in 0..width {
@@ -43,5 +59,4 @@ pub fn compute_optical_depth_in(model: &Model, s: &TableSizes, segments: usize) 
                 }
             }
         });
-    t
 }
