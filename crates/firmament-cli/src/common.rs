@@ -65,11 +65,9 @@ pub struct AtmosphereArgs {
     /// Store single Mie scattering for every wavelength (`separate`) or only the first (`red-only`, ratio rule).
     #[arg(long, default_value = "separate", value_name = "separate|red-only")]
     pub mie: String,
-    /// With `--method hillaire2020`: the second order of multiple scattering as spherical
-    /// harmonics up to this degree, each constituent's phase function applied to it
-    /// (firmament's extension, 1–8; 6 halves Hillaire's error on earth, docs/accuracy.md),
-    /// instead of Hillaire's isotropic field (0, the default: as Unreal and Bevy do).
-    #[arg(long, default_value_t = 0, value_name = "DEGREE")]
+    /// Hillaire 2020's second order in spherical harmonics of this degree (0: its isotropic
+    /// field); set from the commands' own `--hillaire-harmonics`.
+    #[arg(skip)]
     pub hillaire_harmonics: usize,
     /// The ground's albedo per wavelength in place of the atmosphere's (a scene's terrain
     /// sets it to its own mean, so the tables' ground bounce is the terrain's).

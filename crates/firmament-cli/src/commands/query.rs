@@ -21,7 +21,7 @@ use crate::common::{check_range, check_reference_samples, print_wavelengths, Atm
 use crate::method::{CpuSky, Method};
 
 /// Arguments of `firmament query`.
-#[derive(Args, Debug)]
+#[derive(Args, Debug, Clone)]
 pub struct QueryArgs {
     #[command(flatten)]
     pub atmosphere: AtmosphereArgs,
@@ -57,6 +57,12 @@ pub struct QueryArgs {
     /// tracer; adds `radiance_stderr` and `samples` to each view).
     #[arg(long, value_enum, default_value_t = Method::Bruneton4d, value_name = "bruneton4d|lut|hillaire2020|elek3d|reference")]
     pub method: Method,
+    /// With `--method hillaire2020`: the second order of multiple scattering as spherical
+    /// harmonics up to this degree, each constituent's phase function applied to it
+    /// (firmament's extension, 1–8; 6 halves Hillaire's p95 on earth, docs/accuracy.md),
+    /// instead of Hillaire's isotropic field (0, the default: as Unreal and Bevy do).
+    #[arg(long, default_value_t = 0, value_name = "DEGREE")]
+    pub hillaire_harmonics: usize,
     /// Paths per wavelength and view for `--method reference`.
     #[arg(long, default_value_t = 10_000)]
     pub samples: usize,
@@ -185,9 +191,16 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
             Some(settings)
         }
     };
-    if args.atmosphere.hillaire_harmonics != 0 && args.method != Method::Hillaire2020 {
+    if args.hillaire_harmonics != 0 && args.method != Method::Hillaire2020 {
         anyhow::bail!("`--hillaire-harmonics` is for `--method hillaire2020`");
     }
+    let args = &QueryArgs {
+        atmosphere: AtmosphereArgs {
+            hillaire_harmonics: args.hillaire_harmonics,
+            ..args.atmosphere.clone()
+        },
+        ..args.clone()
+    };
     if args.scene.is_some() {
         return super::query_scene::run(args, reference);
     }
