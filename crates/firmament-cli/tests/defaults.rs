@@ -45,7 +45,7 @@ fn render_help_names_every_default_and_they_are_the_scenes() {
         ("--gamut", "rec709".to_string()),
         ("--out", d.output.files[0].display().to_string()),
         ("--table-size", "default".to_string()),
-        ("--method", "lut".to_string()),
+        ("--method", "bruneton4d".to_string()),
         ("--samples", "1024".to_string()),
         ("--backend", "auto".to_string()),
     ] {

@@ -164,9 +164,9 @@ pub struct RenderArgs {
     #[arg(long, short)]
     pub quiet: bool,
     /// Method: `bruneton4d` (or `lut`: the precomputed 4D tables), `hillaire2020`
-    /// (Hillaire 2020's small tables and ray march: milliseconds to build, CPU only so far)
-    /// or `reference` (Monte Carlo path tracer: a ground-truth image of the same scene, no
-    /// tables).
+    /// (Hillaire 2020's small tables and ray march: fast to build; the terrain on the CPU
+    /// only), `elek3d` (Frostbite's 3D table; CPU only so far) or `reference` (Monte Carlo
+    /// path tracer: a ground-truth image of the same scene, no tables).
     #[arg(long, value_enum, default_value_t = Method::Bruneton4d, value_name = "bruneton4d|lut|hillaire2020|elek3d|reference")]
     pub method: Method,
     /// With `--method hillaire2020`: the second order of multiple scattering as spherical
