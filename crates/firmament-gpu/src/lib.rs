@@ -3,8 +3,10 @@
 //! precomputed tables of Bruneton & Neyret 2008 (as refined in Bruneton 2017;
 //! [`firmament::sky::bruneton4d`], sharing its table file format) and the small tables of
 //! Hillaire 2020 with their per-frame sky view ([`firmament::sky::hillaire2020`];
-//! [`hillaire2020`]); and frames of the clear sky rendered from either (over a terrain from
-//! the 4D tables only).
+//! [`hillaire2020`]); a third, Elek 2009 / Yusov 2013's 3D tables
+//! ([`firmament::sky::elek3d`]; [`elek3d`]), uploaded from the CPU's precomputation; and
+//! frames of the clear sky rendered from any of them (over a terrain from the 4D tables
+//! only).
 //!
 //! ```no_run
 //! use firmament::atmosphere::Atmosphere;
@@ -26,18 +28,22 @@
 //! goes the same way: [`GpuHillaire::compute`] (refusing what `Hillaire2020::compute`
 //! refuses), [`GpuHillaire::tables`], [`GpuHillaireRenderer::encode`],
 //! [`shader::hillaire2020_sky_module`], [`GpuHillaireTables::read_back`], with per-pass GPU
-//! times ([`HillairePrecomputer::time_passes`], [`GpuHillaireRenderer::time_render`]).
+//! times ([`HillairePrecomputer::time_passes`], [`GpuHillaireRenderer::time_render`]). The
+//! 3D tables: [`GpuElek3d::from_sky`], [`GpuElek3d::tables`], [`GpuElek3dRenderer::encode`],
+//! [`shader::elek3d_sky_module`], [`GpuElek3dRenderer::time_render`].
 //!
 //! Shaders are WGSL under `shaders/`: `common/` (types, bindings, profiles, phase functions,
 //! geometry), `bruneton4d/` (parameterisations, filters, lookups, `view.wgsl` for rendering,
 //! and `precompute/` one file per pass), `hillaire2020/` (its parameterisations, harmonics,
-//! ray march, passes and `view.wgsl`) and `render/` (lights, cameras, the frame), each named
+//! ray march, passes and `view.wgsl`), `elek3d/` (its parameterisation, filter and
+//! `view.wgsl`) and `render/` (lights, cameras, the frame), each named
 //! like the Rust file it mirrors, composed with a prelude of the Rust constants
 //! ([`shader`]). The atmosphere travels in uniform and storage buffers; changing it compiles
 //! nothing.
 
 pub mod bruneton4d;
 mod device;
+pub mod elek3d;
 mod error;
 pub mod hillaire2020;
 pub mod passes;
@@ -47,6 +53,7 @@ pub mod terrain;
 
 pub use bruneton4d::{GpuSky, GpuTables, Precomputer};
 pub use device::{test_context, GpuContext};
+pub use elek3d::{GpuElek3d, GpuElek3dRenderer, GpuElek3dTables};
 pub use error::GpuError;
 pub use hillaire2020::{
     GpuHillaire, GpuHillaireRenderer, GpuHillaireTables, HillaireFrameTiming, HillairePassTiming,

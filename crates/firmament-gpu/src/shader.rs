@@ -172,6 +172,27 @@ pub const HILLAIRE2020_RENDER: [Module; 5] = [
     module!("render/render.wgsl"),
 ];
 
+/// Elek 2009 / Yusov 2013's 3D tables (after [`COMMON`] and [`BRUNETON4D`], whose lookups
+/// read its optical depth and irradiance): its parameterisation and trilinear filter.
+pub const ELEK3D: [Module; 2] = [module!("elek3d/params.wgsl"), module!("elek3d/table.wgsl")];
+
+/// The 3D tables' render-time modules: the view (with its `camera_slice` entry point) and
+/// the 4D tables' twilight below the tables' lowest sun.
+pub const ELEK3D_VIEW: [Module; 2] = [
+    module!("elek3d/view.wgsl"),
+    module!("bruneton4d/twilight.wgsl"),
+];
+
+/// What a 3D-table frame takes of the renderer's modules (no terrain: its scene is the
+/// clear sky, `elek3d/scene.wgsl`): lights, cameras, the disks' edges, the frame.
+pub const ELEK3D_RENDER: [Module; 5] = [
+    module!("elek3d/scene.wgsl"),
+    module!("render/light.wgsl"),
+    module!("render/camera.wgsl"),
+    module!("render/disk_edges.wgsl"),
+    module!("render/render.wgsl"),
+];
+
 /// The frame's output into a storage buffer.
 pub const OUTPUT_BUFFER: Module = module!("render/output_buffer.wgsl");
 /// The frame's output into a storage texture (`OUTPUT_FORMAT` substituted).
@@ -395,6 +416,44 @@ pub fn hillaire2020_render_source(output_format: Option<&str>) -> String {
     compose_hillaire2020(&modules, output_format)
 }
 
+/// The 3D tables' WGSL for an engine's own shader: the prelude, the common modules, the 4D
+/// tables' lookups (transmittance, irradiance, twilight), the 3D tables' mappings and filter
+/// and the view functions (the names of [`sky_module`]'s `sky_ray`/`sky_radiance`,
+/// `ground_ray`/`sky_radiance_to_point`, `ground_light`/`sun_and_sky_irradiance`, and the
+/// `camera_slice` entry point that fills the per-view slices). The bindings are listed in
+/// `shaders/elek3d/view.wgsl` and on [`crate::GpuElek3d`]. One sky method per shader: it
+/// defines the same names as [`sky_module`].
+pub fn elek3d_sky_module() -> String {
+    let modules: Vec<Module> = COMMON
+        .iter()
+        .chain(&BRUNETON4D)
+        .chain(&ELEK3D)
+        .chain(&ELEK3D_VIEW)
+        .copied()
+        .collect();
+    compose(&modules, None)
+}
+
+/// The render shader of a 3D-table frame ([`render_source`] with the 3D tables' view in
+/// place of the 4D tables' and no terrain), to a buffer or a storage texture.
+pub fn elek3d_render_source(output_format: Option<&str>) -> String {
+    let output = if output_format.is_some() {
+        OUTPUT_TEXTURE
+    } else {
+        OUTPUT_BUFFER
+    };
+    let modules: Vec<Module> = COMMON
+        .iter()
+        .chain(&BRUNETON4D)
+        .chain(&ELEK3D)
+        .chain(&ELEK3D_VIEW)
+        .chain(&ELEK3D_RENDER)
+        .copied()
+        .chain([output])
+        .collect();
+    compose(&modules, output_format)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -417,6 +476,9 @@ mod tests {
             .chain(&HILLAIRE2020)
             .chain(&HILLAIRE2020_VIEW)
             .chain(&HILLAIRE2020_RENDER)
+            .chain(&ELEK3D)
+            .chain(&ELEK3D_VIEW)
+            .chain(&ELEK3D_RENDER)
             .chain(&[
                 hillaire2020_passes::MULTIPLE_SCATTERING,
                 hillaire2020_passes::IRRADIANCE,
@@ -458,6 +520,15 @@ mod tests {
                 "hillaire2020 sky module".to_string(),
                 hillaire2020_sky_module(),
             ),
+            (
+                "elek3d render (buffer)".to_string(),
+                elek3d_render_source(None),
+            ),
+            (
+                "elek3d render (rgba16float)".to_string(),
+                elek3d_render_source(Some("rgba16float")),
+            ),
+            ("elek3d sky module".to_string(), elek3d_sky_module()),
             (
                 "hillaire2020 transmittance (16 segments)".to_string(),
                 hillaire2020_transmittance_source(16),
