@@ -5,8 +5,10 @@
 //! docs/accuracy.md quotes its output ("Hillaire 2020 against the 4D tables").
 //!
 //! ```text
-//! cargo run --release -p firmament --example hillaire_vs_tables -- [PRESET,...] [rgb|spectral]
+//! cargo run --release -p firmament --example hillaire_vs_tables -- [PRESET,...] [rgb|spectral] [ORDERS]
 //! ```
+//!
+//! ORDERS (default 2, Hillaire's) is the harmonic column's `multiple_scattering_orders`.
 
 use std::time::Instant;
 
@@ -75,8 +77,10 @@ fn main() -> firmament::Result<()> {
         Some("spectral") => Wavelengths::spectral(),
         _ => Wavelengths::rgb(),
     };
+    let orders = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(2);
     let harmonics = HillaireConfig {
         multiple_scattering_model: MultipleScatteringModel::Harmonics(6),
+        multiple_scattering_orders: orders,
         multiple_scattering_directions: (24, 12),
         ..HillaireConfig::default()
     };
@@ -104,7 +108,7 @@ fn main() -> firmament::Result<()> {
             iso.max_f_ms,
             t_harm * 1e3
         );
-        println!("  altitude  sun   | isotropic: median   p95   bias  worst (elev, az) | harmonics(6): median   p95   bias  worst");
+        println!("  altitude  sun   | isotropic: median   p95   bias  worst (elev, az) | harmonics(6), {orders} orders: median   p95   bias  worst");
         for altitude in [0.0, 1000.0, 10_000.0] {
             for sun in [60.0, 30.0, 10.0, 5.0, 2.0, 0.0, -3.0] {
                 let a = compare(&model, &iso, &tables, altitude, sun);

@@ -200,6 +200,14 @@ impl HillairePrecomputer {
         config: &HillaireConfig,
     ) -> Result<Build, GpuError> {
         config.validate()?;
+        if config.multiple_scattering_orders != 2 {
+            return Err(firmament::Error::invalid(
+                "hillaire.multiple_scattering_orders",
+                config.multiple_scattering_orders,
+                "2 on the GPU (Hillaire's series; the higher orders' fields are gathered on the CPU only so far)",
+            )
+            .into());
+        }
         let n = model.channels();
         firmament::spectrum::check_channels(n, "Hillaire 2020")?;
         config::check_phases(model)?;

@@ -16,6 +16,7 @@ use crate::spectrum::with_channel_buffers;
 
 /// What a lookup needs: the model's radii, the sizes and the transmittance table (as
 /// optical depth: lookups interpolate τ = −ln T bilinearly, then take e^{−τ}).
+#[derive(Clone, Copy)]
 pub struct Lookup<'a> {
     /// Radii and μ_s,min.
     pub radii: Radii,

@@ -38,6 +38,10 @@ use crate::{Error, Result};
 use march::{Marcher, Medium};
 use params::altitude_mu_s_uv;
 
+/// The most scattering orders the multiple-scattering pass gathers explicitly (each one
+/// beyond the second costs about one more multiple-scattering pass).
+pub const MAX_ORDERS: usize = 16;
+
 /// Sizes and sample counts of the method's tables and marches.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HillaireConfig {
@@ -50,6 +54,11 @@ pub struct HillaireConfig {
     pub multiple_scattering: (usize, usize),
     /// The second order's field: Hillaire's isotropic one, or firmament's harmonics.
     pub multiple_scattering_model: MultipleScatteringModel,
+    /// The highest scattering order computed explicitly (Hillaire: 2, the rest by the
+    /// 1/(1 − f_ms) series; firmament's n > 2 gathers the fields of orders 2 … n − 1 too,
+    /// and from 4 takes the rest as the 4D tables do, by the geometric tail of the last two
+    /// orders: [`multiple_scattering::compute`]).
+    pub multiple_scattering_orders: usize,
     /// Gather directions of the multiple-scattering pass: Gauss–Legendre nodes in μ and
     /// azimuths over [0, π] (the field is symmetric about the light's plane; Hillaire: 64
     /// directions over the sphere).
@@ -77,6 +86,7 @@ impl Default for HillaireConfig {
             transmittance_segments: 16,
             multiple_scattering: (32, 32),
             multiple_scattering_model: MultipleScatteringModel::Isotropic,
+            multiple_scattering_orders: 2,
             multiple_scattering_directions: (8, 8),
             multiple_scattering_steps: 20,
             sky_view: (192, 108),
@@ -132,6 +142,13 @@ impl HillaireConfig {
             if !(2..=4096).contains(&v) {
                 return Err(Error::invalid(field, v, "an integer from 2 to 4096"));
             }
+        }
+        if !(2..=MAX_ORDERS).contains(&self.multiple_scattering_orders) {
+            return Err(Error::invalid(
+                "hillaire.multiple_scattering_orders",
+                self.multiple_scattering_orders,
+                format!("an integer from 2 to {MAX_ORDERS}"),
+            ));
         }
         if let MultipleScatteringModel::Harmonics(d) = self.multiple_scattering_model {
             if !(1..=harmonics::MAX_DEGREE).contains(&d) {
@@ -206,6 +223,7 @@ impl Hillaire2020 {
                 h,
                 config.multiple_scattering_directions,
                 config.multiple_scattering_steps,
+                config.multiple_scattering_orders,
             )
         };
         if ms.max_f_ms > F_MS_LIMIT {

@@ -23,18 +23,26 @@
 use rayon::prelude::*;
 
 use super::harmonics::{coefficient_count, eval, phase_moments};
-use super::march::{Lighting, MarchRay, Marcher};
-use super::params::altitude_mu_s_of_texel;
+use super::march::{Lighting, Lit, MarchRay, Marcher, Medium};
+use super::params::{altitude_mu_s_of_texel, altitude_mu_s_uv};
 use crate::math::quadrature::GaussLegendreRule;
 use crate::math::sphere::{
     distance_to_nearest_atmosphere_boundary, horizon_mu, ray_intersects_ground,
 };
 use crate::math::Vec3;
 use crate::medium::PhaseFunction;
+use crate::sky::bruneton4d::precompute::order_tail_factors;
 use crate::sky::bruneton4d::Table2;
+use crate::spectrum::MAX_CHANNELS;
 
 /// The largest f_ms the method accepts (see the module's notes and docs/accuracy.md).
 pub const F_MS_LIMIT: f64 = 0.8;
+
+/// The harmonics' degree of the fields of orders ≥ 2 (see [`compute`]).
+pub const HIGHER_ORDERS_DEGREE: usize = 4;
+
+/// The gather rule's (μ, φ) nodes for the fields of orders ≥ 2, at most.
+pub const HIGHER_ORDERS_DIRECTIONS: (usize, usize) = (12, 6);
 
 /// The guard on f_ms in 1/(1 − f_ms) while the pass runs (the atmospheres that reach it are
 /// refused after the pass, by [`F_MS_LIMIT`]).
@@ -109,8 +117,143 @@ fn gather_directions(r: f64, bottom: f64, n_mu: usize, n_phi: usize) -> Vec<Gath
     out
 }
 
+/// What one gather over the texels gives: per texel the field's coefficients
+/// ([`coefficient_count`] × channels, coefficient-major), f_ms per channel (the first
+/// gather only; empty after) and the irradiance the field delivers to a horizontal surface
+/// facing up (per channel: at the bottom row, the ground's).
+struct Gathered {
+    field: Vec<f64>,
+    f_ms: Vec<f64>,
+    up_irradiance: Vec<f64>,
+}
+
+/// The radiance arriving along a gather ray (see [`Grid::gather`]).
+type Incoming<'a> = dyn Fn(&MarchRay, bool, &mut [f64], &mut [f64]) + Sync + 'a;
+
+/// The texels' geometry and the gather rule.
+#[derive(Clone, Copy)]
+struct Grid {
+    nmu_s: usize,
+    nr: usize,
+    bottom: f64,
+    top: f64,
+    directions: (usize, usize),
+    degree: usize,
+    channels: usize,
+}
+
+impl Grid {
+    fn texels(&self) -> usize {
+        self.nmu_s * self.nr
+    }
+
+    /// Gather `incoming(ray, ground, l, scattered)` (the radiance arriving at a texel's
+    /// point from the ray's direction, into `l`; ∫T·σ_s along it into `scattered` when that
+    /// is not empty) over every texel's directions; `with_f_ms` sums f_ms too.
+    fn gather(
+        &self,
+        with_f_ms: bool,
+        incoming: &Incoming,
+    ) -> Gathered {
+        let n = self.channels;
+        let coefficients = coefficient_count(self.degree);
+        let p_u = PhaseFunction::Isotropic.eval(1.0);
+        let per_texel: Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> = (0..self.texels())
+            .into_par_iter()
+            .map(|i| {
+                let (r, mu_s) = altitude_mu_s_of_texel(
+                    i % self.nmu_s,
+                    i / self.nmu_s,
+                    self.bottom,
+                    self.top,
+                    self.nmu_s,
+                    self.nr,
+                );
+                let sun = Vec3::new((1.0 - mu_s * mu_s).max(0.0).sqrt(), 0.0, mu_s);
+                let mut l = vec![0.0; n];
+                let mut scattered = vec![0.0; if with_f_ms { n } else { 0 }];
+                let mut f_ms = vec![0.0; if with_f_ms { n } else { 0 }];
+                let mut up = vec![0.0; n];
+                let mut field = vec![0.0; coefficients * n];
+                let mut y = vec![0.0; coefficients];
+                for g in gather_directions(r, self.bottom, self.directions.0, self.directions.1) {
+                    let d = g.dir;
+                    let mu = d.z;
+                    let ground = ray_intersects_ground(r, mu, self.bottom);
+                    let ray = MarchRay {
+                        r,
+                        mu,
+                        mu_s,
+                        nu: d.dot(sun),
+                        length: distance_to_nearest_atmosphere_boundary(
+                            r,
+                            mu,
+                            self.bottom,
+                            self.top,
+                            ground,
+                        ),
+                    };
+                    incoming(&ray, ground, &mut l, &mut scattered);
+                    let s = (1.0 - mu * mu).max(0.0).sqrt();
+                    eval(self.degree, mu, if s > 0.0 { d.x / s } else { 1.0 }, &mut y);
+                    for (c, yc) in y.iter().enumerate() {
+                        for k in 0..n {
+                            field[c * n + k] += g.weight * yc * l[k];
+                        }
+                    }
+                    if mu > 0.0 {
+                        for k in 0..n {
+                            up[k] += g.weight * mu * l[k];
+                        }
+                    }
+                    for k in 0..f_ms.len() {
+                        f_ms[k] += g.weight * p_u * scattered[k];
+                    }
+                }
+                (field, f_ms, up)
+            })
+            .collect();
+        let mut out = Gathered {
+            field: Vec::with_capacity(self.texels() * coefficients * n),
+            f_ms: Vec::new(),
+            up_irradiance: Vec::with_capacity(self.texels() * n),
+        };
+        for (field, f_ms, up) in per_texel {
+            out.field.extend(field);
+            out.f_ms.extend(f_ms);
+            out.up_irradiance.extend(up);
+        }
+        out
+    }
+
+    /// A table of the field's coefficients.
+    fn table(&self, field: &[f64]) -> Table2 {
+        let coefficients = coefficient_count(self.degree);
+        let mut table = Table2::new(self.nmu_s, self.nr, coefficients * self.channels);
+        for (o, v) in table.data.iter_mut().zip(field) {
+            *o = *v as f32;
+        }
+        table
+    }
+
+    /// The irradiance on the ground (the bottom row's) as a one-row table over μ_s.
+    fn ground_table(&self, up_irradiance: &[f64]) -> Table2 {
+        let mut table = Table2::new(self.nmu_s, 1, self.channels);
+        for (o, v) in table.data.iter_mut().zip(up_irradiance) {
+            *o = *v as f32;
+        }
+        table
+    }
+}
+
 /// The pass over `nmu_s` × `nr` texels: `directions` = (μ nodes, φ nodes over [0, π]) per
-/// texel, each ray marched in `steps` steps.
+/// texel, each ray marched in `steps` steps; `orders` is the highest scattering order
+/// gathered explicitly (2: Hillaire's, the field of the light scattered once; n > 2 adds
+/// the fields of orders 2 … n − 1, each marched through the previous one's), the rest by a
+/// series: Hillaire's 1/(1 − f_ms) below 4 orders, from 4 on the geometric tail of the
+/// last two orders' ratio (as the 4D tables' `order_tail_factors`: f_ms, the transfer of
+/// an isotropic radiance at one point, reads the higher orders low on the ground, where
+/// half the sphere is the ground while they were scattered in the air above).
 pub(crate) fn compute(
     marcher: &Marcher,
     model_kind: MultipleScatteringModel,
@@ -118,109 +261,184 @@ pub(crate) fn compute(
     nr: usize,
     directions: (usize, usize),
     steps: usize,
+    orders: usize,
 ) -> MultipleScattering {
     let model = marcher.medium.model;
     let n = model.channels();
     let (bottom, top) = (model.bottom_radius_m, model.top_radius_m);
     let degree = model_kind.degree();
     let coefficients = coefficient_count(degree);
-    let moments: Vec<Vec<f64>> = model
-        .constituents
-        .iter()
-        .map(|c| phase_moments(&c.phase, degree))
-        .collect();
-    let mut table = Table2::new(nmu_s, nr, coefficients * n);
-    let p_u = PhaseFunction::Isotropic.eval(1.0);
-    let texels: Vec<(f64, f64, usize, f64)> = table
-        .data
-        .par_chunks_mut(coefficients * n)
-        .enumerate()
-        .map(|(i, out)| {
-            let (r, mu_s) = altitude_mu_s_of_texel(i % nmu_s, i / nmu_s, bottom, top, nmu_s, nr);
-            let sun = Vec3::new((1.0 - mu_s * mu_s).max(0.0).sqrt(), 0.0, mu_s);
-            let mut phases = Vec::new();
-            let (mut l, mut t, mut scattered, mut t_sun) =
-                (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-            let mut f_ms = vec![0.0; n];
-            let mut field = vec![0.0; coefficients * n];
-            let mut y = vec![0.0; coefficients];
-            for g in gather_directions(r, bottom, directions.0, directions.1) {
-                let d = g.dir;
-                let mu = d.z;
-                let ground = ray_intersects_ground(r, mu, bottom);
-                let ray = MarchRay {
-                    r,
-                    mu,
-                    mu_s,
-                    nu: d.dot(sun),
-                    length: distance_to_nearest_atmosphere_boundary(r, mu, bottom, top, ground),
-                };
-                match model_kind {
-                    MultipleScatteringModel::Isotropic => {
-                        marcher.medium.isotropic_phases(&mut phases)
-                    }
-                    MultipleScatteringModel::Harmonics(_) => {
-                        marcher.medium.phases(ray.nu, &mut phases)
-                    }
-                }
-                marcher.march(
-                    &ray,
-                    steps,
-                    &phases,
-                    &Lighting::ALL,
-                    &mut l,
-                    &mut t,
-                    &mut scattered,
-                );
-                if ground {
-                    // The Lambertian ground lit by the light (eq. 6's ground term).
-                    let (r_g, mu_s_g) = ray.at(ray.length);
-                    marcher.lookup.transmittance_to_sun(r_g, mu_s_g, &mut t_sun);
-                    let cos = mu_s_g.max(0.0);
-                    for k in 0..n {
-                        l[k] +=
-                            t[k] * t_sun[k] * cos * model.ground_albedo[k] / std::f64::consts::PI;
-                    }
-                }
-                let s = (1.0 - mu * mu).max(0.0).sqrt();
-                eval(degree, mu, if s > 0.0 { d.x / s } else { 1.0 }, &mut y);
-                for (c, yc) in y.iter().enumerate() {
-                    for k in 0..n {
-                        field[c * n + k] += g.weight * yc * l[k];
-                    }
-                }
-                for k in 0..n {
-                    f_ms[k] += g.weight * p_u * scattered[k];
-                }
-            }
-            let mut worst = (0.0f64, 0usize);
-            for k in 0..n {
-                if f_ms[k] > worst.0 {
-                    worst = (f_ms[k], k);
-                }
-                // Degree 0 carries the second order's mean and the isotropic series of the
-                // higher orders: ×1/(1 − f_ms) (guarded here; compute() refuses f ≥ the
-                // limit).
-                field[k] /= 1.0 - f_ms[k].min(F_MS_GUARD);
-            }
-            for (o, v) in out.iter_mut().zip(&field) {
-                *o = *v as f32;
-            }
-            (worst.0, mu_s, worst.1, r - bottom)
-        })
-        .collect();
-    let (max_f_ms, mu_s, channel, altitude) = texels
-        .into_iter()
-        .fold((0.0, 1.0, 0, 0.0), |a, b| if b.0 > a.0 { b } else { a });
-    MultipleScattering {
-        table,
+    let grid = Grid {
+        nmu_s,
+        nr,
+        bottom,
+        top,
+        directions,
         degree,
-        moments: match model_kind {
-            // The isotropic field is seen through an isotropic phase: k₀ = 1.
-            MultipleScatteringModel::Isotropic => vec![vec![1.0]; model.constituents.len()],
-            MultipleScatteringModel::Harmonics(_) => moments,
-        },
-        max_f_ms,
-        max_at: (altitude, mu_s, channel),
+        channels: n,
+    };
+    let moments: Vec<Vec<f64>> = match model_kind {
+        // The isotropic field is seen through an isotropic phase: k₀ = 1.
+        MultipleScatteringModel::Isotropic => vec![vec![1.0]; model.constituents.len()],
+        MultipleScatteringModel::Harmonics(_) => model
+            .constituents
+            .iter()
+            .map(|c| phase_moments(&c.phase, degree))
+            .collect(),
+    };
+    // Order 1: the light scattered once towards the point, and the Lambertian ground lit by
+    // the light (eq. 6), with f_ms (eq. 8).
+    let first = grid.gather(true, &|ray, ground, l, scattered| {
+        let mut phases = Vec::new();
+        match model_kind {
+            MultipleScatteringModel::Isotropic => marcher.medium.isotropic_phases(&mut phases),
+            MultipleScatteringModel::Harmonics(_) => marcher.medium.phases(ray.nu, &mut phases),
+        }
+        let mut t = vec![0.0; n];
+        marcher.march(ray, steps, &phases, &Lighting::ALL, l, &mut t, scattered);
+        if ground {
+            let (r_g, mu_s_g) = ray.at(ray.length);
+            let mut t_sun = vec![0.0; n];
+            marcher.lookup.transmittance_to_sun(r_g, mu_s_g, &mut t_sun);
+            let cos = mu_s_g.max(0.0);
+            for k in 0..n {
+                l[k] += t[k] * t_sun[k] * cos * model.ground_albedo[k] / std::f64::consts::PI;
+            }
+        }
+    });
+    let f_ms = first.f_ms.clone();
+    let mut sum = first.field.clone();
+    let mut order_means = vec![degree_zero_means(&first.field, coefficients, n)];
+    let mut last = first;
+    // The higher orders' fields are smoother (diffuse light from everywhere): degree ≤ 2
+    // (exact under Rayleigh's phase function, whose moments vanish beyond it) and a
+    // coarser gather rule.
+    let next_grid = Grid {
+        degree: degree.min(HIGHER_ORDERS_DEGREE),
+        directions: (
+            directions.0.min(HIGHER_ORDERS_DIRECTIONS.0),
+            directions.1.min(HIGHER_ORDERS_DIRECTIONS.1),
+        ),
+        ..grid
+    };
+    let next_coefficients = coefficient_count(next_grid.degree);
+    let mut last_grid = &grid;
+    // Orders 2 … orders − 1 of the field: each marched through the previous order's field
+    // (its phase functions applied by Funk–Hecke), and the ground lit by its irradiance.
+    for _ in 2..orders {
+        let previous = MultipleScattering {
+            table: last_grid.table(&last.field),
+            degree: last_grid.degree,
+            moments: moments.clone(),
+            max_f_ms: 0.0,
+            max_at: (0.0, 0.0, 0),
+        };
+        let ground_irradiance = grid.ground_table(&last.up_irradiance[..nmu_s * n]);
+        let through = Marcher {
+            medium: Medium::new(model),
+            lookup: marcher.lookup,
+            multiple: Some(&previous),
+        };
+        let unlit = Lighting {
+            single: Lit::Intervals(&[]),
+            multiple: Lit::All,
+        };
+        let next = next_grid.gather(false, &|ray, ground, l, _| {
+            let mut t = vec![0.0; n];
+            through.march(ray, steps, &[], &unlit, l, &mut t, &mut []);
+            if ground {
+                let (r_g, mu_s_g) = ray.at(ray.length);
+                let (u, _) = altitude_mu_s_uv(r_g, bottom, top, mu_s_g, nmu_s, nr);
+                let mut e = vec![0.0; n];
+                ground_irradiance.sample_into(u, 0.5, &mut e);
+                for k in 0..n {
+                    l[k] += t[k] * e[k] * model.ground_albedo[k] / std::f64::consts::PI;
+                }
+            }
+        });
+        add_field(
+            &mut sum,
+            coefficients,
+            &next.field,
+            next_coefficients,
+            n,
+            &[1.0; MAX_CHANNELS][..n],
+        );
+        order_means.push(degree_zero_means(&next.field, next_coefficients, n));
+        last = next;
+        last_grid = &next_grid;
     }
+    let last_coefficients = coefficient_count(last_grid.degree);
+    // The orders beyond: the geometric tail of the last two orders' ratio (the table's
+    // means; from 4 orders, the first field being far from the high orders' shape), or
+    // Hillaire's series on the last order's mean, texel by texel (guarded here; compute()
+    // refuses f_ms ≥ the limit).
+    match order_tail_factors(&order_means) {
+        Some(factors) => add_field(
+            &mut sum,
+            coefficients,
+            &last.field,
+            last_coefficients,
+            n,
+            &factors,
+        ),
+        None => {
+            let (per_texel, per_last) = (coefficients * n, last_coefficients * n);
+            for (i, texel) in sum.chunks_mut(per_texel).enumerate() {
+                for k in 0..n {
+                    let f = f_ms[i * n + k].min(F_MS_GUARD);
+                    texel[k] += last.field[i * per_last + k] * f / (1.0 - f);
+                }
+            }
+        }
+    }
+    let mut max = (0.0f64, 1.0, 0usize, 0.0);
+    for i in 0..grid.texels() {
+        let (r, mu_s) = altitude_mu_s_of_texel(i % nmu_s, i / nmu_s, bottom, top, nmu_s, nr);
+        for k in 0..n {
+            if f_ms[i * n + k] > max.0 {
+                max = (f_ms[i * n + k], mu_s, k, r - bottom);
+            }
+        }
+    }
+    MultipleScattering {
+        table: grid.table(&sum),
+        degree,
+        moments,
+        max_f_ms: max.0,
+        max_at: (max.3, max.1, max.2),
+    }
+}
+
+/// `sum` (`coefficients` per texel and channel) += `field` (`field_coefficients` ≤ them, the
+/// lower degrees) × `factors` per channel.
+fn add_field(
+    sum: &mut [f64],
+    coefficients: usize,
+    field: &[f64],
+    field_coefficients: usize,
+    n: usize,
+    factors: &[f64],
+) {
+    for (s, f) in sum
+        .chunks_mut(coefficients * n)
+        .zip(field.chunks(field_coefficients * n))
+    {
+        for (i, v) in f.iter().enumerate() {
+            s[i] += factors[i % n] * v;
+        }
+    }
+}
+
+/// The table-wide mean of each channel's degree-0 coefficient (the field's mean radiance
+/// up to 1/Y₀₀), for the orders' ratio.
+fn degree_zero_means(field: &[f64], coefficients: usize, n: usize) -> Vec<f64> {
+    let texels = field.len() / (coefficients * n);
+    let mut means = vec![0.0; n];
+    for texel in field.chunks(coefficients * n) {
+        for k in 0..n {
+            means[k] += texel[k] / texels as f64;
+        }
+    }
+    means
 }
