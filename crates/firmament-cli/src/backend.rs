@@ -20,6 +20,7 @@ use firmament::scene::terrain::Heightfield;
 use firmament::scene::{Scene, Surface};
 use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, Tables};
 use firmament::sky::SkyMethod;
+use firmament_gpu::elek3d::{GpuElek3d, GpuElek3dRenderer};
 use firmament_gpu::hillaire2020::{GpuHillaire, GpuHillaireRenderer, HillairePrecomputer};
 use firmament_gpu::Precomputer;
 use firmament_gpu::{GpuContext, GpuError, GpuRenderer, GpuSky, GpuTerrain, RenderInputs};
@@ -27,6 +28,7 @@ use firmament_gpu::{GpuContext, GpuError, GpuRenderer, GpuSky, GpuTerrain, Rende
 /// Hillaire 2020 in words, for provenance.
 const HILLAIRE_IN_WORDS: &str =
     "hillaire2020 (transmittance, multiple-scattering and sky-view tables; ray march)";
+use crate::method::ELEK3D_IN_WORDS;
 
 use crate::common::{cancel_flag, print_tables_time, progress_bar, spinner, AtmosphereArgs};
 use crate::method::{CpuSky, Method};
@@ -281,6 +283,13 @@ pub enum RenderSky<'a> {
         sky_model: Box<Model>,
         renderer: Box<GpuHillaireRenderer>,
     },
+    /// The 3D tables, computed on the CPU and rendered on the GPU (the clear sky).
+    GpuElek3d {
+        gpu: &'a Gpu,
+        sky: Box<GpuElek3d>,
+        sky_model: Box<Model>,
+        renderer: Box<GpuElek3dRenderer>,
+    },
 }
 
 impl<'a> RenderSky<'a> {
@@ -303,7 +312,7 @@ impl<'a> RenderSky<'a> {
             (Backend::Gpu(gpu), Method::Bruneton4d) => gpu,
             (Backend::Gpu(gpu), Method::Hillaire2020) => {
                 let model = atmosphere.model()?;
-                let config = crate::method::hillaire_config(atmosphere.hillaire_harmonics);
+                let config = atmosphere.hillaire.config();
                 let started = Instant::now();
                 let sky = on_gpu("Hillaire 2020's tables on the GPU", quiet, || {
                     let precomputer = HillairePrecomputer::new(&gpu.ctx)
@@ -329,7 +338,25 @@ impl<'a> RenderSky<'a> {
                     renderer: Box::new(renderer),
                 });
             }
-            (Backend::Gpu(_), Method::Reference | Method::Elek3d) => {
+            (Backend::Gpu(gpu), Method::Elek3d) => {
+                // The 3D tables precompute on the CPU (under a second) and are uploaded.
+                let CpuSky::Elek3d(cpu) = atmosphere.cpu_sky(method, quiet)? else {
+                    unreachable!("cpu_sky(Elek3d) builds the 3D tables")
+                };
+                let sky = on_gpu("uploading the 3D tables", quiet, || {
+                    GpuElek3d::from_sky(&gpu.ctx, &cpu)
+                        .map_err(|e| gpu_failure("uploading the 3D tables", e))
+                })?;
+                let renderer = GpuElek3dRenderer::new(&gpu.ctx)
+                    .map_err(|e| gpu_failure("compiling the render shader", e))?;
+                return Ok(RenderSky::GpuElek3d {
+                    gpu,
+                    sky: Box::new(sky),
+                    sky_model: Box::new(cpu.model.clone()),
+                    renderer: Box::new(renderer),
+                });
+            }
+            (Backend::Gpu(_), Method::Reference) => {
                 anyhow::bail!(
                     "`--method {}` renders on the CPU only so far",
                     method.name()
@@ -369,9 +396,11 @@ impl<'a> RenderSky<'a> {
     pub fn with_aerial_volume(self, config: AerialVolumeConfig) -> Result<Self> {
         match self {
             RenderSky::Cpu(sky, _) => Ok(RenderSky::Cpu(sky, Some(config))),
-            RenderSky::Gpu { .. } | RenderSky::GpuHillaire { .. } => anyhow::bail!(
+            RenderSky::Gpu { .. } | RenderSky::GpuHillaire { .. } | RenderSky::GpuElek3d { .. } => {
+                anyhow::bail!(
                 "`--aerial-volume` is built by the CPU renderer only so far: use `--backend cpu`"
-            ),
+            )
+            }
         }
     }
 
@@ -379,8 +408,9 @@ impl<'a> RenderSky<'a> {
     pub fn on(&self) -> &'static str {
         match self {
             RenderSky::Cpu(..) => "",
-            RenderSky::GpuHillaire { .. } => " on the GPU",
-            RenderSky::Gpu { .. } => " on the GPU",
+            RenderSky::Gpu { .. } | RenderSky::GpuHillaire { .. } | RenderSky::GpuElek3d { .. } => {
+                " on the GPU"
+            }
         }
     }
 
@@ -398,6 +428,11 @@ impl<'a> RenderSky<'a> {
         if terrain.is_some() && matches!(self, RenderSky::GpuHillaire { .. }) {
             anyhow::bail!(
                 "`--method hillaire2020` draws terrain on the CPU only so far: use `--backend cpu` (or `auto`)"
+            );
+        }
+        if terrain.is_some() && matches!(self, RenderSky::GpuElek3d { .. }) {
+            anyhow::bail!(
+                "`--method elek3d` draws terrain on the CPU only so far: use `--backend cpu` (or `auto`)"
             );
         }
         if planet.is_some() && !matches!(self, RenderSky::Cpu(..)) {
@@ -446,6 +481,25 @@ impl<'a> RenderSky<'a> {
                 Ok(frame)
             }
             RenderSky::GpuHillaire {
+                gpu,
+                sky,
+                sky_model,
+                renderer,
+            } => {
+                let inputs = RenderInputs {
+                    background: sources.background.as_ref(),
+                    ..RenderInputs::default()
+                };
+                let (lights, small) = gpu_lights(sources, settings, sky_model);
+                let mut frame = on_gpu("rendering on the GPU", quiet, || {
+                    renderer
+                        .render_with(&gpu.ctx, sky, &lights, settings, inputs)
+                        .map_err(|e| gpu_failure("rendering", e))
+                })?;
+                draw_points(&mut frame, sources, small, sky_model, settings, None);
+                Ok(frame)
+            }
+            RenderSky::GpuElek3d {
                 gpu,
                 sky,
                 sky_model,
@@ -525,15 +579,15 @@ impl<'a> RenderSky<'a> {
             RenderSky::GpuHillaire { sky, .. } => {
                 crate::method::hillaire_json(sky.config(), sky.max_f_ms())
             }
+            RenderSky::GpuElek3d { sky, .. } => crate::method::elek3d_json(sky.config()),
         }
     }
 
     /// The method in words, for provenance.
     pub fn describe(&self) -> &'static str {
         match self {
-            RenderSky::Cpu(sky, _) if sky.name() == "elek3d" => {
-                "elek3d (3D scattering tables without the view-sun azimuth)"
-            }
+            RenderSky::Cpu(sky, _) if sky.name() == "elek3d" => ELEK3D_IN_WORDS,
+            RenderSky::GpuElek3d { .. } => ELEK3D_IN_WORDS,
             RenderSky::Cpu(sky, _) if sky.bruneton4d().is_none() => HILLAIRE_IN_WORDS,
             RenderSky::GpuHillaire { .. } => HILLAIRE_IN_WORDS,
             _ => "bruneton4d (precomputed tables)",
@@ -546,6 +600,7 @@ impl<'a> RenderSky<'a> {
             RenderSky::Cpu(sky, _) => sky.model(),
             RenderSky::Gpu { sky_model, .. } => sky_model,
             RenderSky::GpuHillaire { sky_model, .. } => sky_model,
+            RenderSky::GpuElek3d { sky_model, .. } => sky_model,
         }
     }
 }

@@ -65,10 +65,10 @@ pub struct AtmosphereArgs {
     /// Store single Mie scattering for every wavelength (`separate`) or only the first (`red-only`, ratio rule).
     #[arg(long, default_value = "separate", value_name = "separate|red-only")]
     pub mie: String,
-    /// Hillaire 2020's second order in spherical harmonics of this degree (0: its isotropic
-    /// field); set from the commands' own `--hillaire-harmonics`.
+    /// Hillaire 2020's options; set from the commands' own `--hillaire-harmonics` and
+    /// `--hillaire-orders`.
     #[arg(skip)]
-    pub hillaire_harmonics: usize,
+    pub hillaire: crate::method::HillaireArgs,
     /// The ground's albedo per wavelength in place of the atmosphere's (a scene's terrain
     /// sets it to its own mean, so the tables' ground bounce is the terrain's).
     #[arg(skip)]

@@ -89,9 +89,17 @@ impl CpuSky {
         match self {
             CpuSky::Bruneton4d(s) => serde_json::to_value(s.tables.config).unwrap_or(Value::Null),
             CpuSky::Hillaire2020(s) => hillaire_json(&s.config, s.max_f_ms),
-            CpuSky::Elek3d(s) => serde_json::json!({ "elek3d": format!("{:?}", s.config) }),
+            CpuSky::Elek3d(s) => elek3d_json(&s.config),
         }
     }
+}
+
+/// The 3D tables in words, for provenance.
+pub const ELEK3D_IN_WORDS: &str = "elek3d (3D scattering tables without the view-sun azimuth)";
+
+/// The 3D tables' configuration as JSON.
+pub fn elek3d_json(c: &Elek3dConfig) -> Value {
+    json!({ "elek3d": format!("{c:?}") })
 }
 
 /// Hillaire's sizes and counts as JSON.
@@ -103,6 +111,7 @@ pub fn hillaire_json(c: &HillaireConfig, max_f_ms: f64) -> Value {
         },
         "transmittance": [c.transmittance.0, c.transmittance.1],
         "multiple_scattering": [c.multiple_scattering.0, c.multiple_scattering.1],
+        "multiple_scattering_orders": c.multiple_scattering_orders,
         "multiple_scattering_directions": c.multiple_scattering_directions,
         "multiple_scattering_steps": c.multiple_scattering_steps,
         "sky_view": [c.sky_view.0, c.sky_view.1],
@@ -127,7 +136,7 @@ impl AtmosphereArgs {
                     );
                 }
                 let model = self.model()?;
-                let config = hillaire_config(self.hillaire_harmonics);
+                let config = self.hillaire.config();
                 Ok(CpuSky::Hillaire2020(Box::new(hillaire(
                     model, &config, quiet,
                 )?)))
@@ -166,15 +175,63 @@ impl AtmosphereArgs {
 
 /// Hillaire's configuration with the second order in harmonics of `degree` (0: Hillaire's
 /// isotropic field).
-pub fn hillaire_config(degree: usize) -> HillaireConfig {
-    match degree {
-        0 => HillaireConfig::default(),
-        d => HillaireConfig {
-            multiple_scattering_model: MultipleScatteringModel::Harmonics(d),
-            // The harmonics need more gather directions than the isotropic mean.
-            multiple_scattering_directions: (24, 12),
+/// Hillaire 2020's options on the commands that evaluate it (query, render, validate).
+#[derive(clap::Args, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HillaireArgs {
+    /// With `--method hillaire2020`: the second order of multiple scattering as spherical
+    /// harmonics up to this degree, each constituent's phase function applied to it
+    /// (firmament's extension, 1–8; 6 halves Hillaire's p95 on earth, docs/accuracy.md),
+    /// instead of Hillaire's isotropic field (0, the default: as Unreal and Bevy do).
+    #[arg(long, default_value_t = 0, value_name = "DEGREE")]
+    pub hillaire_harmonics: usize,
+    /// With `--method hillaire2020`: the highest scattering order computed explicitly, 2–16
+    /// (2, the default: Hillaire's, every further order from the 1/(1 − f_ms) series; from
+    /// 4 the rest by the geometric tail of the last two, as the 4D tables do). With
+    /// `--hillaire-harmonics 6`, 4 orders take the ground's −5 % bias on earth to about −1 %
+    /// at ~3× the build (docs/accuracy.md).
+    #[arg(long, default_value_t = 2, value_name = "N")]
+    pub hillaire_orders: usize,
+}
+
+impl Default for HillaireArgs {
+    fn default() -> Self {
+        HillaireArgs {
+            hillaire_harmonics: 0,
+            hillaire_orders: 2,
+        }
+    }
+}
+
+impl HillaireArgs {
+    /// The method's configuration (the harmonics with the gather rule they need).
+    pub fn config(&self) -> HillaireConfig {
+        let base = HillaireConfig {
+            multiple_scattering_orders: self.hillaire_orders,
             ..HillaireConfig::default()
-        },
+        };
+        match self.hillaire_harmonics {
+            0 => base,
+            d => HillaireConfig {
+                multiple_scattering_model: MultipleScatteringModel::Harmonics(d),
+                // The harmonics need more gather directions than the isotropic mean.
+                multiple_scattering_directions: (24, 12),
+                ..base
+            },
+        }
+    }
+
+    /// Refuse the options with a method that does not take them.
+    pub fn check(&self, methods: &[Method]) -> Result<()> {
+        if methods.contains(&Method::Hillaire2020) {
+            return Ok(());
+        }
+        if self.hillaire_harmonics != 0 {
+            anyhow::bail!("`--hillaire-harmonics` is for `--method hillaire2020`");
+        }
+        if self.hillaire_orders != 2 {
+            anyhow::bail!("`--hillaire-orders` is for `--method hillaire2020`");
+        }
+        Ok(())
     }
 }
 

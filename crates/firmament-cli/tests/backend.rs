@@ -341,6 +341,46 @@ fn gpu_hillaire2020_render_matches_cpu() {
     assert!(!png.exists());
 }
 
+#[test]
+fn gpu_elek3d_render_matches_cpu() {
+    let Some(_lock) = gpu() else { return };
+    // The 3D tables computed on the CPU, uploaded, and drawn by the GPU's renderer.
+    let [(cpu_png, cpu_exr), (gpu_png, gpu_exr)] = render_both(
+        "elek3d",
+        &[
+            "--method",
+            "elek3d",
+            "--wavelengths",
+            "rgb",
+            "--width",
+            "48",
+            "--height",
+            "27",
+            "--sun-zenith-deg",
+            "80",
+        ],
+    );
+    let d8 = png_mean_abs_diff(&gpu_png, &cpu_png);
+    assert!(d8 <= 1.0, "mean |Δ| of 8-bit values {d8}");
+    let rel = exr_mean_rel_diff(&gpu_exr, &cpu_exr);
+    assert!(rel <= 0.01, "mean relative luminance difference {rel}");
+    // The terrain is the CPU's only so far: refused on `--backend gpu`.
+    let png = tmp().join("elek3d-terrain.png");
+    let o = run(&[
+        "render",
+        "--method",
+        "elek3d",
+        "--backend",
+        "gpu",
+        "--width",
+        "32",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    fails_with(&o, &["elek3d", "terrain", "--backend cpu"]);
+    assert!(!png.exists());
+}
+
 /// The default scene's valley (coarse) at golden hour, its tables precomputed on each
 /// backend with the ground lifted to the valley's floor: the GPU walks the same terrain,
 /// shadow fields and light shafts, with the air light computed on the CPU from the tables

@@ -247,6 +247,46 @@ fn hillaire2020_answers_query_render_and_validate() {
     for view in v["views"].as_array().unwrap() {
         assert!(view["luminance_cd_m2"].as_f64().unwrap() > 100.0, "{view}");
     }
+    // More orders gathered: named in the provenance, the ground's sky brighter (the series
+    // read the higher orders low there); refused with another method.
+    let zenith = |orders: &str| {
+        let out = run(&[
+            "query",
+            "--method",
+            "hillaire2020",
+            "--hillaire-orders",
+            orders,
+            "--wavelengths",
+            "rgb",
+            "--altitude-m",
+            "0",
+            "--sun-zenith-deg",
+            "60",
+            "--view",
+            "0,0",
+            "--quiet",
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(
+            v["provenance"]["tables"]["multiple_scattering_orders"].as_u64(),
+            Some(orders.parse().unwrap())
+        );
+        v["views"][0]["luminance_cd_m2"].as_f64().unwrap()
+    };
+    let (two, four) = (zenith("2"), zenith("4"));
+    assert!(four > two * 1.005, "2 orders {two}, 4 orders {four}");
+    let out = run(&[
+        "query",
+        "--hillaire-orders",
+        "4",
+        "--altitude-m",
+        "0",
+        "--view",
+        "0,0",
+    ]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("`--hillaire-orders` is for `--method hillaire2020`"));
     // The 3D table answers too.
     let out = run(&[
         "query",

@@ -57,12 +57,8 @@ pub struct QueryArgs {
     /// tracer; adds `radiance_stderr` and `samples` to each view).
     #[arg(long, value_enum, default_value_t = Method::Bruneton4d, value_name = "bruneton4d|lut|hillaire2020|elek3d|reference")]
     pub method: Method,
-    /// With `--method hillaire2020`: the second order of multiple scattering as spherical
-    /// harmonics up to this degree, each constituent's phase function applied to it
-    /// (firmament's extension, 1–8; 6 halves Hillaire's p95 on earth, docs/accuracy.md),
-    /// instead of Hillaire's isotropic field (0, the default: as Unreal and Bevy do).
-    #[arg(long, default_value_t = 0, value_name = "DEGREE")]
-    pub hillaire_harmonics: usize,
+    #[command(flatten)]
+    pub hillaire: crate::method::HillaireArgs,
     /// Paths per wavelength and view for `--method reference`.
     #[arg(long, default_value_t = 10_000)]
     pub samples: usize,
@@ -191,12 +187,10 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
             Some(settings)
         }
     };
-    if args.hillaire_harmonics != 0 && args.method != Method::Hillaire2020 {
-        anyhow::bail!("`--hillaire-harmonics` is for `--method hillaire2020`");
-    }
+    args.hillaire.check(&[args.method])?;
     let args = &QueryArgs {
         atmosphere: AtmosphereArgs {
-            hillaire_harmonics: args.hillaire_harmonics,
+            hillaire: args.hillaire,
             ..args.atmosphere.clone()
         },
         ..args.clone()
@@ -353,7 +347,7 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
         (None, Method::Hillaire2020) => {
             "hillaire2020 (transmittance, multiple-scattering and sky-view tables; ray march)"
         }
-        (None, Method::Elek3d) => "elek3d (3D scattering tables without the view-sun azimuth)",
+        (None, Method::Elek3d) => crate::method::ELEK3D_IN_WORDS,
         (None, _) => "bruneton4d (precomputed tables)",
     };
     Ok(json!({

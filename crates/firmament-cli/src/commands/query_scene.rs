@@ -35,7 +35,7 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
         args.atmosphere.no_cache,
         args.quiet,
     )?;
-    atmosphere.hillaire_harmonics = args.atmosphere.hillaire_harmonics;
+    atmosphere.hillaire = args.atmosphere.hillaire;
     // What the reference cannot trace is refused before the tables are computed.
     if reference.is_some() && scene.surface.as_ref().is_some_and(|s| s.glint) {
         anyhow::bail!("`--method reference` traces Lambertian surfaces only: the sun's glint on the sea is not in it (set `glint = false` in [surface] to compare the map)");

@@ -249,15 +249,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             return write_outputs(&frame, &scene, ev100, files, &notes, args.quiet);
         }
     }
-    if args.hillaire_harmonics != 0 && args.method != Method::Hillaire2020 {
-        anyhow::bail!("`--hillaire-harmonics` is for `--method hillaire2020`");
-    }
+    args.hillaire.check(&[args.method])?;
     let terrain_wanted = scene.terrain.is_some();
     if args.method == Method::Elek3d {
-        if args.backend == BackendChoice::Gpu {
-            anyhow::bail!(
-                "`--method elek3d` renders on the CPU only so far: use `--backend cpu` or `auto`"
-            );
+        if args.backend == BackendChoice::Gpu && terrain_wanted {
+            anyhow::bail!("`--method elek3d` draws terrain on the CPU only so far: use `--backend cpu` or `auto`, or `--no-terrain`");
         }
         if args.tables.is_some() {
             anyhow::bail!("`--tables` holds 4D tables: `--method elek3d` builds its own 3D ones");
@@ -267,6 +263,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         if args.backend == BackendChoice::Gpu && terrain_wanted {
             anyhow::bail!("`--method hillaire2020` draws terrain on the CPU only so far: use `--backend cpu` or `auto`, or `--no-terrain`");
         }
+        if args.backend == BackendChoice::Gpu && args.hillaire.hillaire_orders != 2 {
+            anyhow::bail!("`--hillaire-orders` gathers the higher orders on the CPU only so far: use `--backend cpu` or `auto`");
+        }
         if args.tables.is_some() {
             anyhow::bail!("`--tables` holds 4D tables: `--method hillaire2020` builds its own (in milliseconds)");
         }
@@ -274,12 +273,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let backend = match Backend::open(args.backend, args.quiet)? {
         Backend::Gpu(_)
             if args.backend == BackendChoice::Auto
-                && ((args.method == Method::Hillaire2020 && terrain_wanted)
-                    || args.method == Method::Elek3d
-                    || args.aerial_volume) =>
+                && ((matches!(args.method, Method::Hillaire2020 | Method::Elek3d)
+                    && terrain_wanted)
+                    || args.aerial_volume
+                    || args.hillaire.hillaire_orders != 2) =>
         {
             if !args.quiet {
-                eprintln!("note: elek3d, hillaire2020's terrain and --aerial-volume render on the CPU only so far: using the CPU");
+                eprintln!("note: the terrain of hillaire2020 and elek3d, --hillaire-orders and --aerial-volume render on the CPU only so far: using the CPU");
             }
             Backend::Cpu
         }
@@ -306,7 +306,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         args.quiet,
     )?;
     atmosphere.order_args = args.order_args;
-    atmosphere.hillaire_harmonics = args.hillaire_harmonics;
+    atmosphere.hillaire = args.hillaire;
     print_wavelengths(&atmosphere.model()?, args.quiet);
     let t = Instant::now();
     let mut sky = RenderSky::new(&backend, &atmosphere, args.method, args.quiet)?;

@@ -165,15 +165,12 @@ pub struct RenderArgs {
     pub quiet: bool,
     /// Method: `bruneton4d` (or `lut`: the precomputed 4D tables), `hillaire2020`
     /// (Hillaire 2020's small tables and ray march: fast to build; the terrain on the CPU
-    /// only), `elek3d` (Frostbite's 3D table; CPU only so far) or `reference` (Monte Carlo
+    /// only), `elek3d` (Frostbite's 3D table; the terrain on the CPU only) or `reference` (Monte Carlo
     /// path tracer: a ground-truth image of the same scene, no tables).
     #[arg(long, value_enum, default_value_t = Method::Bruneton4d, value_name = "bruneton4d|lut|hillaire2020|elek3d|reference")]
     pub method: Method,
-    /// With `--method hillaire2020`: the second order of multiple scattering as spherical
-    /// harmonics up to this degree (firmament's extension, 1–8) instead of Hillaire's
-    /// isotropic field (0, the default).
-    #[arg(long, default_value_t = 0, value_name = "DEGREE")]
-    pub hillaire_harmonics: usize,
+    #[command(flatten)]
+    pub hillaire: crate::method::HillaireArgs,
     /// Surfaces' aerial perspective from a camera-aligned froxel volume (32×32×32 over
     /// 32 km, Hillaire 2020 §5.4) per light instead of per pixel: faster with
     /// `--method hillaire2020`, within 0.5 % mean (docs/accuracy.md); rays with light

@@ -7,6 +7,7 @@
 
 mod cpu;
 mod gpu;
+mod gpu_methods;
 mod methods;
 mod report;
 mod scenes;
@@ -137,6 +138,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         cpu_methods: Default::default(),
         gpu_skipped,
         gpu: Default::default(),
+        gpu_methods: Default::default(),
     };
     if measure_cpu {
         report.cpu_precompute =
@@ -161,6 +163,18 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             runs,
             !args.json,
         )?;
+        if wanted.contains(&Method::Hillaire2020) {
+            if !args.json {
+                eprintln!("gpu: hillaire2020's passes and 1080p frame");
+            }
+            gpu_methods::hillaire_timings(gpu, &model, runs, &mut report.gpu_methods)?;
+        }
+        if wanted.contains(&Method::Elek3d) {
+            if !args.json {
+                eprintln!("gpu: elek3d's 1080p frame");
+            }
+            gpu_methods::elek3d_timings(gpu, &model, runs, &mut report.gpu_methods)?;
+        }
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report.to_json())?);

@@ -26,6 +26,8 @@ pub struct BenchReport {
     pub gpu_skipped: Option<String>,
     #[serde(flatten)]
     pub gpu: GpuTimings,
+    #[serde(flatten)]
+    pub gpu_methods: GpuMethods,
 }
 
 /// The CPU's model name and the threads the CPU work ran on.
@@ -117,6 +119,21 @@ pub struct GpuTimings {
     /// light on the CPU, the upload, the dispatch, the readback and the tone mapping (the
     /// terrain built and the tables read back once beforehand).
     pub gpu_frame_1080p_terrain_with_cpu_parts_s: Option<f64>,
+}
+
+/// The fast methods on the GPU (seconds, medians, `--method`): Hillaire 2020's passes
+/// (timestamp queries on a hardware adapter, the wall clock per pass on a software one), its
+/// sky-view pass and pixels' pass of the 1080p benchmark frame; the 3D table's frame (its
+/// tables are the CPU's, uploaded: `cpu_elek3d_tables_s`), the compute pass alone.
+#[derive(Serialize, Debug, Default)]
+pub struct GpuMethods {
+    pub gpu_hillaire_transmittance_s: Option<f64>,
+    pub gpu_hillaire_multiple_scattering_s: Option<f64>,
+    pub gpu_hillaire_irradiance_s: Option<f64>,
+    pub gpu_hillaire_sky_view_s: Option<f64>,
+    pub gpu_hillaire_frame_1080p_perspective_s: Option<f64>,
+    pub gpu_hillaire_timing_method: Option<String>,
+    pub gpu_elek3d_frame_1080p_perspective_s: Option<f64>,
 }
 
 impl Machine {

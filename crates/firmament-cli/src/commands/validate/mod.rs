@@ -43,7 +43,7 @@ use serde_json::{json, Value};
 use crate::common::{
     check_output_dir, check_range, check_reference_samples, progress_bar, AtmosphereArgs, OrderArgs,
 };
-use crate::method::{CpuSky, Method};
+use crate::method::{CpuSky, HillaireArgs, Method};
 use compare::{compare_method, ViewRecord};
 use sampling::{trace_views, SamplePlan, PILOT_SAMPLES};
 use summary::{RelativeErrors, Summaries};
@@ -90,10 +90,8 @@ pub struct ValidateArgs {
     /// reference (the first is the one checked against the thresholds).
     #[arg(long, default_value = "4", value_name = "N,...")]
     pub orders: String,
-    /// hillaire2020's second order in spherical harmonics of this degree (0: Hillaire's
-    /// isotropic field), as `render --hillaire-harmonics`.
-    #[arg(long, default_value_t = 0, value_name = "DEGREE")]
-    pub hillaire_harmonics: usize,
+    #[command(flatten)]
+    pub hillaire: crate::method::HillaireArgs,
     /// Tables without the geometric tail of the orders beyond --orders.
     #[arg(long)]
     pub no_order_tail: bool,
@@ -140,7 +138,7 @@ struct Selection {
     table_size: String,
     wavelengths: String,
     order_tail: bool,
-    hillaire_harmonics: usize,
+    hillaire: HillaireArgs,
     samples: SamplePlan,
 }
 
@@ -185,6 +183,7 @@ impl Selection {
                 Ok(m) => Ok(m),
             })
             .collect::<Result<_>>()?;
+        args.hillaire.check(&methods)?;
         let table_size = args
             .table_size
             .clone()
@@ -218,7 +217,7 @@ impl Selection {
             table_size,
             wavelengths: args.wavelengths.clone(),
             order_tail: !args.no_order_tail,
-            hillaire_harmonics: args.hillaire_harmonics,
+            hillaire: args.hillaire,
             samples,
         };
         for p in &selection.presets {
@@ -261,7 +260,7 @@ impl Selection {
                 order_tail: self.order_tail,
             },
             table_size: self.table_size.clone(),
-            hillaire_harmonics: self.hillaire_harmonics,
+            hillaire: self.hillaire,
             ..AtmosphereArgs::default()
         }
     }
