@@ -46,9 +46,10 @@ fn sky_view_mu_cos_phi(r_km: f32, rho_km: f32, x: u32, y: u32) -> vec2<f32> {
 }
 
 // The (u, v) of the multiple-scattering and irradiance tables (n_mu_s × n_r texels) at
-// `altitude_km` under a light at zenith cosine `mu_s` (params::altitude_mu_s_uv).
+// `altitude_km` under a light at zenith cosine `mu_s` (params::altitude_mu_s_uv: the rows
+// quadratic in altitude, dense near the ground).
 fn altitude_mu_s_uv(altitude_km: f32, mu_s: f32, n_mu_s: u32, n_r: u32) -> vec2<f32> {
-    let x_r = clamp(altitude_km / (atm.top_radius_km - atm.bottom_radius_km), 0.0, 1.0);
+    let x_r = sqrt(clamp(altitude_km / (atm.top_radius_km - atm.bottom_radius_km), 0.0, 1.0));
     let x_mu_s = clamp(mu_s * 0.5 + 0.5, 0.0, 1.0);
     return vec2<f32>(texcoord_from_unit(x_mu_s, n_mu_s), texcoord_from_unit(x_r, n_r));
 }
@@ -57,7 +58,7 @@ fn altitude_mu_s_uv(altitude_km: f32, mu_s: f32, n_mu_s: u32, n_r: u32) -> vec2<
 fn altitude_mu_s_of_texel(x: u32, y: u32, n_mu_s: u32, n_r: u32) -> vec3<f32> {
     let x_mu_s = f32(x) / f32(n_mu_s - 1u);
     let x_r = f32(y) / f32(n_r - 1u);
-    let altitude_km = x_r * (atm.top_radius_km - atm.bottom_radius_km);
+    let altitude_km = x_r * x_r * (atm.top_radius_km - atm.bottom_radius_km);
     let r_km = atm.bottom_radius_km + altitude_km;
     let rho_km = sqrt(altitude_km * (r_km + atm.bottom_radius_km));
     return vec3<f32>(r_km, rho_km, clamp_cosine(2.0 * x_mu_s - 1.0));

@@ -18,6 +18,7 @@ use std::sync::{Arc, Mutex};
 use firmament::atmosphere::Model;
 use firmament::sky::bruneton4d::Table2;
 use firmament::sky::hillaire2020::harmonics::{coefficient_count, phase_moments};
+use firmament::sky::hillaire2020::params::altitude_mu_s_of_texel;
 use firmament::sky::hillaire2020::{
     Hillaire2020, HillaireConfig, MultipleScattering, MultipleScatteringModel, F_MS_LIMIT,
 };
@@ -537,11 +538,9 @@ fn max_f_ms_of(values: &[f32], model: &Model, config: &HillaireConfig) -> (f64, 
         for k in 0..n {
             let f = values[texel * g * GROUP + k] as f64;
             if f > worst.0 {
-                let (x, y) = (texel % w, texel / w);
-                let altitude =
-                    y as f64 / (h - 1) as f64 * (model.top_radius_m - model.bottom_radius_m);
-                let mu_s = (2.0 * x as f64 / (w - 1) as f64 - 1.0).clamp(-1.0, 1.0);
-                worst = (f, (altitude, mu_s, k));
+                let (bottom, top) = (model.bottom_radius_m, model.top_radius_m);
+                let (r, mu_s) = altitude_mu_s_of_texel(texel % w, texel / w, bottom, top, w, h);
+                worst = (f, (r - bottom, mu_s, k));
             }
         }
     }
