@@ -150,11 +150,7 @@ impl Grid {
     /// Gather `incoming(ray, ground, l, scattered)` (the radiance arriving at a texel's
     /// point from the ray's direction, into `l`; ∫T·σ_s along it into `scattered` when that
     /// is not empty) over every texel's directions; `with_f_ms` sums f_ms too.
-    fn gather(
-        &self,
-        with_f_ms: bool,
-        incoming: &Incoming,
-    ) -> Gathered {
+    fn gather(&self, with_f_ms: bool, incoming: &Incoming) -> Gathered {
         let n = self.channels;
         let coefficients = coefficient_count(self.degree);
         let p_u = PhaseFunction::Isotropic.eval(1.0);
