@@ -3,11 +3,13 @@
 //! whole frame of a terrain scene drawn both ways.
 
 use firmament::atmosphere::{Atmosphere, Model};
+use firmament::math::sphere::ray_sphere;
 use firmament::math::Vec3;
 use firmament::render::aerial_volume::{AerialVolume, AerialVolumeConfig};
 use firmament::render::{self, RenderSettings};
 use firmament::scene::{Camera, Light, Projection, Scene, Sphere};
 use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, TableSizes};
+use firmament::sky::elek3d::{Elek3d, Elek3dConfig};
 use firmament::sky::hillaire2020::{Hillaire2020, HillaireConfig};
 use firmament::sky::{Shadow, SkyMethod};
 use firmament::spectrum::Wavelengths;
@@ -202,4 +204,69 @@ fn frame_difference(sky: &dyn SkyMethod) -> (f64, f64) {
     let mean = sum / count;
     eprintln!("frame: {count} pixels through the volume, mean |relative luminance difference| {:.4} %, worst {:.3} %", 100.0 * mean, 100.0 * worst);
     (mean, worst)
+}
+
+/// From space, the aerial perspective to a point the ray reaches before it enters the
+/// atmosphere is none (radiance 0, transmittance 1), and to a point past the entry it is
+/// the air between the entry and the point: for every method, one point at a time and a
+/// whole froxel column at once (the volume from orbit).
+#[test]
+fn points_before_the_atmosphere_see_no_air_from_space() {
+    let model = earth();
+    let small = TableConfig {
+        sizes: TableSizes::small(),
+        ..TableConfig::default()
+    };
+    let methods: Vec<(&str, Box<dyn SkyMethod>)> = vec![
+        (
+            "bruneton4d",
+            Box::new(Bruneton4d::compute(model.clone(), &small).unwrap()),
+        ),
+        (
+            "hillaire2020",
+            Box::new(Hillaire2020::compute(model.clone(), &HillaireConfig::default()).unwrap()),
+        ),
+        (
+            "elek3d",
+            Box::new(Elek3d::compute(model.clone(), &Elek3dConfig::small()).unwrap()),
+        ),
+    ];
+    let n = model.channels();
+    // 150 km up, looking 40° down.
+    let observer = Vec3::new(0.0, 0.0, model.bottom_radius_m + 150_000.0);
+    let e = (-40.0f64).to_radians();
+    let dir = Vec3::new(e.cos(), 0.0, e.sin());
+    let light = Light::sun(&model, Vec3::new(0.6, 0.0, 0.8), false);
+    for (name, sky) in &methods {
+        let view = sky.probe(observer, &light);
+        let (entry, _) = ray_sphere(observer, dir, model.top_radius_m).unwrap();
+        let points = [
+            observer + dir * (entry - 10_000.0),
+            observer + dir * (entry + 15_000.0),
+        ];
+        let (mut l, mut t) = (vec![0.0; 2 * n], vec![0.0; 2 * n]);
+        view.sky_radiance_along(&points, &mut l, &mut t);
+        for (i, &p) in points.iter().enumerate() {
+            let (mut l1, mut t1, mut t2) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+            view.sky_radiance_to_point(p, Shadow::None, &mut l1, &mut t1);
+            view.transmittance_to_point(p, &mut t2);
+            for k in 0..n {
+                if i == 0 {
+                    assert_eq!((l1[k], t1[k], t2[k]), (0.0, 1.0, 1.0), "{name}");
+                    assert_eq!((l[k], t[k]), (0.0, 1.0), "{name}, column");
+                } else {
+                    assert!(
+                        l1[k] > 0.0 && t1[k] < 1.0 && t1[k] > 0.5,
+                        "{name}: {l1:?} {t1:?}"
+                    );
+                    assert!((t2[k] - t1[k]).abs() < 1e-9, "{name}");
+                    let column = (l[n + k] / l1[k] - 1.0).abs();
+                    assert!(
+                        column < 0.02 && (t[n + k] - t1[k]).abs() < 1e-9,
+                        "{name}: {column}"
+                    );
+                }
+            }
+        }
+    }
 }

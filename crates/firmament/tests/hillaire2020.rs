@@ -261,3 +261,76 @@ fn orders_below_two_or_past_the_limit_are_refused() {
         );
     }
 }
+
+/// The aerial-perspective volume's column march (one march through every slice of a
+/// column, `SkyView::sky_radiance_along`) and the per-point march it replaces (30 steps to
+/// each point), both against a 600-step march to each point, over the volume's quadratic
+/// slices to 32 km: from the ground and from a plane at 9 km (views up, level and down to
+/// the ground), and from space through the atmosphere.
+#[test]
+fn the_column_march_is_as_accurate_as_one_march_per_point() {
+    let model = earth();
+    let hillaire = Hillaire2020::compute(model.clone(), &HillaireConfig::default()).unwrap();
+    let fine = Hillaire2020 {
+        config: HillaireConfig {
+            march_steps: 600,
+            ..hillaire.config
+        },
+        ..Hillaire2020::compute(model.clone(), &HillaireConfig::default()).unwrap()
+    };
+    let n = model.channels();
+    let y = |l: &[f64]| model.colour_matrix().to_xyz(l)[1];
+    // (sum, worst) of |error| for the column march and the per-point march, and the count.
+    let (mut column, mut per_point, mut count) = ((0.0, 0.0f64), (0.0, 0.0f64), 0.0);
+    for (altitude, sun_elevation) in [(2.0, 35.0), (9_000.0, 6.0), (120_000.0, 20.0)] {
+        let light = Light::sun(&model, sun_at(sun_elevation), false);
+        let observer = Vec3::new(0.0, 0.0, model.bottom_radius_m + altitude);
+        let (view, truth) = (
+            hillaire.probe(observer, &light),
+            fine.probe(observer, &light),
+        );
+        for (elevation, azimuth) in [(20.0, 0.0), (2.0, 90.0), (-1.0, 180.0), (-30.0, 30.0)] {
+            let dir = view_dir(elevation, azimuth);
+            let start = if altitude > 100_000.0 { 30_000.0 } else { 0.0 };
+            let points: Vec<Vec3> = (0..32)
+                .map(|z| {
+                    let f = (z as f64 + 1.0) / 32.0;
+                    observer + dir * (start + 32_000.0 * f * f)
+                })
+                .collect();
+            let (mut l, mut t) = (vec![0.0; 32 * n], vec![0.0; 32 * n]);
+            view.sky_radiance_along(&points, &mut l, &mut t);
+            let (mut l1, mut t1, mut l0) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+            for (z, &p) in points.iter().enumerate() {
+                view.sky_radiance_to_point(p, Shadow::None, &mut l1, &mut t1);
+                for k in 0..n {
+                    assert!((t[z * n + k] - t1[k]).abs() < 1e-9, "transmittance {z}");
+                }
+                truth.sky_radiance_to_point(p, Shadow::None, &mut l0, &mut t1);
+                let y0 = y(&l0);
+                if y0 > 0.0 {
+                    for (acc, v) in [
+                        (&mut column, y(&l[z * n..(z + 1) * n])),
+                        (&mut per_point, y(&l1)),
+                    ] {
+                        let e = (v / y0 - 1.0).abs();
+                        acc.0 += e;
+                        acc.1 = acc.1.max(e);
+                    }
+                    count += 1.0;
+                }
+            }
+        }
+    }
+    eprintln!(
+        "against 600 steps per point, over {count} points: column march mean {:.3} %, worst {:.3} %; \
+         30 steps per point mean {:.3} %, worst {:.3} %",
+        100.0 * column.0 / count,
+        100.0 * column.1,
+        100.0 * per_point.0 / count,
+        100.0 * per_point.1
+    );
+    assert!(count > 250.0);
+    assert!(column.0 / count < 0.002 && column.1 < 0.01, "{column:?}");
+    assert!(column.0 <= per_point.0 * 1.5, "{column:?} {per_point:?}");
+}

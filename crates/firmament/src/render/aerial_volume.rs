@@ -2,7 +2,8 @@
 //! camera-aligned froxel grid holding the in-scattered radiance and the transmittance
 //! between the observer and points along each froxel column's direction, at depth slices
 //! spread quadratically out to a maximum distance, filled once per frame and light from the
-//! sky method's own [`SkyView::sky_radiance_to_point`], so every method can use it. A surface
+//! sky method's own [`SkyView::sky_radiance_along`] (one march per column for Hillaire 2020,
+//! one query per froxel for the tables), so every method can use it. A surface
 //! hit then reads its aerial perspective by one trilinear lookup at its pixel's direction
 //! and distance instead of asking the method (a march for Hillaire 2020, a pair of 4D
 //! lookups for the tables).
@@ -19,8 +20,7 @@ use rayon::prelude::*;
 use crate::math::sphere::ray_sphere;
 use crate::math::Vec3;
 use crate::scene::{PreparedCamera, Projection};
-use crate::sky::{Shadow, SkyView};
-use crate::spectrum::with_channel_buffers;
+use crate::sky::SkyView;
 use crate::{Error, Result};
 
 /// The volume's size and reach.
@@ -126,17 +126,20 @@ impl AerialVolume {
                         *ground_m = near;
                     }
                 }
-                with_channel_buffers(channels, |[l, t]| {
-                    for (z, froxel) in out.chunks_mut(stride).enumerate() {
-                        let distance = slice_distance(z, d, config.max_distance_m).min(*ground_m);
-                        let point = observer + ray.dir * distance;
-                        view.sky_radiance_to_point(point, Shadow::None, l, t);
-                        for k in 0..channels {
-                            froxel[k] = l[k] as f32;
-                            froxel[channels + k] = t[k] as f32;
-                        }
+                let points: Vec<Vec3> = (0..d)
+                    .map(|z| {
+                        observer
+                            + ray.dir * slice_distance(z, d, config.max_distance_m).min(*ground_m)
+                    })
+                    .collect();
+                let (mut l, mut t) = (vec![0.0; d * channels], vec![0.0; d * channels]);
+                view.sky_radiance_along(&points, &mut l, &mut t);
+                for (z, froxel) in out.chunks_mut(stride).enumerate() {
+                    for k in 0..channels {
+                        froxel[k] = l[z * channels + k] as f32;
+                        froxel[channels + k] = t[z * channels + k] as f32;
                     }
-                });
+                }
             });
         Some(AerialVolume {
             config,

@@ -103,6 +103,22 @@ pub trait SkyView: Send + Sync {
         transmittance: &mut [f64],
     );
 
+    /// [`SkyView::sky_radiance_to_point`] without shadows for each of `points`, which lie
+    /// on one ray from the observer in increasing distance (an aerial-perspective froxel
+    /// column), into `radiance` and `transmittance` (`points.len()` × channels values,
+    /// point-major). By default one query per point; a method that marches (Hillaire 2020)
+    /// marches the ray once through all of them.
+    fn sky_radiance_along(&self, points: &[Vec3], radiance: &mut [f64], transmittance: &mut [f64]) {
+        let n = radiance.len() / points.len().max(1);
+        for (i, &point) in points.iter().enumerate() {
+            let (l, t) = (
+                &mut radiance[i * n..(i + 1) * n],
+                &mut transmittance[i * n..(i + 1) * n],
+            );
+            self.sky_radiance_to_point(point, Shadow::None, l, t);
+        }
+    }
+
     /// Transmittance (0–1) of the air between the observer and `point` (planet-centred, m).
     fn transmittance_to_point(&self, point: Vec3, out: &mut [f64]);
 

@@ -352,8 +352,14 @@ impl SkyView for Elek3dView<'_> {
             transmittance[..n].iter_mut().for_each(|v| *v = 1.0);
             return;
         };
+        // A point before the ray enters the atmosphere sees no air.
+        let d_total = (point - self.observer).length() - start.offset_m(self.observer);
+        if d_total <= 0.0 {
+            radiance[..n].iter_mut().for_each(|v| *v = 0.0);
+            transmittance[..n].iter_mut().for_each(|v| *v = 1.0);
+            return;
+        }
         let ray = self.geometry(&start, dir);
-        let d_total = (point - start.point).length();
         self.lookup
             .transmittance(ray.r, ray.mu, d_total, ray.ground, &mut transmittance[..n]);
         let t = &transmittance[..n];
@@ -398,7 +404,7 @@ impl SkyView for Elek3dView<'_> {
             return;
         };
         let ray = self.geometry(&start, dir);
-        let d = (point - start.point).length();
+        let d = ((point - self.observer).length() - start.offset_m(self.observer)).max(0.0);
         self.lookup.transmittance(ray.r, ray.mu, d, ray.ground, out);
     }
 

@@ -200,6 +200,33 @@ impl Marcher<'_> {
         transmittance: &mut [f64],
         scattered: &mut [f64],
     ) {
+        self.march_over(
+            ray,
+            (1..=steps).map(|i| step_end(i, steps, ray.length)),
+            phases,
+            lighting,
+            radiance,
+            transmittance,
+            scattered,
+            |_, _| {},
+        );
+    }
+
+    /// [`Marcher::march`] over the steps ending at `ends` (m from the ray's start,
+    /// increasing, up to `ray.length`; nothing when that is not positive), calling `at_end(i, radiance)` after step i
+    /// with the radiance so far (the aerial-perspective volume's slices along one ray).
+    #[allow(clippy::too_many_arguments)]
+    pub fn march_over(
+        &self,
+        ray: &MarchRay,
+        ends: impl Iterator<Item = f64>,
+        phases: &[f64],
+        lighting: &Lighting,
+        radiance: &mut [f64],
+        transmittance: &mut [f64],
+        scattered: &mut [f64],
+        mut at_end: impl FnMut(usize, &[f64]),
+    ) {
         scattered.iter_mut().for_each(|v| *v = 0.0);
         let n = radiance.len();
         let model = self.medium.model;
@@ -219,8 +246,7 @@ impl Marcher<'_> {
         let mut densities = vec![0.0; model.constituents.len()];
         with_channel_buffers(n, |[sigma_t, sigma_s, phased, t_sun, psi, by_degree]| {
             let mut t0 = 0.0;
-            for i in 1..=steps {
-                let t1 = step_end(i, steps, ray.length);
+            for (i, t1) in ends.enumerate() {
                 let dt = t1 - t0;
                 let t_mid = 0.5 * (t0 + t1);
                 let (r_t, mu_s_t) = ray.at(t_mid);
@@ -302,6 +328,7 @@ impl Marcher<'_> {
                     }
                     transmittance[k] *= step_t;
                 }
+                at_end(i, radiance);
                 t0 = t1;
             }
         });
