@@ -324,6 +324,29 @@ fn gpu_hillaire2020_render_matches_cpu() {
     assert!(d8 <= 1.0, "mean |Δ| of 8-bit values {d8}");
     let rel = exr_mean_rel_diff(&gpu_exr, &cpu_exr);
     assert!(rel <= 0.01, "mean relative luminance difference {rel}");
+    // The higher orders' fields are gathered on the device too.
+    let [(_, cpu_exr), (_, gpu_exr)] = render_both(
+        "hillaire2020-orders",
+        &[
+            "--method",
+            "hillaire2020",
+            "--hillaire-orders",
+            "4",
+            "--wavelengths",
+            "rgb",
+            "--width",
+            "48",
+            "--height",
+            "27",
+            "--sun-zenith-deg",
+            "70",
+        ],
+    );
+    let rel = exr_mean_rel_diff(&gpu_exr, &cpu_exr);
+    assert!(
+        rel <= 0.01,
+        "4 orders: mean relative luminance difference {rel}"
+    );
     // The terrain is the CPU's only so far: refused on `--backend gpu`.
     let png = tmp().join("hillaire-terrain.png");
     let o = run(&[

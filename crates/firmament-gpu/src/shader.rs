@@ -149,9 +149,10 @@ pub const HILLAIRE2020: [Module; 4] = [
 /// [`hillaire2020_transmittance_source`]), one file each.
 pub mod hillaire2020_passes {
     use super::Module;
-    /// multiple_scattering.wgsl (entry points `gather` and `main`)
+    /// multiple_scattering.wgsl (entry points `gather`, `main`, `gather_next`,
+    /// `project_next` and `tail`)
     pub const MULTIPLE_SCATTERING: Module = module!("hillaire2020/multiple_scattering.wgsl");
-    /// irradiance.wgsl
+    /// irradiance.wgsl (entry points `gather` and `main`)
     pub const IRRADIANCE: Module = module!("hillaire2020/irradiance.wgsl");
 }
 

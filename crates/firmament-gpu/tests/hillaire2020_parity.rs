@@ -2,16 +2,11 @@
 //! irradiance) of `firmament_gpu::GpuHillaire` against `Hillaire2020::compute`, texel by
 //! texel; one view's sky-view tables; whole frames of `GpuHillaireRenderer` against
 //! `firmament::render::render` with the Hillaire 2020 method (mean relative luminance ≤ 1 %,
-//! SPEC §7, as `render_parity.rs`); and the refusals.
+//! SPEC §7, as `render_parity.rs`); the same for the explicit higher orders
+//! (`multiple_scattering_orders` 3, 4 and 5: Hillaire's series or the geometric tail on the
+//! last order, the isotropic field and harmonics of degree 6); and the refusals.
 //!
-//! Table tolerances: the same f64 computation rounded to f32 at the end (CPU) against f32
-//! throughout (GPU). The largest sums are the multiple-scattering gather (64 rays of 20
-//! steps) and the irradiance (32 rays of 16 steps, each reading Ψ_ms): each step's
-//! exp/smoothstep/bilinear weights carry ~1e-7 relative, and the (r, μ) of a step ~1e-7 of
-//! planet-scale lengths, which moves a lookup near the horizon (where τ and the light's
-//! visible fraction change fastest) by up to ~1e-4; hence a median of 1e-3 and a largest of
-//! 1e-2, relative to each value (values below 1e-6 of the table's largest compared
-//! absolutely against that floor).
+//! Table tolerances: `common::tables`.
 
 mod common;
 
@@ -23,17 +18,17 @@ use firmament::render::{render, RenderSettings};
 use firmament::scene::{sun_direction, Light, Projection, Scene};
 use firmament::sky::bruneton4d::Table2;
 use firmament::sky::hillaire2020::params::sky_view_mu_cos_phi;
-use firmament::sky::hillaire2020::{Hillaire2020, HillaireConfig, MultipleScatteringModel};
+use firmament::sky::hillaire2020::{
+    Hillaire2020, HillaireConfig, MultipleScatteringModel, MAX_ORDERS,
+};
 use firmament::sky::{Shadow, SkyMethod};
 use firmament::spectrum::Wavelengths;
 use firmament_gpu::{GpuContext, GpuError, GpuHillaire, GpuHillaireRenderer, HillairePrecomputer};
 
+use common::tables::assert_tables;
 use common::{
     assert_parity, camera, measure_frames, read_rgba32_texture, serial, shadow_length_frame, Parity,
 };
-
-const TABLE_MEDIAN: f64 = 1e-3;
-const TABLE_MAX: f64 = 1e-2;
 
 struct Gpu {
     ctx: GpuContext,
@@ -84,55 +79,6 @@ fn earth_rgb() -> &'static Hillaire2020 {
         )
         .unwrap()
     })
-}
-
-/// The relative differences of `gpu` against `cpu` texel by texel and channel by channel:
-/// median and largest, printed with the worst texel. Values under 1e-6 of the table's
-/// largest are compared against that floor; with `channels` < the values per texel (Ψ_ms's
-/// harmonics, `channels` per coefficient), those under 1e-4 of their texel's degree-0
-/// coefficient against it (the coefficients a field symmetric about the zenith leaves
-/// at 0 come out as f32 cancellation, ~1e-7 of the field).
-fn compare_tables(name: &str, cpu: &Table2, gpu: &Table2, channels: usize) -> (f64, f64) {
-    assert_eq!(
-        (cpu.width, cpu.height, cpu.channels),
-        (gpu.width, gpu.height, gpu.channels),
-        "{name}: sizes"
-    );
-    let max = cpu.data.iter().fold(0.0f64, |m, v| m.max(v.abs() as f64));
-    let floor = (max * 1e-6).max(f64::MIN_POSITIVE);
-    let per_texel = cpu.channels;
-    let degree0 = |i: usize| cpu.data[i / per_texel * per_texel + i % channels].abs() as f64;
-    let mut rel: Vec<(f64, usize)> = (cpu.data.iter().zip(&gpu.data).enumerate())
-        .map(|(i, (&c, &g))| {
-            assert!(g.is_finite(), "{name}: non-finite GPU value at {i}");
-            let mut f = floor;
-            if channels < per_texel {
-                f = f.max(1e-4 * degree0(i));
-            }
-            ((g as f64 - c as f64).abs() / (c.abs() as f64).max(f), i)
-        })
-        .collect();
-    rel.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let median = rel[rel.len() / 2].0;
-    let (worst, at) = rel[rel.len() - 1];
-    let texel = at / per_texel;
-    eprintln!(
-        "{name}: {}×{}×{per_texel}: median rel {median:.2e}, max rel {worst:.2e} at texel ({}, {}) value {} cpu {:e} gpu {:e}",
-        cpu.width,
-        cpu.height,
-        texel % cpu.width,
-        texel / cpu.width,
-        at % per_texel,
-        cpu.data[at],
-        gpu.data[at],
-    );
-    (median, worst)
-}
-
-fn assert_tables(name: &str, cpu: &Table2, gpu: &Table2, channels: usize) {
-    let (median, max) = compare_tables(name, cpu, gpu, channels);
-    assert!(median <= TABLE_MEDIAN, "{name}: median {median:e}");
-    assert!(max <= TABLE_MAX, "{name}: max {max:e}");
 }
 
 /// The GPU's tables of `model` against the CPU's, and f_ms.
@@ -194,6 +140,77 @@ fn tables_match_the_cpu_texel_by_texel() {
     };
     let cpu = Hillaire2020::compute(model("hazy", Wavelengths::rgb()), &config).unwrap();
     check_tables("hazy rgb, harmonics 2", gpu, &cpu);
+}
+
+/// Small tables with `orders` explicit scattering orders of `field` (the CLI's gather rule
+/// for the harmonics, (24, 12), which the higher orders coarsen to (12, 6) and degree 6 to
+/// 4; the isotropic field's (8, 8) to (8, 6)).
+fn orders_config(field: MultipleScatteringModel, orders: usize) -> HillaireConfig {
+    HillaireConfig {
+        multiple_scattering_model: field,
+        multiple_scattering_orders: orders,
+        multiple_scattering: (16, 16),
+        multiple_scattering_directions: match field {
+            MultipleScatteringModel::Isotropic => (8, 8),
+            MultipleScatteringModel::Harmonics(_) => (24, 12),
+        },
+        irradiance: (16, 8),
+        ..HillaireConfig::default()
+    }
+}
+
+/// The earth preset in RGB with 4 orders of the degree-6 field on the CPU, computed once
+/// (the tables' and the frame's test).
+fn earth_four_orders() -> &'static Hillaire2020 {
+    static SKY: OnceLock<Hillaire2020> = OnceLock::new();
+    SKY.get_or_init(|| {
+        let config = orders_config(MultipleScatteringModel::Harmonics(6), 4);
+        Hillaire2020::compute(model("earth", Wavelengths::rgb()), &config).unwrap()
+    })
+}
+
+#[test]
+fn higher_orders_match_the_cpu_texel_by_texel() {
+    let Some(gpu) = gpu("higher_orders_match_the_cpu_texel_by_texel") else {
+        return;
+    };
+    let _guard = serial();
+    // 2 orders of degree 6: the irradiance pass's harmonics at every step (llvmpipe's loop
+    // limit, irradiance.wgsl); 3 orders: Hillaire's series on order 2; 4: the tail factors
+    // of orders 2 and 3; 5 (the harmonics only): the orders' buffers the other way round.
+    for (field, orders) in [
+        (MultipleScatteringModel::Harmonics(6), 2),
+        (MultipleScatteringModel::Isotropic, 3),
+        (MultipleScatteringModel::Isotropic, 4),
+        (MultipleScatteringModel::Harmonics(6), 3),
+        (MultipleScatteringModel::Harmonics(6), 5),
+    ] {
+        let config = orders_config(field, orders);
+        let cpu = Hillaire2020::compute(model("earth", Wavelengths::rgb()), &config).unwrap();
+        check_tables(&format!("earth rgb, {field:?}, {orders} orders"), gpu, &cpu);
+    }
+    check_tables(
+        "earth rgb, Harmonics(6), 4 orders",
+        gpu,
+        earth_four_orders(),
+    );
+}
+
+#[test]
+fn ground_level_frame_with_four_orders_of_harmonics() {
+    let name = "hillaire2020 ground view, 4 orders of harmonics 6";
+    let Some(gpu) = gpu(name) else { return };
+    let _guard = serial();
+    let cpu = earth_four_orders();
+    let cam = camera(Projection::Perspective, 2.0, 135.0, 20.0, 90.0);
+    let settings = RenderSettings {
+        camera: &cam,
+        width: 64,
+        height: 48,
+        white_balance: false,
+    };
+    let scene = Scene::clear_sky(cpu, sun_direction(80.0, 135.0), true);
+    assert_parity(name, &compare_scene(name, gpu, cpu, &scene, &settings));
 }
 
 /// The CPU view's sky-view table, texel by texel: the view's radiance at each texel's
@@ -550,6 +567,27 @@ fn atmospheres_past_the_series_limit_are_refused_as_on_the_cpu() {
     two.constituents.push(extra);
     let error = GpuHillaire::compute(&gpu.ctx, &gpu.precomputer, &two, &config).unwrap_err();
     assert!(error.to_string().contains("phase"), "{error}");
+
+    // Explicit orders outside 2..=MAX_ORDERS: the CPU's message.
+    let earth = model("earth", Wavelengths::rgb());
+    for orders in [0, 1, MAX_ORDERS + 1] {
+        let config = HillaireConfig {
+            multiple_scattering_orders: orders,
+            ..HillaireConfig::default()
+        };
+        let Err(cpu) = Hillaire2020::compute(earth.clone(), &config) else {
+            panic!("CPU accepted {orders} orders");
+        };
+        let Err(error) = GpuHillaire::compute(&gpu.ctx, &gpu.precomputer, &earth, &config) else {
+            panic!("GPU accepted {orders} orders");
+        };
+        assert!(matches!(error, GpuError::Invalid(_)), "{error:?}");
+        assert_eq!(error.to_string(), cpu.to_string());
+        assert!(
+            cpu.to_string().contains("multiple_scattering_orders"),
+            "{cpu}"
+        );
+    }
 }
 
 #[test]

@@ -263,9 +263,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         if args.backend == BackendChoice::Gpu && terrain_wanted {
             anyhow::bail!("`--method hillaire2020` draws terrain on the CPU only so far: use `--backend cpu` or `auto`, or `--no-terrain`");
         }
-        if args.backend == BackendChoice::Gpu && args.hillaire.hillaire_orders != 2 {
-            anyhow::bail!("`--hillaire-orders` gathers the higher orders on the CPU only so far: use `--backend cpu` or `auto`");
-        }
         if args.tables.is_some() {
             anyhow::bail!("`--tables` holds 4D tables: `--method hillaire2020` builds its own (in milliseconds)");
         }
@@ -275,11 +272,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             if args.backend == BackendChoice::Auto
                 && ((matches!(args.method, Method::Hillaire2020 | Method::Elek3d)
                     && terrain_wanted)
-                    || args.aerial_volume
-                    || args.hillaire.hillaire_orders != 2) =>
+                    || args.aerial_volume) =>
         {
             if !args.quiet {
-                eprintln!("note: the terrain of hillaire2020 and elek3d, --hillaire-orders and --aerial-volume render on the CPU only so far: using the CPU");
+                eprintln!("note: the terrain of hillaire2020 and elek3d and --aerial-volume render on the CPU only so far: using the CPU");
             }
             Backend::Cpu
         }

@@ -5,7 +5,9 @@
 
 struct Hillaire {
     // Ψ_ms table: (μ_s, altitude) texels, the field's spherical-harmonic degree (0: the
-    // isotropic model) and its coefficients per texel and channel group.
+    // isotropic model) and its coefficients per texel and channel group: the field the
+    // march reads at binding 20 (the table's; in the copies the gathers of the higher orders
+    // bind, the previous order's).
     ms_mu_s: u32,
     ms_r: u32,
     ms_degree: u32,
@@ -27,11 +29,21 @@ struct Hillaire {
     irradiance_directions: u32,
     irradiance_steps: u32,
     // Offsets (vec4) in hillaire_data: the gather rules' (node, weight) on [−1, 1] (the
-    // rule below the horizon, then the one above), the irradiance directions (xyz), the
-    // groups' phase moments k_ℓ (group g's ℓ at moments_offset + g·(ms_degree + 1) + ℓ, in x).
+    // rule below the horizon, then the one above; the higher orders' copies point at their
+    // coarser rule), the irradiance directions (xyz), the groups' phase moments k_ℓ (group
+    // g's ℓ at moments_offset + g·moments_stride + ℓ, in x; the stride is the table's
+    // degree + 1).
     gather_offset: u32,
     directions_offset: u32,
     moments_offset: u32,
+    moments_stride: u32,
+    // The explicit orders (multiple_scattering::compute's loop): the table's coefficients
+    // (the sum of the orders), those of the field a pass writes to its order's buffer (the
+    // first order's: the table's; a higher order's: degree ≤ HIGHER_ORDERS_DEGREE), and
+    // HillaireConfig::multiple_scattering_orders.
+    table_coefficients: u32,
+    order_coefficients: u32,
+    orders: u32,
     pad0: u32,
 }
 

@@ -9,7 +9,8 @@
 
 // Ψ_ms per unit light irradiance, as the multiple-scattering pass leaves it: (μ_s, altitude)
 // texel i, coefficient c (harmonics.wgsl), channel group k at (i·ms_coefficients + c)·groups
-// + k (MultipleScattering::table, coefficient-major as on the CPU).
+// + k (MultipleScattering::table, coefficient-major as on the CPU). In the gathers of the
+// higher orders (multiple_scattering.wgsl), the previous order's field.
 @group(0) @binding(20) var<storage, read> multiple_scattering_table: array<vec4<f32>>;
 
 // The air at an altitude (Medium::coefficients): the extinction σ_t and the scattering σ_s of
@@ -76,6 +77,12 @@ fn lit_all() -> Lit {
     return Lit(-3.4e38, 3.4e38);
 }
 
+// Lit::Intervals(&[]): nowhere (the higher orders' gathers, which have no single
+// scattering).
+fn lit_none() -> Lit {
+    return Lit(-1.0, -1.0);
+}
+
 // The fraction of [a, b] that is lit (Lit::fraction).
 fn lit_fraction(lit: Lit, a: f32, b: f32) -> f32 {
     if (b <= a) {
@@ -130,7 +137,7 @@ fn transmittance_to_light_at(r_km: f32, rho_km: f32, mu_s: f32, angular_radius: 
 
 // Group g's phase moment k_ℓ (MultipleScattering::moments; 1 for the isotropic model).
 fn phase_moment(g: u32, l: u32) -> f32 {
-    return hillaire_data[hillaire.moments_offset + g * (hillaire.ms_degree + 1u) + l].x;
+    return hillaire_data[hillaire.moments_offset + g * hillaire.moments_stride + l].x;
 }
 
 // σ_s·Ψ_ms at a step (Marcher::march's multiple-scattering source): the field bilinear at

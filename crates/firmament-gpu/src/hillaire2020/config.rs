@@ -12,6 +12,9 @@ use firmament::math::quadrature::GaussLegendreRule;
 use firmament::math::Vec3;
 use firmament::sky::bruneton4d::TableSizes;
 use firmament::sky::hillaire2020::harmonics::{coefficient_count, phase_moments};
+use firmament::sky::hillaire2020::multiple_scattering::{
+    HIGHER_ORDERS_DEGREE, HIGHER_ORDERS_DIRECTIONS,
+};
 use firmament::sky::hillaire2020::{HillaireConfig, MultipleScatteringModel};
 
 use crate::bruneton4d::atmosphere::{self, Packed};
@@ -22,8 +25,24 @@ use crate::GpuError;
 pub struct PackedConfig {
     /// The uniform's words.
     pub uniform: Vec<u32>,
+    /// The uniform of the gathers of the higher orders
+    /// (`multiple_scattering::compute`'s loop): order 2's (through the first order's
+    /// field), then that of orders ≥ 3 (through a higher order's field, of degree ≤
+    /// [`HIGHER_ORDERS_DEGREE`]), each with the coarser gather rule
+    /// ([`HIGHER_ORDERS_DIRECTIONS`]) and the field it writes of degree ≤
+    /// [`HIGHER_ORDERS_DEGREE`].
+    pub higher_orders: [Vec<u32>; 2],
     /// The data's floats.
     pub data: Vec<f32>,
+}
+
+/// The gather rule of the higher orders for `directions`, the first order's (the coarser
+/// of the two, as `multiple_scattering::compute`'s `next_grid`).
+pub fn higher_orders_directions(directions: (usize, usize)) -> (usize, usize) {
+    (
+        directions.0.min(HIGHER_ORDERS_DIRECTIONS.0),
+        directions.1.min(HIGHER_ORDERS_DIRECTIONS.1),
+    )
 }
 
 /// The gather rules' node counts below and above the horizon for `n_mu` nodes in μ
@@ -75,16 +94,24 @@ pub fn check_phases(model: &Model) -> Result<(), GpuError> {
 /// Pack `config` for `model` (validated by the caller).
 pub fn pack(model: &Model, config: &HillaireConfig) -> PackedConfig {
     let degree = config.multiple_scattering_model.degree();
+    let next_degree = degree.min(HIGHER_ORDERS_DEGREE);
     let (n_mu, n_phi) = config.multiple_scattering_directions;
-    let (below, above) = gather_split(n_mu);
+    let (next_mu, next_phi) = higher_orders_directions(config.multiple_scattering_directions);
     let mut data: Vec<f32> = Vec::new();
-    // The gather rules on [−1, 1]: (node, weight), below the horizon then above.
-    let gather_offset = data.len() / 4;
-    for rule in [GaussLegendreRule::new(below), GaussLegendreRule::new(above)] {
-        for (x, w) in rule.nodes.iter().zip(&rule.weights) {
-            data.extend_from_slice(&[*x as f32, *w as f32, 0.0, 0.0]);
+    // The gather rules on [−1, 1]: (node, weight), below the horizon then above; the first
+    // order's, then the higher orders'.
+    let mut gather_rule = |n_mu: usize| {
+        let offset = data.len() / 4;
+        let (below, above) = gather_split(n_mu);
+        for rule in [GaussLegendreRule::new(below), GaussLegendreRule::new(above)] {
+            for (x, w) in rule.nodes.iter().zip(&rule.weights) {
+                data.extend_from_slice(&[*x as f32, *w as f32, 0.0, 0.0]);
+            }
         }
-    }
+        offset
+    };
+    let gather_offset = gather_rule(n_mu);
+    let next_gather_offset = gather_rule(next_mu);
     // The irradiance pass's directions over the upper hemisphere.
     let directions_offset = data.len() / 4;
     for d in band_directions(Vec3::Z, 0.0, 1.0, config.irradiance_directions) {
@@ -105,29 +132,50 @@ pub fn pack(model: &Model, config: &HillaireConfig) -> PackedConfig {
         }
     }
     let u = |x: usize| x as u32;
-    let uniform = vec![
-        u(config.multiple_scattering.0),
-        u(config.multiple_scattering.1),
-        u(degree),
-        u(coefficient_count(degree)),
-        u(below),
-        u(above),
-        u(n_phi),
-        u(config.multiple_scattering_steps),
-        u(config.sky_view.0),
-        u(config.sky_view.1),
-        u(config.sky_view_steps),
-        u(config.march_steps),
-        u(config.irradiance.0),
-        u(config.irradiance.1),
-        u(config.irradiance_directions),
-        u(config.irradiance_steps),
-        u(gather_offset),
-        u(directions_offset),
-        u(moments_offset),
-        0,
-    ];
-    PackedConfig { uniform, data }
+    // The uniform of a pass whose march reads a field of `field_degree`, gathers on
+    // (`n_mu`, `n_phi`) nodes whose rule is at `gather_offset` and writes a field of
+    // `order_degree`.
+    let uniform = |field_degree: usize,
+                   (n_mu, n_phi): (usize, usize),
+                   gather_offset: usize,
+                   order_degree: usize| {
+        let (below, above) = gather_split(n_mu);
+        vec![
+            u(config.multiple_scattering.0),
+            u(config.multiple_scattering.1),
+            u(field_degree),
+            u(coefficient_count(field_degree)),
+            u(below),
+            u(above),
+            u(n_phi),
+            u(config.multiple_scattering_steps),
+            u(config.sky_view.0),
+            u(config.sky_view.1),
+            u(config.sky_view_steps),
+            u(config.march_steps),
+            u(config.irradiance.0),
+            u(config.irradiance.1),
+            u(config.irradiance_directions),
+            u(config.irradiance_steps),
+            u(gather_offset),
+            u(directions_offset),
+            u(moments_offset),
+            u(degree + 1),
+            u(coefficient_count(degree)),
+            u(coefficient_count(order_degree)),
+            u(config.multiple_scattering_orders),
+            0,
+        ]
+    };
+    let next = (next_mu, next_phi);
+    PackedConfig {
+        uniform: uniform(degree, (n_mu, n_phi), gather_offset, degree),
+        higher_orders: [
+            uniform(degree, next, next_gather_offset, next_degree),
+            uniform(next_degree, next, next_gather_offset, next_degree),
+        ],
+        data,
+    }
 }
 
 #[cfg(test)]
@@ -144,20 +192,53 @@ mod tests {
             ..HillaireConfig::default()
         };
         let p = pack(&model, &config);
-        // 20 fields of the WGSL `Hillaire` struct (a multiple of 4 words).
-        assert_eq!(p.uniform.len(), 20);
+        // 24 fields of the WGSL `Hillaire` struct (a multiple of 4 words).
+        assert_eq!(p.uniform.len(), 24);
         assert_eq!(p.uniform[3], 6);
         let (below, above) = gather_split(config.multiple_scattering_directions.0);
-        assert_eq!(p.uniform[17] as usize, below + above);
-        assert_eq!(
-            p.uniform[18] as usize,
-            below + above + config.irradiance_directions
-        );
+        let next = higher_orders_directions(config.multiple_scattering_directions);
+        let (next_below, next_above) = gather_split(next.0);
+        let rules = below + above + next_below + next_above;
+        assert_eq!(p.uniform[17] as usize, rules);
+        assert_eq!(p.uniform[18] as usize, rules + config.irradiance_directions);
         assert_eq!(p.data.len() / 4, p.uniform[18] as usize + 2 * 3);
-        // Rayleigh's k₀ = 1 and k₂ = 1/10 (depolarisation aside).
+        // Rayleigh's k₀ = 1 and k₂ = 1/10 (depolarisation aside), stride degree + 1.
         let m = p.uniform[18] as usize * 4;
+        assert_eq!(p.uniform[19], 3);
         assert!((p.data[m] - 1.0).abs() < 1e-5);
         assert!((p.data[m + 8] - 0.1).abs() < 0.01);
+        // The higher orders' copies: the coarser rule after the first, the same moments.
+        for h in &p.higher_orders {
+            assert_eq!(h.len(), 24);
+            assert_eq!(h[16] as usize, below + above);
+            assert_eq!((h[4] + h[5]) as usize, next.0);
+            assert_eq!(h[6] as usize, next.1);
+            assert_eq!(&h[17..21], &p.uniform[17..21]);
+        }
+    }
+
+    #[test]
+    fn the_higher_orders_gather_on_the_coarser_rule_and_degree() {
+        let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
+        let config = HillaireConfig {
+            multiple_scattering_model: MultipleScatteringModel::Harmonics(6),
+            multiple_scattering_directions: (24, 12),
+            multiple_scattering_orders: 5,
+            ..HillaireConfig::default()
+        };
+        let p = pack(&model, &config);
+        let count = |d: usize| coefficient_count(d) as u32;
+        // The first order: degree 6 read and written, into a table of degree 6.
+        assert_eq!(
+            (p.uniform[2], p.uniform[3], p.uniform[20], p.uniform[21]),
+            (6, count(6), count(6), count(6))
+        );
+        // Order 2 reads the degree-6 field and writes degree 4; orders ≥ 3 read degree 4.
+        let [second, higher] = &p.higher_orders;
+        assert_eq!((second[2], second[21]), (6, count(HIGHER_ORDERS_DEGREE)));
+        assert_eq!((higher[2], higher[3]), (4, count(HIGHER_ORDERS_DEGREE)));
+        assert_eq!((higher[6], higher[20], higher[22]), (6, count(6), 5));
+        assert_eq!(higher_orders_directions((24, 12)), HIGHER_ORDERS_DIRECTIONS);
     }
 
     #[test]

@@ -19,6 +19,7 @@
 
 pub mod config;
 pub mod precompute;
+mod readback;
 pub mod render;
 pub mod sky;
 pub mod timing;

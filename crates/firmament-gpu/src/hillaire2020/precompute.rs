@@ -4,9 +4,14 @@
 //! `shaders/bruneton4d/precompute/transmittance.wgsl`, compiled with Hillaire's segment
 //! count), the multiple-scattering field Ψ_ms with f_ms
 //! (`shaders/hillaire2020/multiple_scattering.wgsl`: a gather of every ray, then the
-//! projection per coefficient) and the sky irradiance (`irradiance.wgsl`). All passes go
-//! into one command buffer; each is one compute pass, timed by timestamp queries where the
-//! device has them ([`super::timing`]).
+//! projection per coefficient; with `multiple_scattering_orders` > 2 the same for each
+//! higher order through the previous one's field, then the tail of the orders beyond, all
+//! on the device: the tail's table-wide means are a one-workgroup reduction, nothing is read
+//! back between orders) and the sky irradiance (`irradiance.wgsl`: a gather of every
+//! (texel, direction) ray, then the sum per texel). All passes go into one
+//! command buffer; each stage of [`STAGES`] is one compute pass (every order inside
+//! "multiple scattering"), timed by timestamp queries where the device has them
+//! ([`super::timing`]).
 //!
 //! Tables live in storage buffers of `vec4<f32>` in the CPU's texel order with the channels
 //! in groups of four (channel group k of texel i at i·groups + k; Ψ_ms coefficient c at
@@ -17,15 +22,13 @@ use std::sync::{Arc, Mutex};
 
 use firmament::atmosphere::Model;
 use firmament::sky::bruneton4d::Table2;
-use firmament::sky::hillaire2020::harmonics::{coefficient_count, phase_moments};
-use firmament::sky::hillaire2020::params::altitude_mu_s_of_texel;
-use firmament::sky::hillaire2020::{
-    Hillaire2020, HillaireConfig, MultipleScattering, MultipleScatteringModel, F_MS_LIMIT,
-};
+use firmament::sky::hillaire2020::harmonics::coefficient_count;
+use firmament::sky::hillaire2020::multiple_scattering::HIGHER_ORDERS_DEGREE;
+use firmament::sky::hillaire2020::{HillaireConfig, F_MS_LIMIT};
 
-use super::config::{self, gather_split};
+use super::config::{self, gather_split, higher_orders_directions};
 use crate::bruneton4d::atmosphere::{groups, GROUP};
-use crate::device::{check_buffers, f32s, read_back, scoped, staging_buffer};
+use crate::device::{check_buffers, scoped};
 use crate::passes::{dispatch, init, storage, workgroups, Pass, Slot};
 use crate::shader::{
     hillaire2020_pass_source, hillaire2020_passes, hillaire2020_transmittance_source,
@@ -80,16 +83,26 @@ pub struct HillairePrecomputer {
     transmittance: Mutex<Vec<(usize, Arc<Pass>)>>,
     multiple_scattering: Pass,
     gather: wgpu::ComputePipeline,
+    gather_next: wgpu::ComputePipeline,
+    project_next: wgpu::ComputePipeline,
+    tail: wgpu::ComputePipeline,
     irradiance: Pass,
+    irradiance_gather: wgpu::ComputePipeline,
 }
 
 /// One build's buffers and bind groups, recorded pass by pass.
 pub(crate) struct Build {
     pub(crate) tables: GpuHillaireTables,
     transmittance: Arc<Pass>,
+    /// The transmittance's, the first order's and the irradiance's.
     bind_groups: [wgpu::BindGroup; 3],
-    /// Invocations of the transmittance, gather, projection and irradiance dispatches.
-    invocations: [usize; 4],
+    /// Orders 2 … n − 1 of the multiple-scattering field, each through the previous one's.
+    higher_orders: Vec<wgpu::BindGroup>,
+    /// The tail (the last order's field and the one before).
+    tail: wgpu::BindGroup,
+    /// Invocations of the transmittance, gather, projection and irradiance dispatches, then
+    /// of a higher order's gather and projection, then of the irradiance's gather.
+    invocations: [usize; 7],
     groups: usize,
     max_dim: u32,
 }
@@ -115,18 +128,31 @@ impl HillairePrecomputer {
                     (20, Read),
                     (22, Write),
                     (23, Write),
+                    (24, Write),
+                ],
+            );
+            let irradiance = Pass::new(
+                d,
+                "hillaire2020 irradiance",
+                hillaire2020_pass_source(hillaire2020_passes::IRRADIANCE),
+                &[
+                    (3, Read),
+                    (7, Write),
+                    (8, Uniform),
+                    (9, Read),
+                    (20, Read),
+                    (22, Write),
                 ],
             );
             Ok(HillairePrecomputer {
                 transmittance: Mutex::new(Vec::new()),
+                irradiance_gather: irradiance.entry_point(d, "gather"),
                 gather: multiple_scattering.entry_point(d, "gather"),
+                gather_next: multiple_scattering.entry_point(d, "gather_next"),
+                project_next: multiple_scattering.entry_point(d, "project_next"),
+                tail: multiple_scattering.entry_point(d, "tail"),
                 multiple_scattering,
-                irradiance: Pass::new(
-                    d,
-                    "hillaire2020 irradiance",
-                    hillaire2020_pass_source(hillaire2020_passes::IRRADIANCE),
-                    &[(3, Read), (7, Write), (8, Uniform), (9, Read), (20, Read)],
-                ),
+                irradiance,
             })
         })?;
         precomputer.transmittance_pass(ctx, HillaireConfig::default().transmittance_segments)?;
@@ -201,14 +227,6 @@ impl HillairePrecomputer {
         config: &HillaireConfig,
     ) -> Result<Build, GpuError> {
         config.validate()?;
-        if config.multiple_scattering_orders != 2 {
-            return Err(firmament::Error::invalid(
-                "hillaire.multiple_scattering_orders",
-                config.multiple_scattering_orders,
-                "2 on the GPU (Hillaire's series; the higher orders' fields are gathered on the CPU only so far)",
-            )
-            .into());
-        }
         let n = model.channels();
         firmament::spectrum::check_channels(n, "Hillaire 2020")?;
         config::check_phases(model)?;
@@ -217,10 +235,25 @@ impl HillairePrecomputer {
         let t_texels = config.transmittance.0 * config.transmittance.1;
         let ms_texels = config.multiple_scattering.0 * config.multiple_scattering.1;
         let e_texels = config.irradiance.0 * config.irradiance.1;
-        let coefficients = coefficient_count(config.multiple_scattering_model.degree());
+        let e_rays = e_texels * config.irradiance_directions;
+        let degree = config.multiple_scattering_model.degree();
+        let coefficients = coefficient_count(degree);
+        let next_coefficients = coefficient_count(degree.min(HIGHER_ORDERS_DEGREE));
         let (below, above) = gather_split(config.multiple_scattering_directions.0);
         let directions = (below + above) * config.multiple_scattering_directions.1;
+        let next = higher_orders_directions(config.multiple_scattering_directions);
+        let next_directions = {
+            let (below, above) = gather_split(next.0);
+            (below + above) * next.1
+        };
+        let orders = config.multiple_scattering_orders;
         let bytes = |texels: usize| (texels * n_groups) as u64 * vec4;
+        // An order's field and, after it, the bottom row's upward irradiance
+        // (multiple_scattering.wgsl): the first order's, then the higher orders'.
+        let order_bytes = [
+            bytes(ms_texels * coefficients + config.multiple_scattering.0),
+            bytes(ms_texels * next_coefficients + config.multiple_scattering.0),
+        ];
         check_buffers(
             ctx,
             &[
@@ -230,14 +263,16 @@ impl HillairePrecomputer {
                 ),
                 ("transmittance table", bytes(t_texels)),
                 ("multiple-scattering table", bytes(ms_texels * coefficients)),
+                ("multiple-scattering order", order_bytes[0]),
                 ("irradiance table", bytes(e_texels)),
+                ("irradiance rays", bytes(e_rays)),
             ],
         )?;
         let max_dim = ctx.limits().max_compute_workgroups_per_dimension;
-        let largest = ms_texels * directions;
+        let largest = (ms_texels * directions).max(e_rays);
         if workgroups(largest, max_dim).1 > max_dim {
             return Err(GpuError::Limit {
-                what: "the multiple-scattering gather".into(),
+                what: "the multiple-scattering or irradiance gather".into(),
                 needed: format!("{largest} invocations"),
                 limit: format!("{max_dim}² workgroups of {}", crate::passes::WORKGROUP),
                 limit_name: "max_compute_workgroups_per_dimension",
@@ -294,21 +329,60 @@ impl HillairePrecomputer {
                 bytes(2 * ms_texels * directions),
             );
             let no_field = storage(device, "no multiple scattering", 16);
-            let bind_groups = [
-                transmittance.bind(device, common, &[&t.optical_depth]),
+            let irradiance_rays = storage(device, "irradiance rays", bytes(e_rays));
+            // Order j's field: the first order's buffer for odd j, the higher orders' for even
+            // j (each order reads the other one).
+            let fields = [
+                storage(device, "multiple-scattering order", order_bytes[0]),
+                storage(
+                    device,
+                    "multiple-scattering order",
+                    if orders > 2 { order_bytes[1] } else { 16 },
+                ),
+            ];
+            let field = |order: usize| match order {
+                0 => &no_field,
+                j => &fields[1 - j % 2],
+            };
+            let uniforms = hillaire
+                .higher_orders
+                .iter()
+                .map(|words| {
+                    init(
+                        device,
+                        "hillaire2020 higher orders",
+                        bytemuck::cast_slice(words),
+                        uniform,
+                    )
+                })
+                .collect::<Vec<_>>();
+            // The uniform of the pass that gathers order j (and of the tail after it).
+            let uniform_of = |order: usize| match order {
+                1 => &t.config,
+                2 => &uniforms[0],
+                _ => &uniforms[1],
+            };
+            let ms_bind = |order: usize, previous: &wgpu::Buffer| {
                 self.multiple_scattering.bind(
                     device,
                     common,
                     &[
                         &t.optical_depth,
                         &t.multiple_scattering,
-                        &t.config,
+                        uniform_of(order),
                         &t.config_data,
-                        &no_field,
+                        previous,
                         &gathered,
                         &t.f_ms,
+                        field(order),
                     ],
-                ),
+                )
+            };
+            let higher_orders = (2..orders).map(|j| ms_bind(j, field(j - 1))).collect();
+            let tail = ms_bind(orders - 1, field(orders - 2));
+            let bind_groups = [
+                transmittance.bind(device, common, &[&t.optical_depth]),
+                ms_bind(1, &no_field),
                 self.irradiance.bind(
                     device,
                     common,
@@ -318,6 +392,7 @@ impl HillairePrecomputer {
                         &t.config,
                         &t.config_data,
                         &t.multiple_scattering,
+                        &irradiance_rays,
                     ],
                 ),
             ];
@@ -325,11 +400,16 @@ impl HillairePrecomputer {
                 tables,
                 transmittance,
                 bind_groups,
+                higher_orders,
+                tail,
                 invocations: [
                     t_texels,
                     ms_texels * directions,
                     ms_texels * coefficients,
                     e_texels,
+                    ms_texels * next_directions,
+                    ms_texels * next_coefficients,
+                    e_rays,
                 ],
                 groups: n_groups,
                 max_dim,
@@ -366,27 +446,41 @@ impl HillairePrecomputer {
                 max_dim,
             ),
             1 => {
-                let (x, y) = workgroups(inv[1], max_dim);
-                cpass.set_pipeline(&self.gather);
-                cpass.set_bind_group(0, &build.bind_groups[1], &[]);
+                let mut run = |pipeline: &wgpu::ComputePipeline, bind_group, invocations| {
+                    let (x, y) = workgroups(invocations, max_dim);
+                    cpass.set_pipeline(pipeline);
+                    cpass.set_bind_group(0, bind_group, &[]);
+                    cpass.dispatch_workgroups(x, y, g as u32);
+                };
+                run(&self.gather, &build.bind_groups[1], inv[1]);
+                run(
+                    &self.multiple_scattering.pipeline,
+                    &build.bind_groups[1],
+                    inv[2],
+                );
+                for bind_group in &build.higher_orders {
+                    run(&self.gather_next, bind_group, inv[4]);
+                    run(&self.project_next, bind_group, inv[5]);
+                }
+                // The tail: one workgroup per channel group.
+                cpass.set_pipeline(&self.tail);
+                cpass.set_bind_group(0, &build.tail, &[]);
+                cpass.dispatch_workgroups(1, 1, g as u32);
+            }
+            _ => {
+                let (x, y) = workgroups(inv[6], max_dim);
+                cpass.set_pipeline(&self.irradiance_gather);
+                cpass.set_bind_group(0, &build.bind_groups[2], &[]);
                 cpass.dispatch_workgroups(x, y, g as u32);
                 dispatch(
                     &mut cpass,
-                    &self.multiple_scattering,
-                    &build.bind_groups[1],
-                    inv[2],
+                    &self.irradiance,
+                    &build.bind_groups[2],
+                    inv[3],
                     g,
                     max_dim,
                 );
             }
-            _ => dispatch(
-                &mut cpass,
-                &self.irradiance,
-                &build.bind_groups[2],
-                inv[3],
-                g,
-                max_dim,
-            ),
         }
     }
 }
@@ -412,137 +506,4 @@ pub(crate) fn check_f_ms(
         ),
     )
     .into())
-}
-
-/// `values` (`entries` entries of `groups` vec4 each) without the padding lanes: `channels`
-/// values per entry.
-fn unpad(values: &[f32], entries: usize, groups: usize, channels: usize) -> Vec<f32> {
-    let mut out = Vec::with_capacity(entries * channels);
-    for e in 0..entries {
-        out.extend_from_slice(&values[e * groups * GROUP..e * groups * GROUP + channels]);
-    }
-    out
-}
-
-impl GpuHillaireTables {
-    /// The largest f_ms and where (altitude m, μ_s, channel), from the f_ms the pass wrote
-    /// (waits for the build).
-    pub fn max_f_ms(
-        &self,
-        ctx: &GpuContext,
-        model: &Model,
-        config: &HillaireConfig,
-    ) -> Result<(f64, (f64, f64, usize)), GpuError> {
-        let raw = self.read(ctx, &[&self.f_ms])?;
-        Ok(max_f_ms_of(&raw[0], model, config))
-    }
-
-    /// Copy `sources` to the host (waits for the device).
-    fn read(&self, ctx: &GpuContext, sources: &[&wgpu::Buffer]) -> Result<Vec<Vec<f32>>, GpuError> {
-        let device = ctx.device();
-        let staging = scoped(ctx, "Hillaire 2020 tables", || {
-            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("firmament hillaire2020 readback"),
-            });
-            let staging: Vec<wgpu::Buffer> = sources
-                .iter()
-                .map(|src| {
-                    let b = staging_buffer(device, "readback", src.size());
-                    encoder.copy_buffer_to_buffer(src, 0, &b, 0, src.size());
-                    b
-                })
-                .collect();
-            ctx.queue().submit([encoder.finish()]);
-            Ok(staging)
-        })?;
-        let during = "reading the Hillaire 2020 tables back";
-        let bytes = scoped(ctx, during, || {
-            read_back(ctx, &staging.iter().collect::<Vec<_>>(), during)
-        })?;
-        Ok(bytes.iter().map(|b| f32s(b)).collect())
-    }
-
-    /// Read the tables back into the CPU's layout (waits for the build). `model` and
-    /// `config` are the ones they were built with.
-    pub fn read_back(
-        &self,
-        ctx: &GpuContext,
-        model: &Model,
-        config: &HillaireConfig,
-    ) -> Result<HillaireTables, GpuError> {
-        let n = model.channels();
-        let g = groups(n);
-        let raw = self.read(
-            ctx,
-            &[
-                &self.optical_depth,
-                &self.multiple_scattering,
-                &self.irradiance,
-                &self.f_ms,
-            ],
-        )?;
-        let coefficients = coefficient_count(config.multiple_scattering_model.degree());
-        let table = |(w, h): (usize, usize), per_texel: usize, values: &[f32]| Table2 {
-            width: w,
-            height: h,
-            channels: per_texel * n,
-            data: unpad(values, w * h * per_texel, g, n),
-        };
-        let (max_f_ms, max_at) = max_f_ms_of(&raw[3], model, config);
-        Ok(HillaireTables {
-            optical_depth: table(config.transmittance, 1, &raw[0]),
-            multiple_scattering: table(config.multiple_scattering, coefficients, &raw[1]),
-            irradiance: table(config.irradiance, 1, &raw[2]),
-            max_f_ms,
-            max_at,
-        })
-    }
-}
-
-impl HillaireTables {
-    /// The CPU method over these tables (`model` and `config` the ones they were built
-    /// with): its views, probes and frames then evaluate the GPU's tables.
-    pub fn into_method(self, model: Model, config: &HillaireConfig) -> Hillaire2020 {
-        let degree = config.multiple_scattering_model.degree();
-        let moments = (model.constituents.iter())
-            .map(|c| match config.multiple_scattering_model {
-                MultipleScatteringModel::Isotropic => vec![1.0],
-                MultipleScatteringModel::Harmonics(_) => phase_moments(&c.phase, degree),
-            })
-            .collect();
-        Hillaire2020 {
-            model,
-            config: *config,
-            optical_depth: self.optical_depth,
-            multiple_scattering: MultipleScattering {
-                table: self.multiple_scattering,
-                degree,
-                moments,
-                max_f_ms: self.max_f_ms,
-                max_at: self.max_at,
-            },
-            irradiance: self.irradiance,
-            max_f_ms: self.max_f_ms,
-        }
-    }
-}
-
-/// The largest f_ms of the pass's output and where it was met (the CPU's fold: the first
-/// texel, in texel order, holding the largest value).
-fn max_f_ms_of(values: &[f32], model: &Model, config: &HillaireConfig) -> (f64, (f64, f64, usize)) {
-    let n = model.channels();
-    let g = groups(n);
-    let (w, h) = config.multiple_scattering;
-    let mut worst = (0.0f64, (0.0, 1.0, 0));
-    for texel in 0..w * h {
-        for k in 0..n {
-            let f = values[texel * g * GROUP + k] as f64;
-            if f > worst.0 {
-                let (bottom, top) = (model.bottom_radius_m, model.top_radius_m);
-                let (r, mu_s) = altitude_mu_s_of_texel(texel % w, texel / w, bottom, top, w, h);
-                worst = (f, (r - bottom, mu_s, k));
-            }
-        }
-    }
-    worst
 }

@@ -37,7 +37,7 @@ fn use_timestamps(ctx: &GpuContext) -> bool {
 pub struct HillairePassTiming {
     /// The optical-depth table.
     pub transmittance_s: f64,
-    /// The multiple-scattering field (the gather and the projection).
+    /// The multiple-scattering field (every order's gather and projection, and the tail).
     pub multiple_scattering_s: f64,
     /// The sky irradiance.
     pub irradiance_s: f64,

@@ -4,6 +4,8 @@
 
 #![allow(dead_code)]
 
+pub mod tables;
+
 use std::sync::{Mutex, OnceLock};
 
 use firmament::atmosphere::Atmosphere;
