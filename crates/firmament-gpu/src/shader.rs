@@ -346,8 +346,9 @@ pub fn render_source(output_format: Option<&str>) -> String {
 /// The constants Hillaire 2020's shaders add to the prelude.
 fn hillaire2020_prelude() -> String {
     format!(
-        "// Hillaire 2020 (firmament_gpu::hillaire2020).\nconst F_MS_GUARD: f32 = {:?};\n",
-        crate::hillaire2020::F_MS_GUARD as f32
+        "// Hillaire 2020 (firmament_gpu::hillaire2020).\nconst F_MS_GUARD: f32 = {:?};\nconst MU_S_HORIZON_STRETCH: f32 = {:?};\n",
+        crate::hillaire2020::F_MS_GUARD as f32,
+        firmament::sky::hillaire2020::params::MU_S_HORIZON_STRETCH as f32
     )
 }
 

@@ -1,6 +1,7 @@
 // The parameterisations of Hillaire 2020's tables (firmament::sky::hillaire2020::params),
 // texel-centre exact: the transmittance is the 4D tables' (bruneton4d/params.wgsl), the
-// multiple scattering and the sky irradiance are linear in μ_s and the altitude, and the
+// multiple scattering and the sky irradiance are dense around the horizon in μ_s and near
+// the ground in altitude (quadratic), and the
 // sky view maps the azimuth from the light as sin(φ/2) and the zenith angle split at the
 // horizon, each half squashed towards it by a square root. Radii in km; ρ = sqrt(r² − R_g²)
 // carried along as in common/geometry.wgsl.
@@ -45,12 +46,27 @@ fn sky_view_mu_cos_phi(r_km: f32, rho_km: f32, x: u32, y: u32) -> vec2<f32> {
     return vec2<f32>(cos(theta), 1.0 - 2.0 * ux * ux);
 }
 
+// x ∈ [−1, 1] of the light's zenith cosine in those tables' columns: asinh(μ_s·sinh k)/k,
+// dense around the horizon (params::mu_s_unit, k = MU_S_HORIZON_STRETCH).
+fn mu_s_unit(mu_s: f32) -> f32 {
+    return asinh(clamp_cosine(mu_s) * sinh(MU_S_HORIZON_STRETCH)) / MU_S_HORIZON_STRETCH;
+}
+
+// Inverse of mu_s_unit (params::mu_s_of_unit); exact at the ends (a zenith light's field
+// has no azimuthal terms, which an f32 ratio of sinh a hair below 1 would add).
+fn mu_s_of_unit(x: f32) -> f32 {
+    if (abs(x) >= 1.0) {
+        return sign(x);
+    }
+    return clamp_cosine(sinh(x * MU_S_HORIZON_STRETCH) / sinh(MU_S_HORIZON_STRETCH));
+}
+
 // The (u, v) of the multiple-scattering and irradiance tables (n_mu_s × n_r texels) at
 // `altitude_km` under a light at zenith cosine `mu_s` (params::altitude_mu_s_uv: the rows
 // quadratic in altitude, dense near the ground).
 fn altitude_mu_s_uv(altitude_km: f32, mu_s: f32, n_mu_s: u32, n_r: u32) -> vec2<f32> {
     let x_r = sqrt(clamp(altitude_km / (atm.top_radius_km - atm.bottom_radius_km), 0.0, 1.0));
-    let x_mu_s = clamp(mu_s * 0.5 + 0.5, 0.0, 1.0);
+    let x_mu_s = clamp(mu_s_unit(mu_s) * 0.5 + 0.5, 0.0, 1.0);
     return vec2<f32>(texcoord_from_unit(x_mu_s, n_mu_s), texcoord_from_unit(x_r, n_r));
 }
 
@@ -61,5 +77,5 @@ fn altitude_mu_s_of_texel(x: u32, y: u32, n_mu_s: u32, n_r: u32) -> vec3<f32> {
     let altitude_km = x_r * x_r * (atm.top_radius_km - atm.bottom_radius_km);
     let r_km = atm.bottom_radius_km + altitude_km;
     let rho_km = sqrt(altitude_km * (r_km + atm.bottom_radius_km));
-    return vec3<f32>(r_km, rho_km, clamp_cosine(2.0 * x_mu_s - 1.0));
+    return vec3<f32>(r_km, rho_km, mu_s_of_unit(2.0 * x_mu_s - 1.0));
 }

@@ -3,9 +3,9 @@
 //!
 //! - Transmittance: Bruneton's (r, μ) mapping, shared with the 4D tables
 //!   ([`crate::sky::bruneton4d::params::transmittance_uv`]; Hillaire §5.1 uses it too).
-//! - Multiple scattering Ψ_ms and the sky irradiance: linear in the light's zenith cosine
-//!   (μ_s·½ + ½) and in the altitude fraction (Hillaire §5.5;
-//!   [`crate::sky::bruneton4d::params::irradiance_uv`] is the same mapping).
+//! - Multiple scattering Ψ_ms and the sky irradiance: Hillaire's (§5.5) are linear in the
+//!   light's zenith cosine (μ_s·½ + ½) and in the altitude fraction; ours are dense around
+//!   the horizon in μ_s and near the ground in altitude ([`altitude_mu_s_uv`]).
 //! - Sky view (§5.3): the azimuth from the light as u = sin(φ/2) (the released demo's
 //!   mapping: texels densest towards the light, where the aerosols' forward peak lies), the
 //!   view's angle from the zenith split at the geometric horizon, each half squashed
@@ -67,13 +67,37 @@ pub fn sky_view_mu_cos_phi(
     (theta.cos(), 1.0 - 2.0 * x * x)
 }
 
+/// How much denser than Hillaire's linear columns the multiple-scattering and irradiance
+/// tables' μ_s columns are at the horizon: μ_s = sinh(k·x)/sinh(k) over x ∈ [−1, 1], whose
+/// slope at x = 0 is k/sinh(k) (0.30 for k = 3: 3.3× the columns, sparser towards the
+/// zenith and the nadir, where the fields change slowly). Twilight is where they change
+/// fastest: with Hillaire's linear 32 columns (u = μ_s/2 + 1/2) the sky under a sun at 0°
+/// and −3° read +7 % and +18 % against the 4D tables (docs/accuracy.md).
+pub const MU_S_HORIZON_STRETCH: f64 = 3.0;
+
+/// x ∈ [−1, 1] of the light's zenith cosine μ_s in those columns (see
+/// [`MU_S_HORIZON_STRETCH`]).
+#[inline]
+pub fn mu_s_unit(mu_s: f64) -> f64 {
+    let k = MU_S_HORIZON_STRETCH;
+    (mu_s.clamp(-1.0, 1.0) * k.sinh()).asinh() / k
+}
+
+/// Inverse of [`mu_s_unit`].
+#[inline]
+pub fn mu_s_of_unit(x: f64) -> f64 {
+    let k = MU_S_HORIZON_STRETCH;
+    ((x.clamp(-1.0, 1.0) * k).sinh() / k.sinh()).clamp(-1.0, 1.0)
+}
+
 /// The (u, v) of the multiple-scattering and irradiance tables at radius `r` (m) and light
-/// zenith cosine `mu_s` between the ground `bottom` and the top `top` (m). The rows are
-/// quadratic in altitude (v = √(h/H)), firmament's change to Hillaire's linear rows: 32
-/// linear rows over Earth's 60 km put the first above the ground at 1.9 km, above most of
-/// the aerosols (scale height 1.2 km), and the sky from 0–1 km under a low sun read 2–3 %
-/// dark with p95 8–10 % against the 4D tables; quadratic, the first is at 60 m and those
-/// figures fall to 0.8 % and 5 % (docs/accuracy.md).
+/// zenith cosine `mu_s` between the ground `bottom` and the top `top` (m). Both axes are
+/// firmament's change to Hillaire's linear ones. The rows are quadratic in altitude
+/// (v = √(h/H)): 32 linear rows over Earth's 60 km put the first above the ground at
+/// 1.9 km, above most of the aerosols (scale height 1.2 km), and the sky from 0–1 km under
+/// a low sun read 2–3 % dark with p95 8–10 % against the 4D tables; quadratic, the first is
+/// at 60 m and those figures fall to 0.8 % and 5 % (docs/accuracy.md). The columns are
+/// dense around the horizon ([`MU_S_HORIZON_STRETCH`]).
 #[inline]
 pub fn altitude_mu_s_uv(
     r: f64,
@@ -84,7 +108,7 @@ pub fn altitude_mu_s_uv(
     nr: usize,
 ) -> (f64, f64) {
     let x_r = ((r - bottom) / (top - bottom)).clamp(0.0, 1.0).sqrt();
-    let x_mu_s = (mu_s * 0.5 + 0.5).clamp(0.0, 1.0);
+    let x_mu_s = (mu_s_unit(mu_s) * 0.5 + 0.5).clamp(0.0, 1.0);
     (
         texcoord_from_unit(x_mu_s, nmu_s),
         texcoord_from_unit(x_r, nr),
@@ -105,7 +129,7 @@ pub fn altitude_mu_s_of_texel(
     let x_r = unit_from_texcoord((y as f64 + 0.5) / nr as f64, nr);
     (
         bottom + x_r * x_r * (top - bottom),
-        (2.0 * x_mu_s - 1.0).clamp(-1.0, 1.0),
+        mu_s_of_unit(2.0 * x_mu_s - 1.0),
     )
 }
 
