@@ -288,6 +288,36 @@ pub(crate) fn read_back(
     Ok(out)
 }
 
+/// Copy the storage buffers `sources` to the host as f32 (one submission, then waits for the
+/// device); `what` names the work for the errors of the copy, `during` those of the wait.
+pub(crate) fn read_buffers_f32(
+    ctx: &GpuContext,
+    sources: &[&wgpu::Buffer],
+    what: &str,
+    during: &str,
+) -> Result<Vec<Vec<f32>>, GpuError> {
+    let device = ctx.device();
+    let staging = scoped(ctx, what, || {
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("firmament readback"),
+        });
+        let staging: Vec<wgpu::Buffer> = sources
+            .iter()
+            .map(|src| {
+                let b = staging_buffer(device, "readback", src.size());
+                encoder.copy_buffer_to_buffer(src, 0, &b, 0, src.size());
+                b
+            })
+            .collect();
+        ctx.queue().submit([encoder.finish()]);
+        Ok(staging)
+    })?;
+    let bytes = scoped(ctx, during, || {
+        read_back(ctx, &staging.iter().collect::<Vec<_>>(), during)
+    })?;
+    Ok(bytes.iter().map(|b| f32s(b)).collect())
+}
+
 /// A MAP_READ | COPY_DST buffer of `size` bytes to copy GPU results into.
 pub(crate) fn staging_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {

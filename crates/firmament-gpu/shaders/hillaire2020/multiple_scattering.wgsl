@@ -68,6 +68,30 @@ fn gather_direction(r_km: f32, rho_km: f32, j: u32) -> GatherDirection {
     return g;
 }
 
+// A gather ray: direction j of texel `texel` to the boundary it ends on, and whether that
+// is the ground (Grid::gather's MarchRay).
+struct GatherRay {
+    ray: MarchRay,
+    ground: bool,
+}
+
+fn gather_ray(texel: u32, j: u32) -> GatherRay {
+    let p = altitude_mu_s_of_texel(texel % hillaire.ms_mu_s, texel / hillaire.ms_mu_s, hillaire.ms_mu_s, hillaire.ms_r);
+    let sun = vec3<f32>(safe_sqrt(1.0 - p.z * p.z), 0.0, p.z);
+    let g = gather_direction(p.x, p.y, j);
+    let mu = g.dir.z;
+    let ground = ray_intersects_ground(p.x, p.y, mu);
+    var ray: MarchRay;
+    ray.r_km = p.x;
+    ray.rho_km = p.y;
+    ray.mu = mu;
+    ray.mu_s = p.z;
+    ray.nu = clamp_cosine(dot(g.dir, sun));
+    ray.length_km = select(distance_to_top(p.x, p.y, mu), distance_to_bottom(p.x, p.y, mu), ground);
+    ray.angular_radius = atm.sun_angular_radius;
+    return GatherRay(ray, ground);
+}
+
 // L′ and ∫T·σ_s along gather direction j of texel i, channel group k (the inner loop of
 // multiple_scattering::compute): the march without the multiple-scattering field, with an
 // isotropic phase (the isotropic model) or the groups' own (the harmonics), plus the
@@ -82,19 +106,9 @@ fn gather(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
     let k = gid.z;
     let texel = i / d;
     let j = i % d;
-    let p = altitude_mu_s_of_texel(texel % hillaire.ms_mu_s, texel / hillaire.ms_mu_s, hillaire.ms_mu_s, hillaire.ms_r);
-    let sun = vec3<f32>(safe_sqrt(1.0 - p.z * p.z), 0.0, p.z);
-    let g = gather_direction(p.x, p.y, j);
-    let mu = g.dir.z;
-    let ground = ray_intersects_ground(p.x, p.y, mu);
-    var ray: MarchRay;
-    ray.r_km = p.x;
-    ray.rho_km = p.y;
-    ray.mu = mu;
-    ray.mu_s = p.z;
-    ray.nu = clamp_cosine(dot(g.dir, sun));
-    ray.length_km = select(distance_to_top(p.x, p.y, mu), distance_to_bottom(p.x, p.y, mu), ground);
-    ray.angular_radius = atm.sun_angular_radius;
+    let gr = gather_ray(texel, j);
+    let ray = gr.ray;
+    let ground = gr.ground;
     var phases = vec2<f32>(INV_4PI);
     if (hillaire.ms_degree > 0u) {
         phases = vec2<f32>(group_phase(0u, ray.nu), group_phase(1u, ray.nu));
@@ -196,19 +210,9 @@ fn gather_next(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     let k = gid.z;
     let texel = i / d;
     let j = i % d;
-    let p = altitude_mu_s_of_texel(texel % hillaire.ms_mu_s, texel / hillaire.ms_mu_s, hillaire.ms_mu_s, hillaire.ms_r);
-    let sun = vec3<f32>(safe_sqrt(1.0 - p.z * p.z), 0.0, p.z);
-    let g = gather_direction(p.x, p.y, j);
-    let mu = g.dir.z;
-    let ground = ray_intersects_ground(p.x, p.y, mu);
-    var ray: MarchRay;
-    ray.r_km = p.x;
-    ray.rho_km = p.y;
-    ray.mu = mu;
-    ray.mu_s = p.z;
-    ray.nu = clamp_cosine(dot(g.dir, sun));
-    ray.length_km = select(distance_to_top(p.x, p.y, mu), distance_to_bottom(p.x, p.y, mu), ground);
-    ray.angular_radius = atm.sun_angular_radius;
+    let gr = gather_ray(texel, j);
+    let ray = gr.ray;
+    let ground = gr.ground;
     let m = march(ray, hillaire.ms_steps, vec2<f32>(0.0), Lighting(lit_none(), lit_all()), true, k);
     var l = m.radiance;
     if (ground) {

@@ -17,7 +17,7 @@ use firmament::sky::bruneton4d::precompute::{DENSITY_THETA, HARMONICS};
 use firmament::sky::bruneton4d::{MieStorage, Table2, Table4, TableConfig, Tables};
 
 use super::atmosphere::{self, groups, GROUP};
-use crate::device::{check_buffers, f32s, read_back, scoped, staging_buffer};
+use crate::device::{check_buffers, read_buffers_f32, scoped};
 use crate::passes::{self as dispatches, dispatch, init, storage, Pass, Slot};
 use crate::shader::{passes, precompute_source, Module};
 use crate::{GpuContext, GpuError};
@@ -448,7 +448,6 @@ impl GpuTables {
         let e_texels = s.irradiance_mu_s * s.irradiance_r;
         let s_texels = s.scattering_r * s.scattering_mu * s.scattering_mu_s * s.scattering_nu;
         let rows = s.scattering_r * s.scattering_mu;
-        let device = ctx.device();
         let sources = [
             &self.transmittance,
             &self.irradiance,
@@ -457,26 +456,12 @@ impl GpuTables {
             &self.multiple,
             &self.row_sums,
         ];
-        let staging = scoped(ctx, "table precomputation", || {
-            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("firmament tables readback"),
-            });
-            let staging: Vec<wgpu::Buffer> = sources
-                .iter()
-                .map(|src| {
-                    let b = staging_buffer(device, "readback", src.size());
-                    encoder.copy_buffer_to_buffer(src, 0, &b, 0, src.size());
-                    b
-                })
-                .collect();
-            ctx.queue().submit([encoder.finish()]);
-            Ok(staging)
-        })?;
-        let during = "reading the tables back";
-        let bytes = scoped(ctx, during, || {
-            read_back(ctx, &staging.iter().collect::<Vec<_>>(), during)
-        })?;
-        let values: Vec<Vec<f32>> = bytes.iter().map(|b| f32s(b)).collect();
+        let values = read_buffers_f32(
+            ctx,
+            &sources,
+            "table precomputation",
+            "reading the tables back",
+        )?;
         let [t_data, e_data, s_data, m_data, multiple_data, rows_data] =
             <[Vec<f32>; 6]>::try_from(values).expect("six buffers");
         let unpad = |v: &[f32], texels: usize| -> Vec<f32> {

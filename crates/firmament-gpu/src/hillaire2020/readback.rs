@@ -13,7 +13,7 @@ use firmament::sky::hillaire2020::{
 
 use super::precompute::{GpuHillaireTables, HillaireTables};
 use crate::bruneton4d::atmosphere::{groups, GROUP};
-use crate::device::{f32s, read_back, scoped, staging_buffer};
+use crate::device::read_buffers_f32;
 use crate::{GpuContext, GpuError};
 
 /// `values` (`entries` entries of `groups` vec4 each) without the padding lanes: `channels`
@@ -41,27 +41,12 @@ impl GpuHillaireTables {
 
     /// Copy `sources` to the host (waits for the device).
     fn read(&self, ctx: &GpuContext, sources: &[&wgpu::Buffer]) -> Result<Vec<Vec<f32>>, GpuError> {
-        let device = ctx.device();
-        let staging = scoped(ctx, "Hillaire 2020 tables", || {
-            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("firmament hillaire2020 readback"),
-            });
-            let staging: Vec<wgpu::Buffer> = sources
-                .iter()
-                .map(|src| {
-                    let b = staging_buffer(device, "readback", src.size());
-                    encoder.copy_buffer_to_buffer(src, 0, &b, 0, src.size());
-                    b
-                })
-                .collect();
-            ctx.queue().submit([encoder.finish()]);
-            Ok(staging)
-        })?;
-        let during = "reading the Hillaire 2020 tables back";
-        let bytes = scoped(ctx, during, || {
-            read_back(ctx, &staging.iter().collect::<Vec<_>>(), during)
-        })?;
-        Ok(bytes.iter().map(|b| f32s(b)).collect())
+        read_buffers_f32(
+            ctx,
+            sources,
+            "Hillaire 2020 tables",
+            "reading the Hillaire 2020 tables back",
+        )
     }
 
     /// Read the tables back into the CPU's layout (waits for the build). `model` and
