@@ -10,6 +10,7 @@
 use crate::math::quadrature::GL8;
 use crate::medium::PhaseFunction;
 use std::f64::consts::PI;
+use std::sync::LazyLock;
 
 /// The largest degree of the multiple-scattering field's harmonics.
 pub const MAX_DEGREE: usize = 8;
@@ -47,24 +48,38 @@ pub fn eval(degree: usize, mu: f64, cos_phi: f64, out: &mut [f64]) {
     // Associated Legendre functions without the Condon–Shortley phase (the same on both
     // sides of the projection): P_m^m = (2m − 1)!!·sin^m θ, P_{m+1}^m = (2m + 1)μ·P_m^m,
     // (ℓ − m)P_ℓ^m = (2ℓ − 1)μ·P_{ℓ−1}^m − (ℓ + m − 1)·P_{ℓ−2}^m.
+    let norm = &*NORMALISATIONS;
     let mut p_mm = 1.0;
     for m in 0..=degree {
         if m > 0 {
             p_mm *= (2 * m - 1) as f64 * sin_theta;
         }
-        out[index(m, m)] = normalisation(m, m) * p_mm * cos_m[m];
+        out[index(m, m)] = norm[index(m, m)] * p_mm * cos_m[m];
         if m == degree {
             break;
         }
         let (mut p_prev, mut p) = (p_mm, (2 * m + 1) as f64 * mu * p_mm);
-        out[index(m + 1, m)] = normalisation(m + 1, m) * p * cos_m[m];
+        out[index(m + 1, m)] = norm[index(m + 1, m)] * p * cos_m[m];
         for l in (m + 2)..=degree {
             let next = ((2 * l - 1) as f64 * mu * p - (l + m - 1) as f64 * p_prev) / (l - m) as f64;
             (p_prev, p) = (p, next);
-            out[index(l, m)] = normalisation(l, m) * p * cos_m[m];
+            out[index(l, m)] = norm[index(l, m)] * p * cos_m[m];
         }
     }
 }
+
+/// [`normalisation`] of every (ℓ, m) up to [`MAX_DEGREE`], at [`index`]: computed once (each
+/// march step evaluates the harmonics, and the factorial ratios and square roots were half
+/// of that).
+static NORMALISATIONS: LazyLock<[f64; coefficient_count(MAX_DEGREE)]> = LazyLock::new(|| {
+    let mut n = [0.0; coefficient_count(MAX_DEGREE)];
+    for l in 0..=MAX_DEGREE {
+        for m in 0..=l {
+            n[index(l, m)] = normalisation(l, m);
+        }
+    }
+    n
+});
 
 /// N_ℓm with ∫ Y_ℓm² dω = 1 for the cosine harmonics: √((2ℓ+1)/4π · (ℓ−m)!/(ℓ+m)!), times
 /// √2 for m > 0.
