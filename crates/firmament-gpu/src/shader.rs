@@ -345,10 +345,17 @@ pub fn render_source(output_format: Option<&str>) -> String {
 
 /// The constants Hillaire 2020's shaders add to the prelude.
 fn hillaire2020_prelude() -> String {
+    let norms = firmament::sky::hillaire2020::harmonics::normalisations();
+    let list: Vec<String> = norms.iter().map(|&n| format!("{:?}", n as f32)).collect();
     format!(
-        "// Hillaire 2020 (firmament_gpu::hillaire2020).\nconst F_MS_GUARD: f32 = {:?};\nconst MU_S_HORIZON_STRETCH: f32 = {:?};\n",
+        "// Hillaire 2020 (firmament_gpu::hillaire2020).\nconst F_MS_GUARD: f32 = {:?};\nconst MU_S_HORIZON_STRETCH: f32 = {:?};\n\
+         // N_ℓm of the harmonics at harmonic_index(ℓ, m) (harmonics::normalisations).\n\
+         var<private> HARMONIC_NORMALISATIONS: array<f32, {}> = array<f32, {}>({});\n",
         crate::hillaire2020::F_MS_GUARD as f32,
-        firmament::sky::hillaire2020::params::MU_S_HORIZON_STRETCH as f32
+        firmament::sky::hillaire2020::params::MU_S_HORIZON_STRETCH as f32,
+        norms.len(),
+        norms.len(),
+        list.join(", ")
     )
 }
 

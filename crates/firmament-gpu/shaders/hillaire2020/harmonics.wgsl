@@ -18,14 +18,10 @@ fn harmonic_degree_order(c: u32) -> vec2<u32> {
     return vec2<u32>(l, c - harmonic_index(l, 0u));
 }
 
-// N_ℓm = sqrt((2ℓ + 1)/4π · (ℓ − m)!/(ℓ + m)!), times √2 for m > 0 (harmonics::normalisation).
+// N_ℓm = sqrt((2ℓ + 1)/4π · (ℓ − m)!/(ℓ + m)!), times √2 for m > 0 (harmonics::normalisation,
+// computed on the host in f64: HARMONIC_NORMALISATIONS of the prelude).
 fn harmonic_normalisation(l: u32, m: u32) -> f32 {
-    var ratio = 1.0;
-    for (var j = l - m + 1u; j <= l + m; j++) {
-        ratio /= f32(j);
-    }
-    let n = sqrt(f32(2u * l + 1u) / (4.0 * PI) * ratio);
-    return select(n, n * sqrt(2.0), m > 0u);
+    return HARMONIC_NORMALISATIONS[harmonic_index(l, m)];
 }
 
 // Y_ℓm at zenith cosine `mu` and azimuth cosine `cos_phi` from the light's (harmonics::eval

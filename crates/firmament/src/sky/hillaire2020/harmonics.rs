@@ -81,6 +81,12 @@ static NORMALISATIONS: LazyLock<[f64; coefficient_count(MAX_DEGREE)]> = LazyLock
     n
 });
 
+/// N_ℓm (see [`normalisation`]) of every (ℓ, m) up to [`MAX_DEGREE`], at [`index`] (the GPU's
+/// shaders take them as a constant array).
+pub fn normalisations() -> &'static [f64] {
+    &NORMALISATIONS[..]
+}
+
 /// N_ℓm with ∫ Y_ℓm² dω = 1 for the cosine harmonics: √((2ℓ+1)/4π · (ℓ−m)!/(ℓ+m)!), times
 /// √2 for m > 0.
 fn normalisation(l: usize, m: usize) -> f64 {
