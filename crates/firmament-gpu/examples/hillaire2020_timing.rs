@@ -3,17 +3,19 @@
 //! pixel passes of the CPU benchmark's 1920×1080 perspective frame (1.5 km up, heading
 //! 200°, 20° up, 60° field, the sun 60° from the zenith at azimuth 200°;
 //! `GpuHillaireRenderer::time_render`), medians of several runs after a warm-up, for
-//! `earth` in RGB and spectral (16 wavelengths), default `HillaireConfig`; timestamp
-//! queries where the adapter has them, else the wall clock of each pass alone.
+//! `earth` in RGB and spectral (16 wavelengths), default `HillaireConfig` (or, with
+//! `extended`, firmament's harmonics(6) and 4 orders, as `--hillaire-harmonics 6
+//! --hillaire-orders 4`); timestamp queries where the adapter has them, else the wall clock
+//! of each pass alone.
 //!
-//! `cargo run --release -p firmament-gpu --example hillaire2020_timing [RUNS] [WIDTHxHEIGHT]`
+//! `cargo run --release -p firmament-gpu --example hillaire2020_timing [RUNS] [WIDTHxHEIGHT] [extended]`
 
 use std::time::Instant;
 
 use firmament::atmosphere::Atmosphere;
 use firmament::render::RenderSettings;
 use firmament::scene::{sun_direction, Camera, Light, Projection};
-use firmament::sky::hillaire2020::HillaireConfig;
+use firmament::sky::hillaire2020::{HillaireConfig, MultipleScatteringModel};
 use firmament::spectrum::Wavelengths;
 use firmament_gpu::{GpuContext, GpuHillaire, GpuHillaireRenderer, HillairePrecomputer};
 
@@ -26,6 +28,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             (w.parse()?, h.parse()?)
         }
         None => (1920, 1080),
+    };
+    let config = match args.next().as_deref() {
+        Some("extended") => HillaireConfig {
+            multiple_scattering_model: MultipleScatteringModel::Harmonics(6),
+            multiple_scattering_orders: 4,
+            multiple_scattering_directions: (24, 12),
+            ..HillaireConfig::default()
+        },
+        Some(other) => return Err(format!("unknown configuration {other:?} (extended)").into()),
+        None => HillaireConfig::default(),
     };
     let ctx = GpuContext::new()?;
     println!(
@@ -55,7 +67,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         height,
         white_balance: false,
     };
-    let config = HillaireConfig::default();
     let ms = |s: f64| s * 1e3;
     for (name, wavelengths) in [
         ("rgb", Wavelengths::rgb()),
