@@ -260,6 +260,11 @@ pub fn prelude() -> String {
         "const DISK_EDGE_FOOTPRINTS: f32 = {:?};\n",
         disk_edges::EDGE_FOOTPRINTS as f32
     );
+    // The orders' geometric tail (bruneton4d::precompute::order_tail_factors).
+    s += &format!(
+        "const ORDER_RATIO_CAP: f32 = {:?};\n",
+        firmament::sky::bruneton4d::precompute::ORDER_RATIO_CAP as f32
+    );
     s += &format!(
         "const DOME_PIECES = array<vec3<f32>, {}>({});\n",
         sky_dome::PIECES.len(),

@@ -256,7 +256,7 @@ var<workgroup> before_sums: array<vec4<f32>, WORKGROUP>;
 // workgroup per group (the end of multiple_scattering::compute). From 4 orders the geometric
 // tail of the last two: `degree_zero_means` of both (the last order's field at binding 24,
 // the one before at binding 20; the CPU keeps every order's means, the factors read only
-// those two), `order_tail_factors`' q = min(mean_N/mean_{N−1}, 0.95) (0 where either is 0
+// those two), `order_tail_factors`' q = min(mean_N/mean_{N−1}, ORDER_RATIO_CAP) (0 where either is 0
 // or the orders do not decrease) and the last field × q/(1 − q) added to the table. Below 4
 // orders, Hillaire's series on the last order's degree 0, texel by texel: × f/(1 − f) with
 // the first order's f_ms (guarded at F_MS_GUARD).
@@ -286,7 +286,7 @@ fn tail(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) wid: 
         let mean_last = last_sums[0] / f32(texels);
         let mean_before = before_sums[0] / f32(texels);
         let valid = (mean_before > vec4<f32>(0.0)) & (mean_last > vec4<f32>(0.0)) & (mean_last < mean_before);
-        let q = select(vec4<f32>(0.0), min(mean_last / mean_before, vec4<f32>(0.95)), valid);
+        let q = select(vec4<f32>(0.0), min(mean_last / mean_before, vec4<f32>(ORDER_RATIO_CAP)), valid);
         let factor = q / (1.0 - q);
         for (var e = lane; e < texels * n; e += WORKGROUP) {
             let texel = e / n;

@@ -1,6 +1,6 @@
 // Factors q/(1 − q) of the geometric tail of the orders beyond the last one, N (Rust twin
 // precompute/order_tail.rs, `order_tail_factors`): q = Σ ΔS_N / Σ ΔS_{N−1} per channel over
-// the order row sums (order_sums.wgsl, read at slot a), capped at 0.95; 0 where either sum
+// the order row sums (order_sums.wgsl, read at slot a), capped at ORDER_RATIO_CAP; 0 where either sum
 // is 0 or the orders do not decrease (no convergent series to extrapolate); then capped so
 // that no irradiance texel passes the sun outside the air (`cap_by_energy`). N is the pass
 // order. One invocation per channel group.
@@ -25,7 +25,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         before += scattering_a[((n - 2u) * rows + row) * atm.groups + k];
     }
     let valid = (before > vec4<f32>(0.0)) & (last > vec4<f32>(0.0)) & (last < before);
-    let q = select(vec4<f32>(0.0), min(last / before, vec4<f32>(0.95)), valid);
+    let q = select(vec4<f32>(0.0), min(last / before, vec4<f32>(ORDER_RATIO_CAP)), valid);
     var f = q / (1.0 - q);
     // cap_by_energy: no irradiance texel passes the sun's irradiance outside the air.
     let solar = solar_irradiance(k);

@@ -38,7 +38,7 @@ use crate::atmosphere::{Model, ScatteringGroups};
 use crate::{Error, Result};
 pub(crate) use grid::{MuSPositions, ScatteringGrid};
 pub use job::PrecomputeJob;
-pub use order_tail::order_tail_factors;
+pub use order_tail::{order_tail_factors, ORDER_RATIO_CAP};
 pub use plan::{frame_schedule, Pass, Unit};
 pub use transmittance::{compute_optical_depth, compute_optical_depth_in};
 

@@ -7,6 +7,9 @@ use std::ops::Range;
 use super::ScatteringGrid;
 use crate::atmosphere::ScatteringGroups;
 use crate::sky::bruneton4d::table::{Table2, Table4};
+/// The largest ratio q of successive orders the geometric tail takes (the tail multiplies the
+/// last order by q/(1 − q): 19 at the cap). Shared with the GPU's tails (WGSL prelude).
+pub const ORDER_RATIO_CAP: f64 = 0.95;
 
 /// Factors q/(1 − q) per channel for the orders beyond the last computed one, N: with
 /// q = mean(ΔS_N)/mean(ΔS_{N−1}) (`order_means`), the orders N+1, N+2, … are taken as
@@ -34,7 +37,7 @@ pub fn order_tail_factors(order_means: &[Vec<f64>]) -> Option<Vec<f64>> {
             .zip(before)
             .map(|(&l, &b)| {
                 let q = if b > 0.0 && l > 0.0 && l < b {
-                    (l / b).min(0.95)
+                    (l / b).min(ORDER_RATIO_CAP)
                 } else {
                     0.0
                 };
