@@ -28,6 +28,14 @@ impl Entry {
         }
     }
 
+    /// Distance (m) along the ray from the start to `point`, which lies on the ray from
+    /// `observer`: not positive for a point the ray reaches before it enters the atmosphere
+    /// (the air between the observer and it is none).
+    #[inline]
+    pub fn distance_to(&self, observer: Vec3, point: Vec3) -> f64 {
+        (point - observer).length() - self.offset_m(observer)
+    }
+
     /// The zenith cosine of the ray at its start.
     #[inline]
     pub fn mu(&self) -> f64 {

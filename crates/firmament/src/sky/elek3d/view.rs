@@ -353,7 +353,7 @@ impl SkyView for Elek3dView<'_> {
             return;
         };
         // A point before the ray enters the atmosphere sees no air.
-        let d_total = (point - self.observer).length() - start.offset_m(self.observer);
+        let d_total = start.distance_to(self.observer, point);
         if d_total <= 0.0 {
             radiance[..n].iter_mut().for_each(|v| *v = 0.0);
             transmittance[..n].iter_mut().for_each(|v| *v = 1.0);
@@ -404,7 +404,7 @@ impl SkyView for Elek3dView<'_> {
             return;
         };
         let ray = self.geometry(&start, dir);
-        let d = ((point - self.observer).length() - start.offset_m(self.observer)).max(0.0);
+        let d = (start.distance_to(self.observer, point)).max(0.0);
         self.lookup.transmittance(ray.r, ray.mu, d, ray.ground, out);
     }
 

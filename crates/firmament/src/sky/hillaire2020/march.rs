@@ -213,8 +213,9 @@ impl Marcher<'_> {
     }
 
     /// [`Marcher::march`] over the steps ending at `ends` (m from the ray's start,
-    /// increasing, up to `ray.length`; nothing when that is not positive), calling `at_end(i, radiance)` after step i
-    /// with the radiance so far (the aerial-perspective volume's slices along one ray).
+    /// increasing, up to `ray.length`; nothing when that is not positive), calling
+    /// `at_end(i, radiance)` after step i with the radiance so far (the aerial-perspective
+    /// volume's slices along one ray).
     #[allow(clippy::too_many_arguments)]
     pub fn march_over(
         &self,

@@ -84,7 +84,6 @@ impl<'a> Hillaire2020View<'a> {
         let model = &self.sky.model;
         let n = self.channels();
         let mu = start.mu();
-        let nu = dir.dot(self.light.direction).clamp(-1.0, 1.0);
         let length = length.unwrap_or_else(|| {
             let ground = ray_intersects_ground(start.r, mu, model.bottom_radius_m);
             distance_to_nearest_atmosphere_boundary(
@@ -95,14 +94,8 @@ impl<'a> Hillaire2020View<'a> {
                 ground,
             )
         });
-        let ray = MarchRay {
-            r: start.r,
-            mu,
-            mu_s: (start.point.dot(self.light.direction) / start.r).clamp(-1.0, 1.0),
-            nu,
-            length,
-        };
-        self.with_phases(nu, |phases| {
+        let ray = self.march_ray(start, dir, length);
+        self.with_phases(ray.nu, |phases| {
             with_channel_buffers(n, |[t]| {
                 let steps = self.sky.config.march_steps;
                 self.marcher.march(
@@ -118,6 +111,17 @@ impl<'a> Hillaire2020View<'a> {
         });
         for (v, e) in radiance[..n].iter_mut().zip(&self.light.irradiance) {
             *v *= e;
+        }
+    }
+
+    /// The march ray of `dir` from `start` over `length` (m).
+    fn march_ray(&self, start: &Entry, dir: Vec3, length: f64) -> MarchRay {
+        MarchRay {
+            r: start.r,
+            mu: start.mu(),
+            mu_s: (start.point.dot(self.light.direction) / start.r).clamp(-1.0, 1.0),
+            nu: dir.dot(self.light.direction).clamp(-1.0, 1.0),
+            length,
         }
     }
 
@@ -244,7 +248,7 @@ impl SkyView for Hillaire2020View<'_> {
             return;
         };
         // A point before the ray enters the atmosphere sees no air.
-        let d = (point - self.observer).length() - start.offset_m(self.observer);
+        let d = start.distance_to(self.observer, point);
         if d <= 0.0 {
             radiance[..n].iter_mut().for_each(|v| *v = 0.0);
             transmittance[..n].iter_mut().for_each(|v| *v = 1.0);
@@ -295,11 +299,10 @@ impl SkyView for Hillaire2020View<'_> {
             return clear(radiance, transmittance);
         };
         // Each point's distance from the ray's start (0 before the atmosphere's entry).
-        let offset = start.offset_m(self.observer);
         let mut distances = Vec::with_capacity(points.len());
         let mut previous = 0.0f64;
         for &p in points {
-            previous = previous.max((p - self.observer).length() - offset);
+            previous = previous.max(start.distance_to(self.observer, p));
             distances.push(previous);
         }
         if previous <= 0.0 {
@@ -316,21 +319,14 @@ impl SkyView for Hillaire2020View<'_> {
                 &mut transmittance[i * n..(i + 1) * n],
             );
         }
-        let nu = dir.dot(self.light.direction).clamp(-1.0, 1.0);
-        let ray = MarchRay {
-            r: start.r,
-            mu,
-            mu_s: (start.point.dot(self.light.direction) / start.r).clamp(-1.0, 1.0),
-            nu,
-            length: previous,
-        };
+        let ray = self.march_ray(&start, dir, previous);
         let k = COLUMN_STEPS_PER_POINT;
         let ends = distances.iter().enumerate().flat_map(|(i, &d)| {
             let from = if i == 0 { 0.0 } else { distances[i - 1] };
             (1..=k).map(move |j| from + (d - from) * j as f64 / k as f64)
         });
         let irradiance = &self.light.irradiance;
-        self.with_phases(nu, |phases| {
+        self.with_phases(ray.nu, |phases| {
             with_channel_buffers(n, |[l, t]| {
                 self.marcher.march_over(
                     &ray,
@@ -361,7 +357,7 @@ impl SkyView for Hillaire2020View<'_> {
         };
         let mu = start.mu();
         let ground = ray_intersects_ground(start.r, mu, self.sky.model.bottom_radius_m);
-        let d = ((point - self.observer).length() - start.offset_m(self.observer)).max(0.0);
+        let d = (start.distance_to(self.observer, point)).max(0.0);
         self.marcher
             .lookup
             .transmittance(start.r, mu, d, ground, out);
