@@ -12,9 +12,8 @@ use firmament::math::quadrature::GaussLegendreRule;
 use firmament::math::Vec3;
 use firmament::sky::bruneton4d::TableSizes;
 use firmament::sky::hillaire2020::harmonics::{coefficient_count, phase_moments};
-use firmament::sky::hillaire2020::multiple_scattering::{
-    HIGHER_ORDERS_DEGREE, HIGHER_ORDERS_DIRECTIONS,
-};
+pub use firmament::sky::hillaire2020::multiple_scattering::higher_orders_directions;
+use firmament::sky::hillaire2020::multiple_scattering::HIGHER_ORDERS_DEGREE;
 use firmament::sky::hillaire2020::{HillaireConfig, MultipleScatteringModel};
 
 use crate::bruneton4d::atmosphere::{self, Packed};
@@ -29,20 +28,11 @@ pub struct PackedConfig {
     /// (`multiple_scattering::compute`'s loop): order 2's (through the first order's
     /// field), then that of orders ≥ 3 (through a higher order's field, of degree ≤
     /// [`HIGHER_ORDERS_DEGREE`]), each with the coarser gather rule
-    /// ([`HIGHER_ORDERS_DIRECTIONS`]) and the field it writes of degree ≤
+    /// ([`higher_orders_directions`]) and the field it writes of degree ≤
     /// [`HIGHER_ORDERS_DEGREE`].
     pub higher_orders: [Vec<u32>; 2],
     /// The data's floats.
     pub data: Vec<f32>,
-}
-
-/// The gather rule of the higher orders for `directions`, the first order's (the coarser
-/// of the two, as `multiple_scattering::compute`'s `next_grid`).
-pub fn higher_orders_directions(directions: (usize, usize)) -> (usize, usize) {
-    (
-        directions.0.min(HIGHER_ORDERS_DIRECTIONS.0),
-        directions.1.min(HIGHER_ORDERS_DIRECTIONS.1),
-    )
 }
 
 /// The gather rules' node counts below and above the horizon for `n_mu` nodes in μ
@@ -182,6 +172,7 @@ pub fn pack(model: &Model, config: &HillaireConfig) -> PackedConfig {
 mod tests {
     use super::*;
     use firmament::atmosphere::Atmosphere;
+    use firmament::sky::hillaire2020::multiple_scattering::HIGHER_ORDERS_DIRECTIONS;
     use firmament::spectrum::Wavelengths;
 
     #[test]

@@ -44,6 +44,15 @@ pub const HIGHER_ORDERS_DEGREE: usize = 4;
 /// The gather rule's (μ, φ) nodes for the fields of orders ≥ 2, at most.
 pub const HIGHER_ORDERS_DIRECTIONS: (usize, usize) = (12, 6);
 
+/// The gather rule of the orders ≥ 2 for the first order's `directions`: the coarser of the
+/// two (CPU and GPU).
+pub fn higher_orders_directions(directions: (usize, usize)) -> (usize, usize) {
+    (
+        directions.0.min(HIGHER_ORDERS_DIRECTIONS.0),
+        directions.1.min(HIGHER_ORDERS_DIRECTIONS.1),
+    )
+}
+
 /// The guard on f_ms in 1/(1 − f_ms) while the pass runs (the atmospheres that reach it are
 /// refused after the pass, by [`F_MS_LIMIT`]).
 pub const F_MS_GUARD: f64 = 0.999;
@@ -311,10 +320,7 @@ pub(crate) fn compute(
     // coarser gather rule.
     let next_grid = Grid {
         degree: degree.min(HIGHER_ORDERS_DEGREE),
-        directions: (
-            directions.0.min(HIGHER_ORDERS_DIRECTIONS.0),
-            directions.1.min(HIGHER_ORDERS_DIRECTIONS.1),
-        ),
+        directions: higher_orders_directions(directions),
         ..grid
     };
     let next_coefficients = coefficient_count(next_grid.degree);
