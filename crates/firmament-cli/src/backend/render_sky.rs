@@ -18,7 +18,7 @@ use firmament::sky::bruneton4d::{Bruneton4d, TableConfig};
 use firmament::sky::SkyMethod;
 use firmament_gpu::elek3d::{GpuElek3d, GpuElek3dRenderer};
 use firmament_gpu::hillaire2020::{GpuHillaire, GpuHillaireRenderer, HillairePrecomputer};
-use firmament_gpu::{GpuRenderer, GpuSky, GpuTerrain, RenderInputs};
+use firmament_gpu::{GpuError, GpuRenderer, GpuSky, GpuTerrain, RenderInputs};
 
 use super::{gpu_failure, on_gpu, Backend, Gpu};
 use crate::common::{cancel_flag, progress_bar, spinner, AtmosphereArgs};
@@ -239,14 +239,9 @@ impl<'a> RenderSky<'a> {
                     terrain: gpu_terrain.as_ref(),
                     ..RenderInputs::default()
                 };
-                let (lights, small) = gpu_lights(sources, settings, sky_model);
-                let mut frame = on_gpu("rendering on the GPU", quiet, || {
-                    renderer
-                        .render_with(&gpu.ctx, sky, &lights, settings, inputs)
-                        .map_err(|e| gpu_failure("rendering", e))
-                })?;
-                draw_points(&mut frame, sources, small, sky_model, settings, terrain);
-                Ok(frame)
+                gpu_frame(sources, settings, sky_model, terrain, quiet, |lights| {
+                    renderer.render_with(&gpu.ctx, sky, lights, settings, inputs)
+                })
             }
             RenderSky::GpuHillaire {
                 gpu,
@@ -258,14 +253,9 @@ impl<'a> RenderSky<'a> {
                     background: sources.background.as_ref(),
                     ..RenderInputs::default()
                 };
-                let (lights, small) = gpu_lights(sources, settings, sky_model);
-                let mut frame = on_gpu("rendering on the GPU", quiet, || {
-                    renderer
-                        .render_with(&gpu.ctx, sky, &lights, settings, inputs)
-                        .map_err(|e| gpu_failure("rendering", e))
-                })?;
-                draw_points(&mut frame, sources, small, sky_model, settings, None);
-                Ok(frame)
+                gpu_frame(sources, settings, sky_model, None, quiet, |lights| {
+                    renderer.render_with(&gpu.ctx, sky, lights, settings, inputs)
+                })
             }
             RenderSky::GpuElek3d {
                 gpu,
@@ -277,14 +267,9 @@ impl<'a> RenderSky<'a> {
                     background: sources.background.as_ref(),
                     ..RenderInputs::default()
                 };
-                let (lights, small) = gpu_lights(sources, settings, sky_model);
-                let mut frame = on_gpu("rendering on the GPU", quiet, || {
-                    renderer
-                        .render_with(&gpu.ctx, sky, &lights, settings, inputs)
-                        .map_err(|e| gpu_failure("rendering", e))
-                })?;
-                draw_points(&mut frame, sources, small, sky_model, settings, None);
-                Ok(frame)
+                gpu_frame(sources, settings, sky_model, None, quiet, |lights| {
+                    renderer.render_with(&gpu.ctx, sky, lights, settings, inputs)
+                })
             }
         }
     }
@@ -371,6 +356,24 @@ impl<'a> RenderSky<'a> {
             RenderSky::GpuElek3d { sky_model, .. } => sky_model,
         }
     }
+}
+
+/// A GPU frame of `render(lights)` under a spinner, with the stars and the small disks
+/// splatted into it on the CPU (hidden by `terrain`).
+fn gpu_frame(
+    sources: &SkySources,
+    settings: &RenderSettings,
+    model: &Model,
+    terrain: Option<&Heightfield>,
+    quiet: bool,
+    render: impl FnOnce(&[firmament::scene::Light]) -> Result<Frame, GpuError>,
+) -> Result<Frame> {
+    let (lights, small) = gpu_lights(sources, settings, model);
+    let mut frame = on_gpu("rendering on the GPU", quiet, || {
+        render(&lights).map_err(|e| gpu_failure("rendering", e))
+    })?;
+    draw_points(&mut frame, sources, small, model, settings, terrain);
+    Ok(frame)
 }
 
 /// The lights a GPU frame draws, and the disks smaller than four pixels, which are points
