@@ -137,6 +137,39 @@ fn twilight_from_the_ground_itself() {
 }
 
 #[test]
+fn twilight_between_the_tables_sun_samples() {
+    // The sun 5.5° and 6.5° below the horizon, between the μ_s samples at −7.2°, −6.0° and
+    // −5.0°, where the tables blend along μ_s by the twilight rule (mu_s_blend.rs and its
+    // twin mu_s_blend.wgsl; a linear blend reads +22 % there): from 10 km towards the
+    // horizon, and from 1 km looking down at the ground, which the irradiance table's
+    // twilight blend lights.
+    for (name, altitude_m, pitch_deg, sun_zenith_deg) in [
+        ("twilight at 10 km, sun -5.5", 10_000.0, 10.0, 95.5),
+        (
+            "twilight at 1 km looking down, sun -6.5",
+            1_000.0,
+            -30.0,
+            96.5,
+        ),
+    ] {
+        let cam = camera(Projection::Fisheye, altitude_m, 0.0, pitch_deg, 60.0);
+        let settings = RenderSettings {
+            camera: &cam,
+            width: 64,
+            height: 64,
+            white_balance: false,
+        };
+        check(
+            name,
+            earth_rgb(),
+            &settings,
+            sun_direction(sun_zenith_deg, 80.0),
+            true,
+        );
+    }
+}
+
+#[test]
 fn deep_twilight_below_the_tables_lowest_sun() {
     // The sun 21° below the horizon, under the tables' lowest (−12°), 2 m above the
     // ground: the sky and the ground's sky light fall on from the lowest tabulated sun

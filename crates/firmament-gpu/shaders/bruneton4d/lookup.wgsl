@@ -66,22 +66,57 @@ fn transmittance_to_sun(r_km: f32, rho_km: f32, mu_s: f32, k: u32) -> vec4<f32> 
     return transmittance_to_top(r_km, rho_km, mu_s, k) * fraction;
 }
 
-// ΔE at (altitude, μ_s).
-fn delta_irradiance(altitude_km: f32, mu_s: f32, k: u32) -> vec4<f32> {
-    let f = table2_filter(irradiance_uv(altitude_km, mu_s), atm.irradiance_mu_s, atm.irradiance_r);
-    return f.weight.x * delta_irradiance_table[f.index.x + k] + f.weight.y * delta_irradiance_table[f.index.y + k]
-        + f.weight.z * delta_irradiance_table[f.index.z + k] + f.weight.w * delta_irradiance_table[f.index.w + k];
+// The irradiance table at slot 4 (ΔE in the precomputation, E when rendering) at texture
+// coordinates uv (Lookup::irradiance, Table2::sample_twilight_into): bilinear, or in a
+// twilight cell the twilight blend along μ_s per row and then linear in r.
+fn irradiance_at(uv: vec2<f32>, k: u32) -> vec4<f32> {
+    let w = atm.irradiance_mu_s;
+    let m = mu_s_filter(uv.x, w, atm.irradiance_twilight_cells);
+    if (!m.twilight) {
+        let f = table2_filter(uv, w, atm.irradiance_r);
+        return f.weight.x * delta_irradiance_table[f.index.x + k] + f.weight.y * delta_irradiance_table[f.index.y + k]
+            + f.weight.z * delta_irradiance_table[f.index.z + k] + f.weight.w * delta_irradiance_table[f.index.w + k];
+    }
+    let ly = lerp_weights(uv.y, atm.irradiance_r);
+    let g = atm.groups;
+    let r0 = ly.i0 * w;
+    let r1 = ly.i1 * w;
+    let e0 = mu_s_blend_at(m, delta_irradiance_table[(r0 + m.below) * g + k], delta_irradiance_table[(r0 + m.s0) * g + k],
+        delta_irradiance_table[(r0 + m.s1) * g + k], delta_irradiance_table[(r0 + m.above) * g + k]);
+    let e1 = mu_s_blend_at(m, delta_irradiance_table[(r1 + m.below) * g + k], delta_irradiance_table[(r1 + m.s0) * g + k],
+        delta_irradiance_table[(r1 + m.s1) * g + k], delta_irradiance_table[(r1 + m.above) * g + k]);
+    return (1.0 - ly.t) * e0 + ly.t * e1;
 }
 
-// Σ over the four (ν, μ_s) columns of one (r, μ) row, channel group k.
+// ΔE at (altitude, μ_s).
+fn delta_irradiance(altitude_km: f32, mu_s: f32, k: u32) -> vec4<f32> {
+    return irradiance_at(irradiance_uv(altitude_km, mu_s), k);
+}
+
+// Σ over the four (ν, μ_s) columns of one (r, μ) row, channel group k; in a twilight cell
+// the twilight blend along μ_s of each ν column, then linear in ν.
 fn scattering_a_row(f: Filter4, row: u32, k: u32) -> vec4<f32> {
     let g = atm.groups;
+    if (f.mu_s.twilight) {
+        let c0 = mu_s_blend_at(f.mu_s, scattering_a[(row + f.colb.x) * g + k], scattering_a[(row + f.col.x) * g + k],
+            scattering_a[(row + f.col.y) * g + k], scattering_a[(row + f.cola.x) * g + k]);
+        let c1 = mu_s_blend_at(f.mu_s, scattering_a[(row + f.colb.y) * g + k], scattering_a[(row + f.col.z) * g + k],
+            scattering_a[(row + f.col.w) * g + k], scattering_a[(row + f.cola.y) * g + k]);
+        return f.wnu.x * c0 + f.wnu.y * c1;
+    }
     return f.wcol.x * scattering_a[(row + f.col.x) * g + k] + f.wcol.y * scattering_a[(row + f.col.y) * g + k]
         + f.wcol.z * scattering_a[(row + f.col.z) * g + k] + f.wcol.w * scattering_a[(row + f.col.w) * g + k];
 }
 
 fn scattering_b_row(f: Filter4, row: u32, k: u32) -> vec4<f32> {
     let g = atm.groups;
+    if (f.mu_s.twilight) {
+        let c0 = mu_s_blend_at(f.mu_s, scattering_b[(row + f.colb.x) * g + k], scattering_b[(row + f.col.x) * g + k],
+            scattering_b[(row + f.col.y) * g + k], scattering_b[(row + f.cola.x) * g + k]);
+        let c1 = mu_s_blend_at(f.mu_s, scattering_b[(row + f.colb.y) * g + k], scattering_b[(row + f.col.z) * g + k],
+            scattering_b[(row + f.col.w) * g + k], scattering_b[(row + f.cola.y) * g + k]);
+        return f.wnu.x * c0 + f.wnu.y * c1;
+    }
     return f.wcol.x * scattering_b[(row + f.col.x) * g + k] + f.wcol.y * scattering_b[(row + f.col.y) * g + k]
         + f.wcol.z * scattering_b[(row + f.col.z) * g + k] + f.wcol.w * scattering_b[(row + f.col.w) * g + k];
 }

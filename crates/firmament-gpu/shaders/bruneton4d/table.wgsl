@@ -24,11 +24,19 @@ fn lerp_weights(u: f32, n: u32) -> Lerp {
 // row[i] + col[j] with weight wrow[i]·wcol[j]: rows are the (r, μ) pairs (z0 y0, z0 y1,
 // z1 y0, z1 y1), columns the (ν, μ_s) pairs (ν0 s0, ν0 s1, ν1 s0, ν1 s1). Vectors, not
 // arrays: no dynamically indexed private memory (slow on software rasterisers).
+//
+// In a twilight cell along μ_s (mu_s_blend.wgsl) the columns are blended along μ_s with
+// their outer neighbours colb (ν0, ν1 at the sample below s0) and cola (above s1), then in ν
+// by wnu, instead of by wcol.
 struct Filter4 {
     row: vec4<u32>,
     col: vec4<u32>,
     wrow: vec4<f32>,
     wcol: vec4<f32>,
+    mu_s: MuSFilter,
+    colb: vec2<u32>,
+    cola: vec2<u32>,
+    wnu: vec2<f32>,
 }
 
 fn scattering_filter_rows(u_nu: f32, u_mu_s: f32, ly: Lerp, lz: Lerp) -> Filter4 {
@@ -38,7 +46,11 @@ fn scattering_filter_rows(u_nu: f32, u_mu_s: f32, ly: Lerp, lz: Lerp) -> Filter4
     let nu0 = min(u32(floor(tex_x)), nnu - 1u);
     let nu1 = min(nu0 + 1u, nnu - 1u);
     let tnu = tex_x - f32(nu0);
-    let ls = lerp_weights(u_mu_s, nmu_s);
+    let m = mu_s_filter(u_mu_s, nmu_s, atm.mu_s_twilight_cells);
+    var ls: Lerp;
+    ls.i0 = m.s0;
+    ls.i1 = m.s1;
+    ls.t = m.t;
     let width = scattering_width();
     let z = vec4<u32>(lz.i0, lz.i0, lz.i1, lz.i1);
     let y = vec4<u32>(ly.i0, ly.i1, ly.i0, ly.i1);
@@ -49,6 +61,10 @@ fn scattering_filter_rows(u_nu: f32, u_mu_s: f32, ly: Lerp, lz: Lerp) -> Filter4
     f.col = n * nmu_s + ms;
     f.wrow = vec4<f32>(1.0 - lz.t, 1.0 - lz.t, lz.t, lz.t) * vec4<f32>(1.0 - ly.t, ly.t, 1.0 - ly.t, ly.t);
     f.wcol = vec4<f32>(1.0 - tnu, 1.0 - tnu, tnu, tnu) * vec4<f32>(1.0 - ls.t, ls.t, 1.0 - ls.t, ls.t);
+    f.mu_s = m;
+    f.colb = vec2<u32>(nu0, nu1) * nmu_s + m.below;
+    f.cola = vec2<u32>(nu0, nu1) * nmu_s + m.above;
+    f.wnu = vec2<f32>(1.0 - tnu, tnu);
     return f;
 }
 

@@ -18,7 +18,7 @@ fn twilight_lowest_texel() -> vec2<f32> {
 const TWILIGHT_TEXEL_TOLERANCE: f32 = 1e-4;
 
 fn twilight_irradiance_at(altitude_km: f32, mu_s: f32, k: u32) -> vec4<f32> {
-    return sample_irradiance(table2_filter(irradiance_uv(altitude_km, mu_s), atm.irradiance_mu_s, atm.irradiance_r), k);
+    return irradiance_at(irradiance_uv(altitude_km, mu_s), k);
 }
 
 struct TwilightDecay {

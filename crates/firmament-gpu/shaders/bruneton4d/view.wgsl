@@ -205,18 +205,19 @@ fn sample_transmittance_between(f: TransmittanceFilters, k: u32) -> vec4<f32> {
     return transmittance_between(sample_optical_depth(f.a, k), sample_optical_depth(f.b, k));
 }
 
-// Lookup::irradiance on the final irradiance table (bound at slot 4).
-fn sample_irradiance(f: Filter2, k: u32) -> vec4<f32> {
-    return f.weight.x * delta_irradiance_table[f.index.x + k] + f.weight.y * delta_irradiance_table[f.index.y + k]
-        + f.weight.z * delta_irradiance_table[f.index.z + k] + f.weight.w * delta_irradiance_table[f.index.w + k];
-}
-
 // Channel 0 of a red-only single Mie table: texel t at t (one vec4 per texel, from the CPU)
 // or at t·groups (the full layout of the GPU precomputation).
 fn mie_red_row(v: View, f: Filter4, row: u32) -> f32 {
     var g = atm.groups;
     if (v.mie_layout == 1u) {
         g = 1u;
+    }
+    if (f.mu_s.twilight) {
+        let c0 = mu_s_blend_at(f.mu_s, vec4<f32>(scattering_b[(row + f.colb.x) * g].x), vec4<f32>(scattering_b[(row + f.col.x) * g].x),
+            vec4<f32>(scattering_b[(row + f.col.y) * g].x), vec4<f32>(scattering_b[(row + f.cola.x) * g].x));
+        let c1 = mu_s_blend_at(f.mu_s, vec4<f32>(scattering_b[(row + f.colb.y) * g].x), vec4<f32>(scattering_b[(row + f.col.z) * g].x),
+            vec4<f32>(scattering_b[(row + f.col.w) * g].x), vec4<f32>(scattering_b[(row + f.cola.y) * g].x));
+        return f.wnu.x * c0.x + f.wnu.y * c1.x;
     }
     return f.wcol.x * scattering_b[(row + f.col.x) * g].x + f.wcol.y * scattering_b[(row + f.col.y) * g].x
         + f.wcol.z * scattering_b[(row + f.col.z) * g].x + f.wcol.w * scattering_b[(row + f.col.w) * g].x;
@@ -231,6 +232,13 @@ fn sample_mie_red(v: View, f: Filter4) -> f32 {
 // Tables::multiple), as sample_scattering_a does for slot a.
 fn multiple_row(f: Filter4, row: u32, k: u32) -> vec4<f32> {
     let g = atm.groups;
+    if (f.mu_s.twilight) {
+        let c0 = mu_s_blend_at(f.mu_s, multiple_table[(row + f.colb.x) * g + k], multiple_table[(row + f.col.x) * g + k],
+            multiple_table[(row + f.col.y) * g + k], multiple_table[(row + f.cola.x) * g + k]);
+        let c1 = mu_s_blend_at(f.mu_s, multiple_table[(row + f.colb.y) * g + k], multiple_table[(row + f.col.z) * g + k],
+            multiple_table[(row + f.col.w) * g + k], multiple_table[(row + f.cola.y) * g + k]);
+        return f.wnu.x * c0 + f.wnu.y * c1;
+    }
     return f.wcol.x * multiple_table[(row + f.col.x) * g + k] + f.wcol.y * multiple_table[(row + f.col.y) * g + k]
         + f.wcol.z * multiple_table[(row + f.col.z) * g + k] + f.wcol.w * multiple_table[(row + f.col.w) * g + k];
 }
@@ -589,29 +597,51 @@ fn camera_slice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     let y = e / atm.scattering_nu;
     let nu = e % atm.scattering_nu;
     let at = slice_coordinates.at[light];
-    let ls = lerp_weights(at.x, atm.scattering_mu_s);
+    let m = mu_s_filter(at.x, atm.scattering_mu_s, atm.mu_s_twilight_cells);
     let lz = lerp_weights(at.y, atm.scattering_r);
     let width = scattering_width();
-    // Texels (z_a, s_b) with weights wz·ws, as Table4::slice sums them.
-    let rows = (vec4<u32>(lz.i0, lz.i0, lz.i1, lz.i1) * atm.scattering_mu + y) * width;
-    let texels = rows + nu * atm.scattering_mu_s + vec4<u32>(ls.i0, ls.i1, ls.i0, ls.i1);
-    let w = vec4<f32>(1.0 - lz.t, 1.0 - lz.t, lz.t, lz.t) * vec4<f32>(1.0 - ls.t, ls.t, 1.0 - ls.t, ls.t);
-    let scattering = w.x * scattering_a[texels.x * g + k] + w.y * scattering_a[texels.y * g + k]
-        + w.z * scattering_a[texels.z * g + k] + w.w * scattering_a[texels.w * g + k];
-    let multiple = w.x * multiple_table[texels.x * g + k] + w.y * multiple_table[texels.y * g + k]
-        + w.z * multiple_table[texels.z * g + k] + w.w * multiple_table[texels.w * g + k];
-    var mie = vec4<f32>(0.0);
     let mie_layout = slice_coordinates.mie_layout;
-    if (mie_layout == 0u) {
-        mie = w.x * scattering_b[texels.x * g + k] + w.y * scattering_b[texels.y * g + k]
-            + w.z * scattering_b[texels.z * g + k] + w.w * scattering_b[texels.w * g + k];
-    } else if (k == 0u) {
-        var gm = g;
-        if (mie_layout == 1u) {
-            gm = 1u;
+    var gm = g;
+    if (mie_layout == 1u) {
+        gm = 1u;
+    }
+    var scattering = vec4<f32>(0.0);
+    var multiple = vec4<f32>(0.0);
+    var mie = vec4<f32>(0.0);
+    if (m.twilight) {
+        // Table4::slice in a twilight cell: the twilight blend along μ_s per r row, then
+        // linear in r.
+        let rows = (vec2<u32>(lz.i0, lz.i1) * atm.scattering_mu + y) * width + nu * atm.scattering_mu_s;
+        let wz = vec2<f32>(1.0 - lz.t, lz.t);
+        for (var a = 0u; a < 2u; a++) {
+            let base = select(rows.x, rows.y, a == 1u);
+            let w = select(wz.x, wz.y, a == 1u);
+            let t = vec4<u32>(base + m.below, base + m.s0, base + m.s1, base + m.above);
+            scattering += w * mu_s_blend_at(m, scattering_a[t.x * g + k], scattering_a[t.y * g + k], scattering_a[t.z * g + k], scattering_a[t.w * g + k]);
+            multiple += w * mu_s_blend_at(m, multiple_table[t.x * g + k], multiple_table[t.y * g + k], multiple_table[t.z * g + k], multiple_table[t.w * g + k]);
+            if (mie_layout == 0u) {
+                mie += w * mu_s_blend_at(m, scattering_b[t.x * g + k], scattering_b[t.y * g + k], scattering_b[t.z * g + k], scattering_b[t.w * g + k]);
+            } else if (k == 0u) {
+                mie.x += w * mu_s_blend_at(m, vec4<f32>(scattering_b[t.x * gm].x), vec4<f32>(scattering_b[t.y * gm].x),
+                    vec4<f32>(scattering_b[t.z * gm].x), vec4<f32>(scattering_b[t.w * gm].x)).x;
+            }
         }
-        mie.x = w.x * scattering_b[texels.x * gm].x + w.y * scattering_b[texels.y * gm].x
-            + w.z * scattering_b[texels.z * gm].x + w.w * scattering_b[texels.w * gm].x;
+    } else {
+        // Texels (z_a, s_b) with weights wz·ws, as Table4::slice sums them.
+        let rows = (vec4<u32>(lz.i0, lz.i0, lz.i1, lz.i1) * atm.scattering_mu + y) * width;
+        let texels = rows + nu * atm.scattering_mu_s + vec4<u32>(m.s0, m.s1, m.s0, m.s1);
+        let w = vec4<f32>(1.0 - lz.t, 1.0 - lz.t, lz.t, lz.t) * vec4<f32>(1.0 - m.t, m.t, 1.0 - m.t, m.t);
+        scattering = w.x * scattering_a[texels.x * g + k] + w.y * scattering_a[texels.y * g + k]
+            + w.z * scattering_a[texels.z * g + k] + w.w * scattering_a[texels.w * g + k];
+        multiple = w.x * multiple_table[texels.x * g + k] + w.y * multiple_table[texels.y * g + k]
+            + w.z * multiple_table[texels.z * g + k] + w.w * multiple_table[texels.w * g + k];
+        if (mie_layout == 0u) {
+            mie = w.x * scattering_b[texels.x * g + k] + w.y * scattering_b[texels.y * g + k]
+                + w.z * scattering_b[texels.z * g + k] + w.w * scattering_b[texels.w * g + k];
+        } else if (k == 0u) {
+            mie.x = w.x * scattering_b[texels.x * gm].x + w.y * scattering_b[texels.y * gm].x
+                + w.z * scattering_b[texels.z * gm].x + w.w * scattering_b[texels.w * gm].x;
+        }
     }
     let o = i * SLICE_TABLES * g;
     slice_table[o + k] = scattering;

@@ -43,6 +43,10 @@ struct Atmosphere {
     phase1_c: f32,
     group0_present: u32,
     group1_present: u32,
+    // The μ_s cells of the scattering and the irradiance tables that take the twilight
+    // blend (firmament::sky::bruneton4d::mu_s_blend::twilight_cells, irradiance_twilight_cells).
+    mu_s_twilight_cells: u32,
+    irradiance_twilight_cells: u32,
 }
 
 // Which radiance field a pass reads (0: single scattering, phase functions applied at lookup;

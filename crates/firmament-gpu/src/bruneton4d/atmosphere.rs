@@ -8,7 +8,7 @@ use firmament::atmosphere::groups::{AEROSOLS, MOLECULES};
 use firmament::atmosphere::{Model, ScatteringGroups};
 use firmament::math::sphere::distance_to_top_atmosphere_boundary;
 use firmament::medium::PhaseFunction;
-use firmament::sky::bruneton4d::{params, TableSizes};
+use firmament::sky::bruneton4d::{mu_s_blend, params, TableSizes};
 
 /// Wavelengths per channel group (one vec4).
 pub const GROUP: usize = 4;
@@ -153,6 +153,17 @@ pub fn pack(model: &Model, sizes: &TableSizes) -> Packed {
     uniform.extend_from_slice(&phase1);
     uniform.push(groups_info.present(MOLECULES) as u32);
     uniform.push(groups_info.present(AEROSOLS) as u32);
+    // The μ_s cells of the scattering and irradiance tables that take the twilight blend
+    // (mu_s_blend.wgsl), counted in f64 as on the CPU.
+    let radii = params::Radii {
+        bottom,
+        top,
+        mu_s_min: model.mu_s_min,
+    };
+    uniform.push(u(mu_s_blend::twilight_cells(&radii, sizes.scattering_mu_s)));
+    uniform.push(u(mu_s_blend::irradiance_twilight_cells(
+        sizes.irradiance_mu_s,
+    )));
     while !uniform.len().is_multiple_of(4) {
         uniform.push(0);
     }
@@ -169,7 +180,7 @@ mod tests {
     fn uniform_has_the_shader_struct_size() {
         let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
         let p = pack(&model, &TableSizes::small());
-        // 37 fields of the WGSL `Atmosphere` struct, padded to 16 bytes.
+        // 39 fields of the WGSL `Atmosphere` struct, padded to 16 bytes.
         assert_eq!(p.uniform.len(), 40);
         assert_eq!(p.data.len() % 4, 0);
         assert!(model.groups.present(MOLECULES));

@@ -31,8 +31,29 @@ fn multiple_sample(t: ScatteringTexel, d_km: f32, k: u32) -> MultipleSample {
     s.t = transmittance(t.r_km, t.rho_km, t.mu, d_km, t.ground, k);
     let altitude_km = altitude_of(rho_d_km, r_d_km);
     s.f = (group_scattering(0u, altitude_km, k) + group_scattering(1u, altitude_km, k)) * s.t;
-    s.j = sample_scattering_a(f, k);
+    s.j = sample_density_rows_first(f, k);
     return s;
+}
+
+// ΔJ at slot a at one column of the filter, (r, μ)-filtered.
+fn density_column(f: Filter4, col: u32, k: u32) -> vec4<f32> {
+    let g = atm.groups;
+    return f.wrow.x * scattering_a[(f.row.x + col) * g + k] + f.wrow.y * scattering_a[(f.row.y + col) * g + k]
+        + f.wrow.z * scattering_a[(f.row.z + col) * g + k] + f.wrow.w * scattering_a[(f.row.w + col) * g + k];
+}
+
+// ΔJ at a sample as compute_multiple_scattering filters it: in a twilight cell along μ_s
+// the (μ, r)-filtered columns blended along μ_s (mu_s_blend.wgsl), then in ν; else the
+// plain lookup.
+fn sample_density_rows_first(f: Filter4, k: u32) -> vec4<f32> {
+    if (!f.mu_s.twilight) {
+        return sample_scattering_a(f, k);
+    }
+    let c0 = mu_s_blend_at(f.mu_s, density_column(f, f.colb.x, k), density_column(f, f.col.x, k),
+        density_column(f, f.col.y, k), density_column(f, f.cola.x, k));
+    let c1 = mu_s_blend_at(f.mu_s, density_column(f, f.colb.y, k), density_column(f, f.col.z, k),
+        density_column(f, f.col.w, k), density_column(f, f.cola.y, k));
+    return f.wnu.x * c0 + f.wnu.y * c1;
 }
 
 @compute @workgroup_size(64)

@@ -6,6 +6,7 @@
 //! the cosine of the view ray's zenith angle there, μ_s the sun's; outputs per channel,
 //! transmittances in [0, 1], irradiance in W·m⁻²·nm⁻¹.
 
+use super::mu_s_blend::{irradiance_twilight_cells, twilight_cells};
 use super::params::{self, Radii, TableSizes};
 use super::table::{Table2, MAX_OPTICAL_DEPTH};
 use crate::atmosphere::Model;
@@ -28,17 +29,25 @@ pub struct Lookup<'a> {
     /// Angular radius of the light (rad): the sun's in the precomputation, the lit
     /// view's light when rendering.
     pub sun_angular_radius: f64,
+    /// The μ_s cells of the scattering tables that take the twilight blend
+    /// ([`super::mu_s_blend::twilight_cells`]).
+    pub twilight_cells: usize,
+    /// The same for the irradiance table ([`super::mu_s_blend::irradiance_twilight_cells`]).
+    pub irradiance_twilight_cells: usize,
 }
 
 impl<'a> Lookup<'a> {
     /// Lookup context for a model.
     pub fn new(model: &Model, sizes: TableSizes, optical_depth: &'a Table2) -> Self {
+        let radii = Radii {
+            bottom: model.bottom_radius_m,
+            top: model.top_radius_m,
+            mu_s_min: model.mu_s_min,
+        };
         Lookup {
-            radii: Radii {
-                bottom: model.bottom_radius_m,
-                top: model.top_radius_m,
-                mu_s_min: model.mu_s_min,
-            },
+            radii,
+            twilight_cells: twilight_cells(&radii, sizes.scattering_mu_s),
+            irradiance_twilight_cells: irradiance_twilight_cells(sizes.irradiance_mu_s),
             sizes,
             optical_depth,
             sun_angular_radius: model.sun_angular_radius_rad,
@@ -137,7 +146,8 @@ impl<'a> Lookup<'a> {
     }
 
     /// Irradiance-table lookup at (r, μ_s): for [`super::Tables::irradiance`], the sky's
-    /// irradiance (W·m⁻²·nm⁻¹) on a horizontal surface at radius r.
+    /// irradiance (W·m⁻²·nm⁻¹) on a horizontal surface at radius r; the twilight blend of
+    /// [`super::mu_s_blend`] for a sun below the horizon.
     #[inline]
     pub fn irradiance(&self, table: &Table2, r: f64, mu_s: f64, out: &mut [f64]) {
         let (u, v) = params::irradiance_uv(
@@ -147,6 +157,6 @@ impl<'a> Lookup<'a> {
             self.sizes.irradiance_mu_s,
             self.sizes.irradiance_r,
         );
-        table.sample_into(u, v, out);
+        table.sample_twilight_into(u, v, self.irradiance_twilight_cells, out);
     }
 }

@@ -9,6 +9,7 @@ pub mod cache;
 pub mod compact;
 pub mod file;
 pub mod lookup;
+pub mod mu_s_blend;
 pub mod params;
 pub mod precompute;
 pub mod table;

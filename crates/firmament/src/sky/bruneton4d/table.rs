@@ -3,6 +3,7 @@
 //! table the packing of Bruneton 2017 (ν and μ_s share the x axis; two 3D fetches and a
 //! manual lerp along ν), so CPU and GPU tables compare texel by texel.
 
+use super::mu_s_blend::{blend_at, MuSFilter};
 use super::params::TableSizes;
 
 /// Linear-filter weights for texture coordinate `u` over `n` texels: (i0, i1, t).
@@ -107,6 +108,23 @@ impl Table2 {
         }
     }
 
+    /// As [`Table2::sample_into`] for a table whose x axis is μ_s: the first
+    /// `twilight_cells` cells along x take the twilight blend ([`super::mu_s_blend`]) per
+    /// row, then the rows are blended linearly.
+    #[inline]
+    pub fn sample_twilight_into(&self, u: f64, v: f64, twilight_cells: usize, out: &mut [f64]) {
+        let s = MuSFilter::new(u, self.width, twilight_cells);
+        if !s.geometric {
+            return self.sample_into(u, v, out);
+        }
+        let (y0, y1, ty) = lerp_weights(v, self.height);
+        let c = self.channels;
+        for k in 0..c {
+            let row = |y: usize| blend_at(&self.data, y * self.width * c + k, c, &s);
+            out[k] = (1.0 - ty) * row(y0) + ty * row(y1);
+        }
+    }
+
     /// Element-wise a += b.
     pub fn add_assign(&mut self, other: &Table2) {
         for (a, b) in self.data.iter_mut().zip(&other.data) {
@@ -175,21 +193,23 @@ impl Table4 {
     }
 
     /// Sample at (u_ν, u_μs, u_μ, u_r) into `out` (overwritten), Bruneton 2017's
-    /// `GetScattering`: trilinear in (μ_s, μ, r) at the two nearest ν slices, then a lerp.
+    /// `GetScattering`: trilinear in (μ_s, μ, r) at the two nearest ν slices, then a lerp;
+    /// the first `twilight_cells` cells along μ_s blend as twilight ([`mu_s_blend`]).
     #[inline]
-    pub fn sample_into(&self, uvwz: [f64; 4], out: &mut [f64]) {
+    pub fn sample_into(&self, uvwz: [f64; 4], twilight_cells: usize, out: &mut [f64]) {
         let (y0, y1, ty) = lerp_weights(uvwz[2], self.nmu);
         let (z0, z1, tz) = lerp_weights(uvwz[3], self.nr);
-        self.sample_rows_into(uvwz[0], uvwz[1], [y0, y1], ty, [z0, z1], tz, out);
+        let s = MuSFilter::new(uvwz[1], self.nmu_s, twilight_cells);
+        self.sample_rows_into(uvwz[0], s, [y0, y1], ty, [z0, z1], tz, out);
     }
 
-    /// As [`Table4::sample_into`] with the (μ, r) filter weights already known (rays whose
-    /// samples share them).
+    /// As [`Table4::sample_into`] with the μ_s filter and the (μ, r) filter weights already
+    /// known (rays whose samples share them).
     #[inline]
     pub fn sample_rows_into(
         &self,
         u_nu: f64,
-        u_mu_s: f64,
+        s: MuSFilter,
         y: [usize; 2],
         ty: f64,
         z: [usize; 2],
@@ -200,7 +220,7 @@ impl Table4 {
         let nu0 = (tex_x.max(0.0) as usize).min(self.nnu - 1);
         let nu1 = (nu0 + 1).min(self.nnu - 1);
         let tnu = tex_x - nu0 as f64;
-        let (s0, s1, ts) = lerp_weights(u_mu_s, self.nmu_s);
+        let (s0, s1, ts) = (s.s0, s.s1, s.t);
         let c = self.channels;
         out[..c].iter_mut().for_each(|o| *o = 0.0);
         let wy = [1.0 - ty, ty];
@@ -218,6 +238,17 @@ impl Table4 {
                 }
                 let row = (zz * self.nmu + yy) * self.width();
                 for (e, &nn) in [nu0, nu1].iter().enumerate() {
+                    if s.geometric {
+                        let w = wzy * wn[e];
+                        if w == 0.0 {
+                            continue;
+                        }
+                        let base = (row + nn * self.nmu_s) * c;
+                        for k in 0..c {
+                            out[k] += w * blend_at(&self.data, base + k, c, &s);
+                        }
+                        continue;
+                    }
                     for (f, &ss) in [s0, s1].iter().enumerate() {
                         let w = wzy * wn[e] * ws[f];
                         if w == 0.0 {
@@ -235,10 +266,12 @@ impl Table4 {
 
     /// The table filtered at fixed (u_μs, u_r): a 2D (μ, ν) slice, `[(y·nnu + ν)·channels + c]`.
     /// Sampling the slice with [`Table4::sample_slice_into`] equals [`Table4::sample_into`]
-    /// at that (u_μs, u_r): the filter is separable. Used for every pixel of a frame whose
-    /// camera and sun are fixed.
-    pub fn slice(&self, u_mu_s: f64, u_r: f64) -> Vec<f64> {
-        let (s0, s1, ts) = lerp_weights(u_mu_s, self.nmu_s);
+    /// at that (u_μs, u_r): the filter is separable, and the twilight cells' blend
+    /// ([`super::mu_s_blend`]) is made per texel before the linear filters in both. Used for every pixel of a
+    /// frame whose camera and sun are fixed.
+    pub fn slice(&self, u_mu_s: f64, u_r: f64, twilight_cells: usize) -> Vec<f64> {
+        let s = MuSFilter::new(u_mu_s, self.nmu_s, twilight_cells);
+        let (s0, s1, ts) = (s.s0, s.s1, s.t);
         let (z0, z1, tz) = lerp_weights(u_r, self.nr);
         let c = self.channels;
         let mut out = vec![0.0; self.nmu * self.nnu * c];
@@ -246,6 +279,16 @@ impl Table4 {
             for nu in 0..self.nnu {
                 let o = &mut out[(y * self.nnu + nu) * c..(y * self.nnu + nu + 1) * c];
                 for (z, wz) in [(z0, 1.0 - tz), (z1, tz)] {
+                    if s.geometric {
+                        if wz == 0.0 {
+                            continue;
+                        }
+                        let base = self.index(nu * self.nmu_s, y, z);
+                        for k in 0..c {
+                            o[k] += wz * blend_at(&self.data, base + k, c, &s);
+                        }
+                        continue;
+                    }
                     for (sx, wsx) in [(s0, 1.0 - ts), (s1, ts)] {
                         let w = wz * wsx;
                         if w == 0.0 {

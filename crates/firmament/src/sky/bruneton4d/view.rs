@@ -169,8 +169,12 @@ impl<'a> Bruneton4dView<'a> {
                     let uvwz = params::scattering_uvwz(
                         &lk.radii, &lk.sizes, r, mu, mu_s, ray.nu, ray.ground,
                     );
-                    tables.single_rayleigh.sample_into(uvwz, scat);
-                    tables.multiple.sample_into(uvwz, &mut both[n..2 * n]);
+                    tables
+                        .single_rayleigh
+                        .sample_into(uvwz, lk.twilight_cells, scat);
+                    tables
+                        .multiple
+                        .sample_into(uvwz, lk.twilight_cells, &mut both[n..2 * n]);
                     At::Table(uvwz)
                 }
             };
@@ -189,7 +193,7 @@ impl<'a> Bruneton4dView<'a> {
         let single_mie = &tables.single_mie;
         let sample = |out: &mut [f64]| match at {
             At::Slice(s, u_nu, u_mu) => single_mie.sample_slice_into(&s.mie, u_nu, u_mu, out),
-            At::Table(uvwz) => single_mie.sample_into(uvwz, out),
+            At::Table(uvwz) => single_mie.sample_into(uvwz, self.lookup.twilight_cells, out),
         };
         match (orders, tables.config.mie) {
             (Orders::Multiple, _) => mie.iter_mut().for_each(|v| *v = 0.0),
@@ -496,8 +500,12 @@ impl Slice {
         let tables = &sky.tables;
         let uvwz = params::scattering_uvwz(&lookup.radii, &lookup.sizes, r, 0.0, mu_s, 0.0, false);
         let n = sky.channels();
-        let single = tables.single_rayleigh.slice(uvwz[1], uvwz[3]);
-        let multiple = tables.multiple.slice(uvwz[1], uvwz[3]);
+        let single = tables
+            .single_rayleigh
+            .slice(uvwz[1], uvwz[3], lookup.twilight_cells);
+        let multiple = tables
+            .multiple
+            .slice(uvwz[1], uvwz[3], lookup.twilight_cells);
         let mut scattering = Vec::with_capacity(2 * single.len());
         for (a, b) in single.chunks(n).zip(multiple.chunks(n)) {
             scattering.extend_from_slice(a);
@@ -505,7 +513,9 @@ impl Slice {
         }
         Slice {
             scattering,
-            mie: tables.single_mie.slice(uvwz[1], uvwz[3]),
+            mie: tables
+                .single_mie
+                .slice(uvwz[1], uvwz[3], lookup.twilight_cells),
         }
     }
 }

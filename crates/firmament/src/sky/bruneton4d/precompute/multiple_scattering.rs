@@ -9,6 +9,7 @@ use super::ray::RaySamples;
 use super::ScatteringGrid;
 use crate::atmosphere::Model;
 use crate::sky::bruneton4d::lookup::Lookup;
+use crate::sky::bruneton4d::mu_s_blend::{hermite_exp, ln, tangent, MuSFilter};
 use crate::sky::bruneton4d::params;
 use crate::sky::bruneton4d::table::{lerp_weights, Table4};
 
@@ -33,6 +34,7 @@ pub(super) fn multiple_scattering_slices(
     let first_row = slices.start * s.scattering_mu;
     let radii = lookup.radii;
     let mu_s_positions = super::MuSPositions::new(&radii, s.scattering_mu_s);
+    let twilight_cells = lookup.twilight_cells;
     out.par_chunks_mut(row_len).enumerate().for_each(|(i, o)| {
         let row = first_row + i;
         let (z, y) = (row / s.scattering_mu, row % s.scattering_mu);
@@ -79,6 +81,38 @@ pub(super) fn multiple_scattering_slices(
         }
         let nmu_s = s.scattering_mu_s;
         let nnu = s.scattering_nu;
+        // ln ΔJ and its tangent (mu_s_blend::tangent) at the μ_s samples the twilight cells
+        // read (0 to twilight_cells of each ν column; the next sample for the last
+        // tangent), once per ray sample: `[(i·nnu + ν)·tw_s + s]·n + k`.
+        let tw_s = (twilight_cells + 1).min(nmu_s);
+        let logs: Vec<(f64, f64)> = if twilight_cells == 0 {
+            Vec::new()
+        } else {
+            let mut logs = Vec::with_capacity(count * nnu * tw_s * n);
+            let mut ln_column = vec![0.0; (tw_s + 1) * n];
+            for i in 0..count {
+                for nu in 0..nnu {
+                    let start = i * row_len + nu * nmu_s * n;
+                    let end = (start + (tw_s + 1) * n).min(start + nmu_s * n);
+                    ln_column.iter_mut().for_each(|l| *l = f64::NAN);
+                    for (l, v) in ln_column.iter_mut().zip(&blended[start..end]) {
+                        *l = ln(*v);
+                    }
+                    for s in 0..tw_s {
+                        for k in 0..n {
+                            let prev = if s == 0 {
+                                f64::NAN
+                            } else {
+                                ln_column[(s - 1) * n + k]
+                            };
+                            let l = ln_column[s * n + k];
+                            logs.push((l, tangent(prev, l, ln_column[(s + 1) * n + k])));
+                        }
+                    }
+                }
+            }
+            logs
+        };
         // Per texel: r·μ_s and ν, once.
         let texels: Vec<MultipleTexel> = (0..width)
             .map(|x| {
@@ -113,7 +147,9 @@ pub(super) fn multiple_scattering_slices(
                 let nu0 = (tex_x as i32 as usize).min(nnu - 1);
                 let nu1 = (nu0 + 1).min(nnu - 1);
                 let t_nu = tex_x - nu0 as f64;
+                let mu_s = MuSFilter::from_weights(s0, s1, ts, nmu_s, twilight_cells);
                 *f = TapFilter {
+                    twilight: mu_s.geometric.then_some((mu_s, nu0, nu1, t_nu)),
                     a0: nu0 * nmu_s + s0,
                     a1: nu0 * nmu_s + s1,
                     a2: nu1 * nmu_s + s0,
@@ -127,6 +163,24 @@ pub(super) fn multiple_scattering_slices(
             let tap = |texel: usize| &b[texel * n..][..n];
             for (a, f) in acc.chunks_exact_mut(n).zip(&filters) {
                 let (b0, b1, b2, b3) = (tap(f.a0), tap(f.a1), tap(f.a2), tap(f.a3));
+                if let Some((m, nu0, nu1, tn)) = &f.twilight {
+                    // A twilight cell: the blend along μ_s of mu_s_blend, then ν.
+                    let column = |nu: usize, k: usize| {
+                        let at = &logs[(i * nnu + nu) * tw_s * n + k..];
+                        let ((l0, m0), (l1, m1)) = (at[m.s0 * n], at[m.s1 * n]);
+                        if l0.is_finite() && l1.is_finite() {
+                            hermite_exp(l0, l1, m0, m1, m.t)
+                        } else {
+                            let v = &b[nu * nmu_s * n + k..];
+                            v[m.s0 * n] + m.t * (v[m.s1 * n] - v[m.s0 * n])
+                        }
+                    };
+                    for k in 0..n {
+                        let j = (1.0 - tn) * column(*nu0, k) + tn * column(*nu1, k);
+                        a[k] += wt_t[k] * j;
+                    }
+                    continue;
+                }
                 for k in 0..n {
                     let j = f.w0 * b0[k] + f.w1 * b1[k] + f.w2 * b2[k] + f.w3 * b3[k];
                     a[k] += wt_t[k] * j;
@@ -150,6 +204,9 @@ struct MultipleTexel {
 /// weights.
 #[derive(Clone, Copy, Default)]
 struct TapFilter {
+    /// A twilight cell along μ_s: its μ_s filter, the two ν columns and t_ν, blended by
+    /// `mu_s_blend`'s Hermite rather than by w0–w3.
+    twilight: Option<(MuSFilter, usize, usize, f64)>,
     a0: usize,
     a1: usize,
     a2: usize,
