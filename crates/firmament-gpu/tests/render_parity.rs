@@ -152,7 +152,7 @@ fn twilight_between_the_tables_sun_samples() {
             96.5,
         ),
     ] {
-        let cam = camera(Projection::Fisheye, altitude_m, 0.0, pitch_deg, 60.0);
+        let cam = camera(Projection::Perspective, altitude_m, 80.0, pitch_deg, 90.0);
         let settings = RenderSettings {
             camera: &cam,
             width: 64,
