@@ -204,6 +204,36 @@ pub fn compute_tables(model: &Model, config: &TableConfig, quiet: bool) -> Resul
     Ok(tables)
 }
 
+/// The clouds of a scene file over a planet of `planet_radius_m`, their noise textures
+/// from the user's cache directory ([`TableCache::from_env`]) or computed (about 2 s) and
+/// kept there, with a line on stderr (unless `quiet`).
+pub fn scene_clouds(
+    scene: &firmament::scene::SceneFile,
+    planet_radius_m: f64,
+    quiet: bool,
+) -> Result<Vec<firmament::scene::clouds::CloudMedium>> {
+    if scene.clouds.is_empty() {
+        return Ok(Vec::new());
+    }
+    let started = Instant::now();
+    let cache = TableCache::from_env()?.map(|c| c.dir);
+    let clouds = scene.build_clouds(planet_radius_m, cache.as_deref())?;
+    if !quiet {
+        eprintln!(
+            "clouds: {} layer{} ({}) ready in {:.2} s",
+            clouds.len(),
+            if clouds.len() == 1 { "" } else { "s" },
+            clouds
+                .iter()
+                .map(|c| format!("{:?} {:.0}–{:.0} m", c.layer.params.kind, c.layer.params.bottom_m, c.layer.params.top_m).to_lowercase())
+                .collect::<Vec<_>>()
+                .join(", "),
+            started.elapsed().as_secs_f64()
+        );
+    }
+    Ok(clouds)
+}
+
 /// The tables from the user's cache ([`TableCache::from_env`]), or computed and cached
 /// there, with a line on stderr saying which (unless `quiet`) and a warning when a cached
 /// file was unusable (deleted, computed again) or the tables could not be cached.

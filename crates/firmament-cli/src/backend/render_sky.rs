@@ -11,6 +11,7 @@ use firmament::math::Vec3;
 use firmament::render::aerial_volume::AerialVolumeConfig;
 use firmament::render::{stars, Frame, RenderSettings};
 use firmament::scene::planet::PlanetSurface;
+use firmament::scene::clouds::CloudMedium;
 use firmament::scene::sky_lights::SkySources;
 use firmament::scene::terrain::Heightfield;
 use firmament::scene::{Scene, Surface};
@@ -191,8 +192,14 @@ impl<'a> RenderSky<'a> {
         sources: &SkySources,
         terrain: Option<&Heightfield>,
         planet: Option<&PlanetSurface>,
+        clouds: &[CloudMedium],
         quiet: bool,
     ) -> Result<Frame> {
+        if !clouds.is_empty() && !matches!(self, RenderSky::Cpu(..)) {
+            anyhow::bail!(
+                "clouds ([[clouds]]) render on the CPU only so far: use `--backend cpu` (or `auto`)"
+            );
+        }
         if terrain.is_some() && matches!(self, RenderSky::GpuHillaire { .. }) {
             anyhow::bail!(
                 "`--method hillaire2020` draws terrain on the CPU only so far: use `--backend cpu` (or `auto`)"
@@ -214,6 +221,9 @@ impl<'a> RenderSky<'a> {
                 bar.set_message("rendering");
                 let mut scene = cpu_scene(sky.method(), sources, terrain, planet);
                 scene.aerial_volume = *aerial;
+                for c in clouds {
+                    scene.volumes.push(Box::new(c));
+                }
                 let frame = firmament::render::render(
                     &scene,
                     settings,

@@ -169,12 +169,13 @@ pub fn render_scene(
     let camera = scene.camera_over(terrain, sky.model().bottom_radius_m);
     let radius = terrain.map_or(sky.model().bottom_radius_m, |t| t.radius_m);
     let planet = scene.build_surface(radius, sky.model().wavelengths.nm())?;
+    let clouds = crate::common::scene_clouds(scene, radius, quiet)?;
     let settings = RenderSettings {
         camera: &camera,
         ..render_settings(scene)
     };
     let frame = sky
-        .render(&settings, &sources, terrain, planet.as_ref(), quiet)
+        .render(&settings, &sources, terrain, planet.as_ref(), &clouds, quiet)
         .context("rendering")?;
     let ev100 = ev100(scene, &frame);
     Ok((frame, ev100))
@@ -283,6 +284,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             anyhow::bail!(
                 "the planet's surface map ([surface]) renders on the CPU only so far: `--backend cpu` or `auto` render it"
             )
+        }
+        Backend::Gpu(_) if !scene.clouds.is_empty() && args.backend == BackendChoice::Gpu => {
+            anyhow::bail!(
+                "clouds ([[clouds]]) render on the CPU only so far: `--backend cpu` or `auto` render them"
+            )
+        }
+        Backend::Gpu(_) if !scene.clouds.is_empty() => {
+            if !args.quiet {
+                eprintln!("note: clouds render on the CPU only so far: using the CPU");
+            }
+            Backend::Cpu
         }
         Backend::Gpu(_) if scene.surface.is_some() => {
             if !args.quiet {

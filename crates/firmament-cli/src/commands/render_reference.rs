@@ -9,7 +9,7 @@ use firmament::atmosphere::Model;
 use firmament::reference::{self, Progress, ReferenceSettings};
 use firmament::render::{self, RenderSettings};
 use firmament::scene::terrain::Heightfield;
-use firmament::scene::{Light, SceneFile as Scene, Surface};
+use firmament::scene::{Light, SceneFile as Scene, Surface, Volume};
 
 use super::render::{ev100, render_settings, sources_of_scene};
 use crate::common::{cancel_flag, check_reference_samples, drawn_bar};
@@ -21,6 +21,7 @@ const PILOT_WIDTH: usize = 12;
 /// view (the same mix of sky, ground and terrain), its time per pixel times the pixels.
 fn estimate_s(
     model: &Model,
+    volumes: &[Box<dyn Volume + '_>],
     surfaces: &[Box<dyn Surface + '_>],
     settings: &RenderSettings,
     sun: &Light,
@@ -36,7 +37,7 @@ fn estimate_s(
     };
     let t = Instant::now();
     let (frame, _) =
-        reference::render_frame(model, &[], surfaces, &pilot, sun, reference, &|_| {}, None)?;
+        reference::render_frame(model, volumes, surfaces, &pilot, sun, reference, &|_| {}, None)?;
     let traced = frame.mask.iter().filter(|&&m| m).count().max(1);
     let per_pixel = t.elapsed().as_secs_f64() / traced as f64;
     let full = w * h * traced / (pw * ph);
@@ -62,6 +63,9 @@ pub fn render_scene_reference(
     }
     let sun = &lights[0];
     let surfaces: Vec<Box<dyn Surface + '_>> = terrain.iter().map(|t| Box::new(*t) as _).collect();
+    let radius = terrain.map_or(model.bottom_radius_m, |t| t.radius_m);
+    let clouds = crate::common::scene_clouds(scene, radius, quiet)?;
+    let volumes: Vec<Box<dyn Volume + '_>> = clouds.iter().map(|c| Box::new(c) as _).collect();
     let camera = scene.camera_over(terrain, model.bottom_radius_m);
     let settings = RenderSettings {
         camera: &camera,
@@ -69,7 +73,7 @@ pub fn render_scene_reference(
     };
     let reference = ReferenceSettings::with_samples(samples);
     if !quiet {
-        let estimate = estimate_s(model, &surfaces, &settings, sun, &reference)?;
+        let estimate = estimate_s(model, &volumes, &surfaces, &settings, sun, &reference)?;
         eprintln!(
             "reference: {}×{} at {samples} paths/λ, about {} (estimated from a {PILOT_WIDTH}-pixel-wide pilot); Ctrl-C stops it",
             settings.width,
@@ -85,7 +89,7 @@ pub fn render_scene_reference(
     bar.set_message(format!("{samples} paths/λ"));
     let result = reference::render_frame(
         model,
-        &[],
+        &volumes,
         &surfaces,
         &settings,
         sun,

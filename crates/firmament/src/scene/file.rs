@@ -159,6 +159,9 @@ pub struct SceneFile {
     /// and ice, and the sun's glint (none: the atmosphere's uniform ground albedo).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub surface: Option<super::planet_config::SurfaceConfig>,
+    /// Cloud layers (`[[clouds]]`), none by default in a file.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub clouds: Vec<super::clouds::CloudLayerConfig>,
     /// Output.
     pub output: SceneOutput,
 }
@@ -202,6 +205,7 @@ impl Default for SceneFile {
             time: None,
             terrain: Some(TerrainConfig::default()),
             surface: None,
+            clouds: Vec::new(),
             output: SceneOutput {
                 ev100: None,
                 tonemap: ToneCurve::Aces,
@@ -245,6 +249,9 @@ impl SceneFile {
         }
         if let (Some(s), Some(dir)) = (&mut scene.surface, path.parent()) {
             s.resolve_paths(dir);
+        }
+        if let Some(dir) = path.parent() {
+            scene.clouds.iter_mut().for_each(|c| c.resolve_paths(dir));
         }
         scene.validate()?;
         Ok(scene)
@@ -308,6 +315,21 @@ impl SceneFile {
         camera
     }
 
+    /// The cloud layers' volumes over a planet of `planet_radius_m`, their noise textures
+    /// read from (or computed into) the cache directory `cache`; empty without `[[clouds]]`.
+    pub fn build_clouds(
+        &self,
+        planet_radius_m: f64,
+        cache: Option<&Path>,
+    ) -> Result<Vec<super::clouds::CloudMedium>> {
+        if self.clouds.is_empty() {
+            return Ok(Vec::new());
+        }
+        let sizes = [super::clouds::BASE_SHAPE_SIZE, super::clouds::EROSION_SIZE];
+        let (noise, _) = super::clouds::CloudNoise::new(sizes, cache)?;
+        super::clouds::cloud_media(&self.clouds, planet_radius_m, &noise)
+    }
+
     /// Check every value; messages name the field.
     pub fn validate(&self) -> Result<()> {
         self.camera.validate()?;
@@ -364,6 +386,7 @@ impl SceneFile {
         if let Some(s) = &self.surface {
             s.validate()?;
         }
+        super::clouds::validate_layers(&self.clouds)?;
         if let Some(ev) = self.output.ev100 {
             if !(ev.is_finite() && (-20.0..=30.0).contains(&ev)) {
                 return Err(Error::invalid("output.ev100", ev, "a number in [-20, 30]"));

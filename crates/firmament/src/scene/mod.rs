@@ -6,6 +6,7 @@
 //! on the +z axis, whose local frame is x = east, y = north, z = up.
 
 pub mod camera;
+pub mod clouds;
 pub mod file;
 pub mod light;
 pub mod lunar;
@@ -20,7 +21,7 @@ pub use camera::{Camera, PreparedCamera, Projection, Ray};
 pub use file::SceneFile;
 pub use light::{DiskProfile, Light};
 pub use surface::{Relief, Sphere, Surface, SurfaceHit};
-pub use volume::{HomogeneousSphere, Volume};
+pub use volume::{HomogeneousSphere, Octaves, Volume};
 
 use crate::math::{direction_from_zenith_azimuth, Vec3};
 use crate::sky::SkyMethod;

@@ -28,6 +28,106 @@ pub trait Volume: Send + Sync {
 
     /// The optical depth of `channel` along `ray` over [t0, t1].
     fn optical_depth(&self, ray: &Ray, t0: f64, t1: f64, channel: usize) -> f64;
+
+    /// Whether the coefficients are the same in every channel (then the renderer asks the
+    /// estimates below once, for channel 0).
+    fn is_grey(&self) -> bool {
+        false
+    }
+
+    /// The renderer's multiple scattering by octaves (Wrenninge 2015); by default one octave:
+    /// single scattering.
+    fn octaves(&self) -> Octaves {
+        Octaves::SINGLE
+    }
+
+    /// The renderer's estimate of the optical depth of `channel` from `ray.origin` towards a
+    /// light along `ray.dir` (to infinity), `jitter` ∈ [0, 1) placing the samples of a
+    /// march; by default the exact [`Volume::optical_depth`].
+    fn light_optical_depth(&self, ray: &Ray, channel: usize, _jitter: f64) -> f64 {
+        self.optical_depth(ray, 0.0, f64::INFINITY, channel)
+    }
+
+    /// The optical depths of `channel` from `point` straight up and straight down through
+    /// the volume, which dim the ambient light from the sky above and the ground below; by
+    /// default none.
+    fn vertical_optical_depths(&self, _point: Vec3, _channel: usize) -> [f64; 2] {
+        [0.0; 2]
+    }
+
+    /// The scale (m) of the volume's smallest features: the renderer's march steps at about
+    /// this length (growing with distance) instead of by optical depth; None: by optical
+    /// depth.
+    fn feature_size_m(&self) -> Option<f64> {
+        None
+    }
+}
+
+/// A borrowed volume is a volume (a scene can hold volumes it does not own, such as the
+/// clouds a program builds once for many frames).
+impl<V: Volume + ?Sized> Volume for &V {
+    fn bounds(&self, ray: &Ray) -> Option<(f64, f64)> {
+        (**self).bounds(ray)
+    }
+    fn coefficients(&self, point: Vec3, extinction: &mut [f64], scattering: &mut [f64]) {
+        (**self).coefficients(point, extinction, scattering)
+    }
+    fn phase(&self, point: Vec3) -> &PhaseFunction {
+        (**self).phase(point)
+    }
+    fn majorant(&self, ray: &Ray, t0: f64, t1: f64, channel: usize) -> f64 {
+        (**self).majorant(ray, t0, t1, channel)
+    }
+    fn optical_depth(&self, ray: &Ray, t0: f64, t1: f64, channel: usize) -> f64 {
+        (**self).optical_depth(ray, t0, t1, channel)
+    }
+    fn is_grey(&self) -> bool {
+        (**self).is_grey()
+    }
+    fn octaves(&self) -> Octaves {
+        (**self).octaves()
+    }
+    fn light_optical_depth(&self, ray: &Ray, channel: usize, jitter: f64) -> f64 {
+        (**self).light_optical_depth(ray, channel, jitter)
+    }
+    fn vertical_optical_depths(&self, point: Vec3, channel: usize) -> [f64; 2] {
+        (**self).vertical_optical_depths(point, channel)
+    }
+    fn feature_size_m(&self) -> Option<f64> {
+        (**self).feature_size_m()
+    }
+}
+
+/// Multiple scattering by octaves (Wrenninge 2015, "Art-directable multiple scattering";
+/// Hillaire 2016 §5.6): octave n scatters aⁿ·σ_s with the extinction towards the light
+/// bⁿ·σ_t and the phase asymmetry cⁿ·g, and the octaves are summed. With a ≤ b no octave's
+/// effective albedo aⁿσ_s/(bⁿσ_t) exceeds the medium's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Octaves {
+    /// Number of octaves (1: single scattering).
+    pub count: u32,
+    /// a: the scattering gain per octave.
+    pub scattering: f64,
+    /// b: the extinction gain per octave.
+    pub extinction: f64,
+    /// c: the phase asymmetry gain per octave.
+    pub eccentricity: f64,
+}
+
+impl Octaves {
+    /// Single scattering.
+    pub const SINGLE: Octaves = Octaves {
+        count: 1,
+        scattering: 1.0,
+        extinction: 1.0,
+        eccentricity: 1.0,
+    };
+
+    /// Octave n's effective single-scattering albedo for a medium of albedo `albedo`:
+    /// aⁿ·albedo/bⁿ.
+    pub fn effective_albedo(&self, n: u32, albedo: f64) -> f64 {
+        albedo * (self.scattering / self.extinction).powi(n as i32)
+    }
 }
 
 /// A ball of homogeneous medium (a cloud puff, a test case with closed forms: the

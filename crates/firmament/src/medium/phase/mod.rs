@@ -196,6 +196,26 @@ impl PhaseFunction {
         }
     }
 
+    /// [`PhaseFunction::eval`] with the asymmetry parameters scaled by `scale` ∈ [0, 1]
+    /// (Henyey–Greenstein, its dual lobe, Schlick, Cornette–Shanks; the others unchanged):
+    /// the phase of a higher octave of multiple scattering (Wrenninge 2015), g·cⁿ.
+    #[inline]
+    pub fn eval_scaled(&self, cos_theta: f64, scale: f64) -> f64 {
+        if scale == 1.0 {
+            return self.eval(cos_theta);
+        }
+        let mu = cos_theta.clamp(-1.0, 1.0);
+        match self {
+            PhaseFunction::HenyeyGreenstein { g } => hg(g * scale, mu),
+            PhaseFunction::CornetteShanks { g } => cornette_shanks(g * scale, mu),
+            PhaseFunction::Schlick { g } => PhaseFunction::Schlick { g: g * scale }.eval(mu),
+            PhaseFunction::DualLobeHg { g1, g2, weight } => {
+                weight * hg(g1 * scale, mu) + (1.0 - weight) * hg(g2 * scale, mu)
+            }
+            other => other.eval(mu),
+        }
+    }
+
     /// Samples a scattering direction from two uniform numbers in [0, 1]: returns
     /// (cos θ, φ) with φ = 2π·u2, distributed with density `eval` over the sphere.
     ///

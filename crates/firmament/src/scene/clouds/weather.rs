@@ -1,0 +1,199 @@
+//! The weather map: a world-space texture that tiles over the planet (Hillaire 2016, seed
+//! "Cloud distribution and density"; Schneider 2015) and says, at each place, how likely
+//! cloud is (the weather value w ∈ [0, 1], red), which type it is (t ∈ [0, 1], green: 0
+//! stratus … 1 cumulus) and how dark with precipitation (p ∈ [0, 1], blue).
+//!
+//! The procedural map is tileable gradient-noise fBm, histogram-equalised so that w is
+//! uniform on [0, 1]: a layer of coverage c then has cloud where w > 1 − c, i.e. over the
+//! fraction c of its area (before the 3D noise carves the shapes). A user's PNG gives the
+//! three channels directly (8 or 16 bits; grey: w only).
+
+use std::path::Path;
+
+use super::noise::perlin2;
+use super::profile::CloudKind;
+use crate::{Error, Result};
+
+/// Texels per side of the procedural map's tile.
+const PROCEDURAL_TEXELS: usize = 256;
+/// Lattice cells of the procedural coverage's lowest octave across a tile.
+const COVERAGE_CELLS: u32 = 4;
+/// Octaves of the procedural coverage.
+const COVERAGE_OCTAVES: u32 = 5;
+
+/// One tile of weather, bilinearly sampled and repeated every `tile_m` metres.
+#[derive(Clone, Debug)]
+pub struct WeatherMap {
+    /// Texels per side (x) and (y).
+    pub width: usize,
+    /// Texels in y.
+    pub height: usize,
+    /// [w, t, p] per texel, row-major from the tile's south-west corner.
+    pub texels: Vec<[f32; 3]>,
+    /// The tile's side, m.
+    pub tile_m: f64,
+}
+
+impl WeatherMap {
+    /// The procedural map of `kind` with `seed`: w equalised to uniform, t around the kind's
+    /// default type, p = 0.
+    pub fn procedural(kind: CloudKind, seed: u32, tile_m: f64) -> WeatherMap {
+        let n = PROCEDURAL_TEXELS;
+        let (t_mean, t_spread) = kind.default_type();
+        let mut raw = Vec::with_capacity(n * n);
+        let mut types = Vec::with_capacity(n * n);
+        for j in 0..n {
+            for i in 0..n {
+                let (x, y) = ((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
+                let (mut v, mut a, mut norm) = (0.0, 1.0, 0.0);
+                for o in 0..COVERAGE_OCTAVES {
+                    let f = (COVERAGE_CELLS << o) as f64;
+                    v += a * perlin2(x * f, y * f, COVERAGE_CELLS << o, seed.wrapping_add(o));
+                    norm += a;
+                    a *= 0.55;
+                }
+                raw.push(v / norm);
+                let t = perlin2(x * 2.0, y * 2.0, 2, seed ^ 0x68e3_1da4);
+                types.push((t_mean + t_spread * 1.5 * t).clamp(0.0, 1.0));
+            }
+        }
+        // Histogram equalisation: each texel's w is its rank among all.
+        let mut order: Vec<usize> = (0..raw.len()).collect();
+        order.sort_by(|&a, &b| raw[a].total_cmp(&raw[b]));
+        let mut texels = vec![[0.0f32; 3]; raw.len()];
+        for (rank, &idx) in order.iter().enumerate() {
+            texels[idx] = [
+                ((rank as f64 + 0.5) / raw.len() as f64) as f32,
+                types[idx] as f32,
+                0.0,
+            ];
+        }
+        WeatherMap {
+            width: n,
+            height: n,
+            texels,
+            tile_m,
+        }
+    }
+
+    /// A map from a PNG at `path` (red w, green t, blue p; a grey image gives w and leaves t
+    /// to the kind's default), tiling every `tile_m` metres. `field` names the setting in
+    /// errors.
+    pub fn from_png(path: &Path, kind: CloudKind, tile_m: f64, field: &str) -> Result<WeatherMap> {
+        let bad = |why: String| Error::invalid(field, path.display(), why);
+        let is_png = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        if !is_png {
+            return Err(bad("a PNG file (.png): red coverage, green type, blue precipitation".into()));
+        }
+        let image = image::ImageReader::open(path)
+            .map_err(|e| bad(format!("a readable PNG file ({e})")))?
+            .with_guessed_format()
+            .map_err(|e| bad(format!("a readable PNG file ({e})")))?;
+        if image.format() != Some(image::ImageFormat::Png) {
+            return Err(bad("a PNG file (the contents are not PNG)".into()));
+        }
+        let image = image
+            .decode()
+            .map_err(|e| bad(format!("a decodable PNG file ({e})")))?;
+        let (width, height) = (image.width() as usize, image.height() as usize);
+        if width < 2 || height < 2 {
+            return Err(bad(format!("a PNG of at least 2×2 texels, not {width}×{height}")));
+        }
+        let grey = !image.color().has_color();
+        let rgb = image.to_rgb32f();
+        let t_default = kind.default_type().0 as f32;
+        // PNG rows run top to bottom; the map's from south to north.
+        let mut texels = Vec::with_capacity(width * height);
+        for j in (0..height).rev() {
+            for i in 0..width {
+                let px = rgb.get_pixel(i as u32, j as u32).0;
+                texels.push(if grey {
+                    [px[0], t_default, 0.0]
+                } else {
+                    px
+                });
+            }
+        }
+        Ok(WeatherMap {
+            width,
+            height,
+            texels,
+            tile_m,
+        })
+    }
+
+    /// [w, t, p] at planar coordinates (x, y) (m), bilinear, repeating.
+    #[inline]
+    pub fn sample(&self, x: f64, y: f64) -> [f64; 3] {
+        let (w, h) = (self.width, self.height);
+        let u = x / self.tile_m;
+        let v = y / self.tile_m;
+        // Into [0, 1) tiles, then texels (centres at ½).
+        let fx = (u - u.floor()) * w as f64 - 0.5;
+        let fy = (v - v.floor()) * h as f64 - 0.5;
+        let (cx, cy) = (fx.floor(), fy.floor());
+        let (tx, ty) = (fx - cx, fy - cy);
+        let i0 = if cx < 0.0 { w - 1 } else { cx as usize };
+        let j0 = if cy < 0.0 { h - 1 } else { cy as usize };
+        let i1 = if i0 + 1 == w { 0 } else { i0 + 1 };
+        let j1 = if j0 + 1 == h { 0 } else { j0 + 1 };
+        let (a, b) = (self.texels[j0 * w + i0], self.texels[j0 * w + i1]);
+        let (c, d) = (self.texels[j1 * w + i0], self.texels[j1 * w + i1]);
+        std::array::from_fn(|k| {
+            let lo = a[k] as f64 + (b[k] as f64 - a[k] as f64) * tx;
+            let hi = c[k] as f64 + (d[k] as f64 - c[k] as f64) * tx;
+            lo + (hi - lo) * ty
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn procedural_weather_is_uniform_and_tiles() {
+        let map = WeatherMap::procedural(CloudKind::Cumulus, 1, 10_000.0);
+        // Equalised: the fraction of texels above 1 − c is c.
+        for c in [0.1, 0.3, 0.5, 0.8] {
+            let above = map.texels.iter().filter(|t| t[0] as f64 > 1.0 - c).count();
+            let fraction = above as f64 / map.texels.len() as f64;
+            assert!((fraction - c).abs() < 0.005, "{c}: {fraction}");
+        }
+        // Tiles: one tile over is the same, and across the seam it continues smoothly.
+        let a = map.sample(1234.0, 5678.0);
+        let b = map.sample(1234.0 + 10_000.0, 5678.0 - 20_000.0);
+        assert_eq!(a, b);
+        let step = 10_000.0 / 256.0;
+        let seam = (map.sample(-0.5 * step, 3000.0)[0] - map.sample(0.5 * step, 3000.0)[0]).abs();
+        assert!(seam < 0.1, "seam {seam}");
+        assert!(map.texels.iter().all(|t| (0.0..=1.0).contains(&t[1])));
+    }
+
+    #[test]
+    fn weather_png_of_the_wrong_format_is_refused() {
+        let dir = std::env::temp_dir().join(format!("firmament-weather-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let not_png = dir.join("weather.png");
+        std::fs::write(&not_png, b"not an image").unwrap();
+        let err = WeatherMap::from_png(&not_png, CloudKind::Cumulus, 1e4, "clouds[0].weather")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("clouds[0].weather") && err.contains("PNG"), "{err}");
+        let jpeg_name = dir.join("weather.jpg");
+        std::fs::write(&jpeg_name, b"x").unwrap();
+        assert!(WeatherMap::from_png(&jpeg_name, CloudKind::Cumulus, 1e4, "w").is_err());
+        // A real 3×2 RGB PNG reads, rows flipped to south-first.
+        let good = dir.join("good.png");
+        let img = image::RgbImage::from_fn(3, 2, |x, y| image::Rgb([(x * 100) as u8, (y * 255) as u8, 0]));
+        img.save(&good).unwrap();
+        let map = WeatherMap::from_png(&good, CloudKind::Cumulus, 1e4, "w").unwrap();
+        assert_eq!((map.width, map.height), (3, 2));
+        assert_eq!(map.texels[0][1], 1.0); // the bottom row (y = 1 in the PNG) is south
+        assert_eq!(map.texels[3][1], 0.0);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
