@@ -3,13 +3,17 @@
 //! by the weather map, the type's height profile and the two noise textures, after
 //! Schneider (2015) and Hillaire (2016, seed "Cloud distribution and density"):
 //!
-//! shape = max(0, remap(base·profile(h, t), 1 − c_w, 1, 0, 1))·c_w,
+//! c_loc = clamp(c + k·(w − ½), 0, 1),
+//! shape = max(0, remap(base·profile(h, t), 1 − c_loc, 1, 0, 1)),
 //! density = max(0, remap(shape, erosion(h)·detail, 1, 0, 1))·(1 + 2p),
 //!
-//! with c_w the weather's local coverage (a soft threshold of the weather value at 1 − c),
-//! base and detail the Perlin–Worley and Worley fBm textures, t and p the weather's type
-//! and precipitation. The medium's extinction is `extinction_per_m`·density, its
-//! scattering albedo `albedo`, its phase function two Henyey–Greenstein lobes.
+//! with c the layer's coverage, w the weather value (uniform on [0, 1]) and k its contrast,
+//! base and detail the Perlin–Worley (equalised to uniform on [0, 1]) and Worley fBm
+//! textures, t and p the weather's type and precipitation. With base uniform, the fraction
+//! of the layer's volume with cloud at the profile's peak is c_loc: the noise carves the
+//! cells, the weather gathers them into fields and clears gaps between. The medium's
+//! extinction is `extinction_per_m`·density, its scattering albedo `albedo`, its phase
+//! function two Henyey–Greenstein lobes.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -18,14 +22,13 @@ use serde::{Deserialize, Serialize};
 
 use super::noise::remap;
 use super::noise_volume::NoiseVolume;
-use super::profile::{smoothstep, CloudKind};
+use super::profile::{CloudKind};
 use super::weather::WeatherMap;
 use crate::math::Vec3;
 use crate::{Error, Result};
 
-/// Half-width of the soft threshold of the weather value (c_w from 0 to 1 over
-/// w ∈ [1 − c − s, 1 − c + s]).
-const COVERAGE_SOFTNESS: f64 = 0.08;
+/// How far the weather moves the local coverage about the layer's: c_loc = c + k·(w − ½).
+const WEATHER_CONTRAST: f64 = 1.2;
 /// How much the weather's precipitation raises the density (1 + gain·p).
 const PRECIPITATION_GAIN: f64 = 2.0;
 
@@ -42,8 +45,8 @@ pub struct CloudLayerConfig {
     /// The layer's top above the planet's surface (m).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub top_m: Option<f64>,
-    /// The fraction of the layer's area with cloud, before the noise carves it, in [0, 1]
-    /// (1 for `uniform`).
+    /// The fraction of the layer's volume with cloud at its profile's peak height, in
+    /// [0, 1] (1 for `uniform`); the weather varies it from place to place.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coverage: Option<f64>,
     /// Extinction coefficient at density 1 (m⁻¹): 0.04–0.12 for cumulus (Hillaire 2016).
@@ -155,7 +158,7 @@ impl CloudLayerConfig {
         }
     }
 
-    /// The settings with the kind's defaults where none is given: cumulus 1.5–4 km,
+    /// The settings with the kind's defaults where none is given: cumulus 1.5–3.5 km,
     /// coverage 0.45, 0.05 m⁻¹ (Hillaire 2016's 0.04–0.12); altostratus 4–5.5 km, 0.8,
     /// 0.01 m⁻¹; cirrus 8–9.5 km, 0.5, 3·10⁻⁴ m⁻¹ (optical depth ≈ 0.3, Sassen & Cho
     /// 1992's thin cirrus); uniform 1–2 km, 0.01 m⁻¹ (optical thickness 10). Phase: g
@@ -163,9 +166,9 @@ impl CloudLayerConfig {
     /// back scatter); octaves 3 with a = b = c = 0.5 (Wrenninge 2015; Hillaire 2016).
     pub fn resolved(&self) -> LayerParams {
         let (bottom, top, coverage, extinction, tile) = match self.kind {
-            CloudKind::Cumulus => (1500.0, 4000.0, 0.45, 0.05, 6000.0),
-            CloudKind::Altostratus => (4000.0, 5500.0, 0.8, 0.01, 12_000.0),
-            CloudKind::Cirrus => (8000.0, 9500.0, 0.5, 3e-4, 20_000.0),
+            CloudKind::Cumulus => (1500.0, 3500.0, 0.45, 0.05, 10_000.0),
+            CloudKind::Altostratus => (4000.0, 5500.0, 0.8, 0.01, 20_000.0),
+            CloudKind::Cirrus => (8000.0, 9500.0, 0.5, 3e-4, 30_000.0),
             CloudKind::Uniform => (1000.0, 2000.0, 1.0, 0.01, 6000.0),
         };
         LayerParams {
@@ -368,24 +371,25 @@ impl CloudLayer {
         };
         let (x, y) = self.planar(point / r);
         let (x, y) = (x + self.params.wind_offset_m[0], y + self.params.wind_offset_m[1]);
-        let [w, t, precipitation] = weather.sample(x, y);
-        let c = self.params.coverage;
-        let cw = smoothstep(1.0 - c - COVERAGE_SOFTNESS, 1.0 - c + COVERAGE_SOFTNESS, w);
+        let [w, t, precipitation, warp_x, warp_y] = weather.sample(x, y);
+        let c = (self.params.coverage + WEATHER_CONTRAST * (w - 0.5)).clamp(0.0, 1.0);
         let profile = self.params.kind.density(h, t);
-        // The shape is 0 unless base·profile > 1 − c_w, and base ≤ 1.
-        if cw <= 0.0 || profile + cw <= 1.0 {
+        // The shape is 0 unless base·profile > 1 − c, and base ≤ 1.
+        if profile <= 1.0 - c {
             return 0.0;
         }
         let [_, shape_tile, detail_tile] = self.params.tiles_m;
         let stretch = self.params.kind.horizontal_stretch();
         let z = r - rb;
-        let b = base.sample([x / shape_tile, y / shape_tile, z * stretch / shape_tile]);
-        let shape = remap(b * profile, 1.0 - cw, 1.0, 0.0, 1.0).max(0.0) * cw;
+        let (u, v) = (x / shape_tile + warp_x, y / shape_tile + warp_y);
+        let b = base.sample([u, v, z * stretch / shape_tile]);
+        let shape = remap(b * profile, 1.0 - c, 1.0, 0.0, 1.0).max(0.0);
         if shape <= 0.0 {
             return 0.0;
         }
         let e = self.params.kind.erosion(h);
-        let d = detail.sample([x / detail_tile, y / detail_tile, z * stretch / detail_tile]);
+        let k = shape_tile / detail_tile;
+        let d = detail.sample([u * k, v * k, z * stretch / detail_tile]);
         let eroded = remap(shape, e * d, 1.0, 0.0, 1.0).max(0.0);
         eroded * (1.0 + PRECIPITATION_GAIN * precipitation)
     }

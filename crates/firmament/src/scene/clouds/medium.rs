@@ -162,8 +162,9 @@ impl Volume for CloudMedium {
 
     /// The progressive march (Hillaire 2016): [`LIGHT_SAMPLES`] steps growing by
     /// [`LIGHT_STEP_GROWTH`] to the layer's exit (at most [`LIGHT_MARCH_MAX_M`]), each
-    /// sampled at its `jitter`-offset point; the uniform layer's depth in closed form.
-    fn light_optical_depth(&self, ray: &Ray, _channel: usize, jitter: f64) -> f64 {
+    /// sampled at its midpoint (a jittered point makes neighbouring pixels see different
+    /// shadows: visible grain); the uniform layer's depth in closed form.
+    fn light_optical_depth(&self, ray: &Ray, _channel: usize, _jitter: f64) -> f64 {
         let (segs, n) = self.segments(ray);
         if n == 0 {
             return 0.0;
@@ -178,7 +179,7 @@ impl Volume for CloudMedium {
         let mut step = (end - a) / total;
         let (mut t, mut tau) = (a, 0.0);
         for _ in 0..LIGHT_SAMPLES {
-            tau += self.extinction(ray.origin + (t + jitter * step) * ray.dir) * step;
+            tau += self.extinction(ray.origin + (t + 0.5 * step) * ray.dir) * step;
             t += step;
             step *= LIGHT_STEP_GROWTH;
         }

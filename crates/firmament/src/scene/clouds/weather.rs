@@ -4,9 +4,13 @@
 //! stratus … 1 cumulus) and how dark with precipitation (p ∈ [0, 1], blue).
 //!
 //! The procedural map is tileable gradient-noise fBm, histogram-equalised so that w is
-//! uniform on [0, 1]: a layer of coverage c then has cloud where w > 1 − c, i.e. over the
-//! fraction c of its area (before the 3D noise carves the shapes). A user's PNG gives the
-//! three channels directly (8 or 16 bits; grey: w only).
+//! uniform on [0, 1] (its mean ½ leaves a layer's mean coverage as set). A user's PNG gives
+//! the three channels directly (8 or 16 bits; grey: w only).
+//!
+//! Every map also carries a smooth warp (two more channels, procedural): an offset of the
+//! 3D noise's coordinates, up to [`WARP_TILES`] of the noise's tile, varying over a third
+//! of the weather's tile, so that the noise's repetition never lines up (a domain warp,
+//! Perlin 1985 §5 "turbulence" used as a displacement).
 
 use std::path::Path;
 
@@ -20,16 +24,23 @@ const PROCEDURAL_TEXELS: usize = 256;
 const COVERAGE_CELLS: u32 = 4;
 /// Octaves of the procedural coverage.
 const COVERAGE_OCTAVES: u32 = 5;
+/// The warp's amplitude in tiles of the 3D noise.
+pub const WARP_TILES: f64 = 0.35;
+/// Lattice cells of the warp across the weather's tile.
+const WARP_CELLS: u32 = 3;
 
 /// One tile of weather, bilinearly sampled and repeated every `tile_m` metres.
+///
+/// Warp: see the module's notes.
 #[derive(Clone, Debug)]
 pub struct WeatherMap {
     /// Texels per side (x) and (y).
     pub width: usize,
     /// Texels in y.
     pub height: usize,
-    /// [w, t, p] per texel, row-major from the tile's south-west corner.
-    pub texels: Vec<[f32; 3]>,
+    /// [w, t, p, warp x, warp y] per texel (the warp in tiles of the 3D noise), row-major
+    /// from the tile's south-west corner.
+    pub texels: Vec<[f32; 5]>,
     /// The tile's side, m.
     pub tile_m: f64,
 }
@@ -60,20 +71,22 @@ impl WeatherMap {
         // Histogram equalisation: each texel's w is its rank among all.
         let mut order: Vec<usize> = (0..raw.len()).collect();
         order.sort_by(|&a, &b| raw[a].total_cmp(&raw[b]));
-        let mut texels = vec![[0.0f32; 3]; raw.len()];
+        let mut texels = vec![[0.0f32; 5]; raw.len()];
         for (rank, &idx) in order.iter().enumerate() {
-            texels[idx] = [
+            texels[idx][..3].copy_from_slice(&[
                 ((rank as f64 + 0.5) / raw.len() as f64) as f32,
                 types[idx] as f32,
                 0.0,
-            ];
+            ]);
         }
-        WeatherMap {
+        let mut map = WeatherMap {
             width: n,
             height: n,
             texels,
             tile_m,
-        }
+        };
+        map.add_warp(seed);
+        map
     }
 
     /// A map from a PNG at `path` (red w, green t, blue p; a grey image gives w and leaves t
@@ -104,6 +117,7 @@ impl WeatherMap {
         }
         let grey = !image.color().has_color();
         let rgb = image.to_rgb32f();
+        let seed = 0;
         let t_default = kind.default_type().0 as f32;
         // PNG rows run top to bottom; the map's from south to north.
         let mut texels = Vec::with_capacity(width * height);
@@ -111,23 +125,45 @@ impl WeatherMap {
             for i in 0..width {
                 let px = rgb.get_pixel(i as u32, j as u32).0;
                 texels.push(if grey {
-                    [px[0], t_default, 0.0]
+                    [px[0], t_default, 0.0, 0.0, 0.0]
                 } else {
-                    px
+                    [px[0], px[1], px[2], 0.0, 0.0]
                 });
             }
         }
-        Ok(WeatherMap {
+        let mut map = WeatherMap {
             width,
             height,
             texels,
             tile_m,
-        })
+        };
+        map.add_warp(seed);
+        Ok(map)
     }
 
-    /// [w, t, p] at planar coordinates (x, y) (m), bilinear, repeating.
+    /// Fill the warp channels: two tileable gradient noises of [`WARP_CELLS`] cells (two
+    /// octaves), scaled to ±[`WARP_TILES`].
+    fn add_warp(&mut self, seed: u32) {
+        let (w, h) = (self.width, self.height);
+        for j in 0..h {
+            for i in 0..w {
+                let (x, y) = ((i as f64 + 0.5) / w as f64, (j as f64 + 0.5) / h as f64);
+                let c = WARP_CELLS as f64;
+                let field = |salt: u32| {
+                    let a = perlin2(x * c, y * c, WARP_CELLS, salt);
+                    let b = perlin2(2.0 * x * c, 2.0 * y * c, 2 * WARP_CELLS, salt ^ 1);
+                    (WARP_TILES * 1.4 * (a + 0.5 * b) / 1.5).clamp(-WARP_TILES, WARP_TILES)
+                };
+                let t = &mut self.texels[j * w + i];
+                t[3] = field(seed ^ 0x7761_7270) as f32;
+                t[4] = field(seed ^ 0x7761_7271) as f32;
+            }
+        }
+    }
+
+    /// [w, t, p, warp x, warp y] at planar coordinates (x, y) (m), bilinear, repeating.
     #[inline]
-    pub fn sample(&self, x: f64, y: f64) -> [f64; 3] {
+    pub fn sample(&self, x: f64, y: f64) -> [f64; 5] {
         let (w, h) = (self.width, self.height);
         let u = x / self.tile_m;
         let v = y / self.tile_m;
@@ -166,7 +202,7 @@ mod tests {
         // Tiles: one tile over is the same, and across the seam it continues smoothly.
         let a = map.sample(1234.0, 5678.0);
         let b = map.sample(1234.0 + 10_000.0, 5678.0 - 20_000.0);
-        assert_eq!(a, b);
+        assert!(a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-9), "{a:?} {b:?}");
         let step = 10_000.0 / 256.0;
         let seam = (map.sample(-0.5 * step, 3000.0)[0] - map.sample(0.5 * step, 3000.0)[0]).abs();
         assert!(seam < 0.1, "seam {seam}");
