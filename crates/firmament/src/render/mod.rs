@@ -247,6 +247,20 @@ impl<'s> Shader<'s> {
                     if !lit_at_end {
                         direct.iter_mut().for_each(|v| *v = 0.0);
                     }
+                    if !scene.volumes.is_empty() {
+                        let light = view.light();
+                        view.transmittance_to_light(hit.position, share);
+                        volumes::dim_surface_light(
+                            scene,
+                            hit.position,
+                            hit.normal,
+                            light.direction,
+                            &light.irradiance[..n],
+                            share,
+                            direct,
+                            sky,
+                        );
+                    }
                     if let Some(domes) = domes {
                         // The sky's light under the horizon, weighted by its radiance, in
                         // place of the open plane's (1 + n·up)/2 that the sky method applied.

@@ -31,7 +31,7 @@ use std::f64::consts::PI;
 
 use crate::math::hash::{lowbias32, unit};
 use crate::math::Vec3;
-use crate::scene::{Ray, Scene, Volume};
+use crate::scene::{DiffuseLight, Octaves, Ray, Scene, Volume};
 use crate::sky::{Shadow, SkyView};
 use crate::spectrum::MAX_CHANNELS;
 
@@ -47,19 +47,24 @@ const STEP_DISTANCE_FRACTION: f64 = 0.003;
 const EMPTY_BEFORE_LEAP: usize = 2;
 /// Steps in one leap over empty space.
 const LEAP_STEPS: f64 = 3.0;
-/// The march stops once the volumes' transmittance is below this in every channel.
+/// The march stops once the volumes' transmittance is below this in every channel and
+/// octave.
 const OPAQUE_TRANSMITTANCE: f64 = 1e-4;
+/// The most octaves of multiple scattering.
+pub const MAX_OCTAVES: usize = 8;
 
 /// Per-channel scratch of one march.
 struct Buffers {
     sigma_t: [f64; MAX_CHANNELS],
     e_v: [f64; MAX_CHANNELS],
     s_v: [f64; MAX_CHANNELS],
-    source: [f64; MAX_CHANNELS],
+    /// The source of each octave.
+    source: [[f64; MAX_CHANNELS]; MAX_OCTAVES],
     t_light: [f64; MAX_CHANNELS],
     tau_light: [f64; MAX_CHANNELS],
-    ambient: [[f64; MAX_CHANNELS]; 2],
-    e: [[f64; MAX_CHANNELS]; 2],
+    /// [E↓ of the sky at the sample, the direct and the sky irradiance of the clear
+    /// ground below it].
+    ambient: [[f64; MAX_CHANNELS]; 3],
 }
 
 /// Composite the volumes crossed by `ray` before `end` over `out` (the radiance behind).
@@ -113,15 +118,23 @@ pub(super) fn composite(
         sigma_t: [0.0; MAX_CHANNELS],
         e_v: [0.0; MAX_CHANNELS],
         s_v: [0.0; MAX_CHANNELS],
-        source: [0.0; MAX_CHANNELS],
+        source: [[0.0; MAX_CHANNELS]; MAX_OCTAVES],
         t_light: [0.0; MAX_CHANNELS],
         tau_light: [0.0; MAX_CHANNELS],
-        ambient: [[0.0; MAX_CHANNELS]; 2],
-        e: [[0.0; MAX_CHANNELS]; 2],
+        ambient: [[0.0; MAX_CHANNELS]; 3],
     };
     // Each volume's scattering coefficient at the current sample.
     let mut scattering = vec![[0.0f64; MAX_CHANNELS]; scene.volumes.len()];
-    let mut t_vol = [1.0f64; MAX_CHANNELS];
+    // The octaves of the march: the most any volume asks for, with its extinction gain.
+    let octaves = scene
+        .volumes
+        .iter()
+        .map(|v| v.octaves())
+        .max_by_key(|o| o.count)
+        .unwrap_or(Octaves::SINGLE);
+    let count = (octaves.count as usize).min(MAX_OCTAVES);
+    // Octave m's transmittance along the view, through b^m times the extinction.
+    let mut t_vol = [[1.0f64; MAX_CHANNELS]; MAX_OCTAVES];
     let mut l_vol = [0.0f64; MAX_CHANNELS];
     // Σ opacity·t and Σ opacity (channel means) for the mean depth.
     let (mut depth_sum, mut weight_sum) = (0.0, 0.0);
@@ -143,7 +156,12 @@ pub(super) fn composite(
                 // Leap when the point a leap ahead is empty too.
                 let leap = LEAP_STEPS * dt;
                 let probe = ray.origin + (t + leap + jitter * dt) * ray.dir;
-                if t + leap < b && scene.volumes.iter().all(|v| extinction_is_zero(v.as_ref(), probe, &mut buf, n)) {
+                if t + leap < b
+                    && scene
+                        .volumes
+                        .iter()
+                        .all(|v| extinction_is_zero(v.as_ref(), probe, &mut buf, n))
+                {
                     t += leap;
                     continue;
                 }
@@ -154,22 +172,27 @@ pub(super) fn composite(
         empty_run = 0;
         light_sources(scene, views, x, ray.dir, jitter, &scattering, &mut buf, n);
         let mut opacity = 0.0;
-        for k in 0..n {
-            let sigma = buf.sigma_t[k];
-            let step_t = (-sigma * dt).exp();
-            let integral = if sigma > 0.0 {
-                (buf.source[k] - buf.source[k] * step_t) / sigma
-            } else {
-                buf.source[k] * dt
-            };
-            l_vol[k] += t_vol[k] * integral;
-            opacity += t_vol[k] * (1.0 - step_t);
-            t_vol[k] *= step_t;
+        let mut gain_t = 1.0;
+        for (m, t_m) in t_vol.iter_mut().enumerate().take(count) {
+            for k in 0..n {
+                let sigma = gain_t * buf.sigma_t[k];
+                let step_t = (-sigma * dt).exp();
+                let source = buf.source[m][k];
+                l_vol[k] += t_m[k] * step_integral(source, sigma, dt, step_t);
+                if m == 0 {
+                    opacity += t_m[k] * (1.0 - step_t);
+                }
+                t_m[k] *= step_t;
+            }
+            gain_t *= octaves.extinction;
         }
         let mid = t + 0.5 * dt;
         depth_sum += opacity * mid;
         weight_sum += opacity;
-        if t_vol[..n].iter().all(|&v| v < OPAQUE_TRANSMITTANCE) {
+        if t_vol[..count]
+            .iter()
+            .all(|t_m| t_m[..n].iter().all(|&v| v < OPAQUE_TRANSMITTANCE))
+        {
             break;
         }
         t += dt;
@@ -191,7 +214,18 @@ pub(super) fn composite(
     let mut t_air = [0.0f64; MAX_CHANNELS];
     views[0].transmittance_to_point(point, &mut t_air[..n]);
     for k in 0..n {
-        out[k] = front[k] + t_air[k] * l_vol[k] + t_vol[k] * (out[k] - front[k]);
+        out[k] = front[k] + t_air[k] * l_vol[k] + t_vol[0][k] * (out[k] - front[k]);
+    }
+}
+
+/// ∫₀^dt S·e^{−σs} ds = (S − S·e^{−σ·dt})/σ (Hillaire 2016 §5.6.3, eq. 17), `step_t` being
+/// e^{−σ·dt}; S·dt where σ = 0.
+#[inline]
+pub fn step_integral(source: f64, sigma: f64, dt: f64, step_t: f64) -> f64 {
+    if sigma > 0.0 {
+        (source - source * step_t) / sigma
+    } else {
+        source * dt
     }
 }
 
@@ -223,7 +257,9 @@ fn light_sources(
     buf: &mut Buffers,
     n: usize,
 ) {
-    buf.source[..n].iter_mut().for_each(|v| *v = 0.0);
+    buf.source
+        .iter_mut()
+        .for_each(|s| s[..n].iter_mut().for_each(|v| *v = 0.0));
     for view in views {
         let light = view.light();
         let mut lit = false;
@@ -234,23 +270,56 @@ fn light_sources(
             if !lit {
                 view.transmittance_to_light(x, &mut buf.t_light[..n]);
                 light_optical_depth(scene, x, light.direction, jitter, &mut buf.tau_light[..n]);
-                ambient_irradiance(scene, view.as_ref(), x, &mut buf.ambient, &mut buf.e, n);
+                ambient_irradiance(scene, view.as_ref(), x, &mut buf.ambient, n);
                 lit = true;
             }
             let octaves = volume.octaves();
             let phase = volume.phase(x);
             let cos = dir.dot(light.direction);
             let (mut gain_s, mut gain_t, mut gain_g) = (1.0, 1.0, 1.0);
-            for _ in 0..octaves.count {
+            for source in buf.source.iter_mut().take((octaves.count as usize).min(MAX_OCTAVES)) {
                 let p = phase.eval_scaled(cos, gain_g);
                 for k in 0..n {
                     let t_vol = (-gain_t * buf.tau_light[k]).exp();
-                    buf.source[k] +=
-                        gain_s * s_v[k] * p * light.irradiance[k] * buf.t_light[k] * t_vol;
+                    source[k] += gain_s * s_v[k] * p * light.irradiance[k] * buf.t_light[k] * t_vol;
                 }
                 gain_s *= octaves.scattering;
                 gain_t *= octaves.extinction;
                 gain_g *= octaves.eccentricity;
+            }
+            let up = x.normalize_or_zero();
+            let mu_light = light.direction.dot(up);
+            if let Some(f0) = volume.diffuse_radiance(x, mu_light, buf.tau_light[0], 0) {
+                // The volume's own estimate of its diffuse light, scattered isotropically;
+                // the ground below lit through the column.
+                let albedo = &scene.sky.model().ground_albedo;
+                let [_, ground_direct, ground_sky] = &buf.ambient;
+                for k in 0..n {
+                    let f = if volume.is_grey() || k == 0 {
+                        f0
+                    } else {
+                        volume
+                            .diffuse_radiance(x, mu_light, buf.tau_light[k], k)
+                            .unwrap_or(f0)
+                    };
+                    let beam = light.irradiance[k] * buf.t_light[k];
+                    let ground = ground_direct[k] * f.base_direct
+                        + beam * f.base_from_light
+                        + ground_sky[k] * f.base_from_above;
+                    // The field's moments, then the radiance scattered towards the eye
+                    // (travelling along −dir): I₀ + g′·I₁·μ.
+                    let e = [beam, buf.ambient[0][k], albedo[k] * ground];
+                    let moments = [f.from_light, f.from_above, f.from_below];
+                    let (mut i0, mut i1) = (0.0, 0.0);
+                    for (m, e) in moments.iter().zip(e) {
+                        i0 += m[0] * e;
+                        i1 += m[1] * e;
+                    }
+                    let towards_eye = -dir.dot(up);
+                    let radiance = (i0 + f.asymmetry * i1 * towards_eye).max(0.0);
+                    buf.source[1][k] += s_v[k] * f.scattering_scale * radiance;
+                }
+                continue;
             }
             let one_minus_g = 1.0 - phase.mean_cosine();
             let depths = volume.vertical_optical_depths(x, 0);
@@ -263,9 +332,9 @@ fn light_sources(
                 };
                 let w_sky = 1.0 / (1.0 + one_minus_g * up);
                 let w_ground = 1.0 / (1.0 + one_minus_g * down);
-                buf.source[k] += s_v[k]
-                    * (w_sky * buf.ambient[0][k] + w_ground * buf.ambient[1][k])
-                    / (2.0 * PI);
+                let ground = albedo_of(scene, k) * (buf.ambient[1][k] + buf.ambient[2][k]);
+                buf.source[0][k] +=
+                    s_v[k] * (w_sky * buf.ambient[0][k] + w_ground * ground) / (2.0 * PI);
             }
         }
     }
@@ -294,23 +363,105 @@ fn light_optical_depth(scene: &Scene, x: Vec3, direction: Vec3, jitter: f64, out
 }
 
 /// The ambient hemispheric irradiances at `x` under the view's light: [E↓ from the sky
-/// above, E↑ reflected by the ground below] (the ground's albedo times its direct and sky
-/// irradiance, the air between not counted). `e` is scratch.
+/// above, the direct and the sky irradiance of the ground below] (clear: the volumes'
+/// shadow is applied by the caller).
 fn ambient_irradiance(
     scene: &Scene,
     view: &dyn SkyView,
     x: Vec3,
-    out: &mut [[f64; MAX_CHANNELS]; 2],
-    e: &mut [[f64; MAX_CHANNELS]; 2],
+    out: &mut [[f64; MAX_CHANNELS]; 3],
     n: usize,
 ) {
     let up = x.normalize_or_zero();
-    let [direct, sky] = e;
-    view.sun_and_sky_irradiance(x, up, &mut direct[..n], &mut out[0][..n]);
-    let model = scene.sky.model();
-    let ground = up * model.bottom_radius_m;
-    view.sun_and_sky_irradiance(ground, up, &mut direct[..n], &mut sky[..n]);
+    let [sky, ground_direct, ground_sky] = out;
+    view.sun_and_sky_irradiance(x, up, &mut ground_direct[..n], &mut sky[..n]);
+    let ground = up * scene.sky.model().bottom_radius_m;
+    view.sun_and_sky_irradiance(ground, up, &mut ground_direct[..n], &mut ground_sky[..n]);
+}
+
+/// The ground's albedo in channel `k`.
+fn albedo_of(scene: &Scene, k: usize) -> f64 {
+    scene.sky.model().ground_albedo[k]
+}
+
+/// The light a surface at `x` (normal `normal`) gets under the volumes (cloud shadows on
+/// the ground), for a light in `direction` of irradiance `e_light` (W·m⁻²·nm⁻¹ at the top
+/// of the atmosphere) with transmittance `t_air` through the air to it: `direct` (the beam
+/// on the surface, as the sky method gave it) is dimmed by the volumes' transmittance
+/// towards the light e^{−τ_l} (the march towards the light: the shadows' shapes), and the
+/// beam the volumes scatter forward reaches the surface as diffuse light, added to `sky`
+/// (the sky's irradiance, itself dimmed by the volumes above), on a tilted surface by
+/// (1 + n·up)/2 like the sky's:
+///
+/// - a volume with its own diffuse estimate ([`Volume::diffuse_radiance`], the clouds'
+///   two-stream) gives the flux leaving the base of the column above the point;
+/// - otherwise the volume's total transmission of light from above is taken as a
+///   conservative slab's two-stream transmission 1/(1 + (1 − g)τ↑), τ↑ its optical depth
+///   straight up (the hemispheric-mean closure, as for the ambient light in
+///   [`composite`]), of which the beam's unscattered part e^{−τ_l} is taken out.
+///
+/// Several volumes stack: the light one diffuses crosses those below like the sky's.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn dim_surface_light(
+    scene: &Scene,
+    x: Vec3,
+    normal: Vec3,
+    direction: Vec3,
+    e_light: &[f64],
+    t_air: &[f64],
+    direct: &mut [f64],
+    sky: &mut [f64],
+) {
+    let n = direct.len();
+    let up = x.normalize_or_zero();
+    let mu = direction.dot(up);
+    let towards = Ray {
+        origin: x,
+        dir: direction,
+    };
+    let above = Ray { origin: x, dir: up };
+    let mut beam = [1.0f64; MAX_CHANNELS];
+    let mut sky_factor = [1.0f64; MAX_CHANNELS];
+    let mut diffuse = [0.0f64; MAX_CHANNELS];
+    for volume in &scene.volumes {
+        let crosses = volume.bounds(&towards).is_some();
+        let over = volume.bounds(&above).is_some();
+        if !crosses && !over {
+            continue;
+        }
+        let one_minus_g = 1.0 - volume.phase(x).mean_cosine();
+        let mut first: Option<(f64, f64, Option<DiffuseLight>)> = None;
+        for k in 0..n {
+            let (tau_l, tau_up, f) = match first {
+                Some(v) if volume.is_grey() => v,
+                _ => {
+                    let tau_l = if crosses { volume.light_optical_depth(&towards, k, 0.5) } else { 0.0 };
+                    let f = volume.diffuse_radiance(x, mu, tau_l, k);
+                    let tau_up = match f {
+                        Some(_) => 0.0,
+                        None if over => volume.light_optical_depth(&above, k, 0.5),
+                        None => 0.0,
+                    };
+                    first = Some((tau_l, tau_up, f));
+                    (tau_l, tau_up, f)
+                }
+            };
+            let unscattered = (-tau_l).exp();
+            let (through, from_beam) = match f {
+                Some(f) => (f.base_from_above, f.base_from_light),
+                None => {
+                    let total = 1.0 / (1.0 + one_minus_g * tau_up);
+                    (total, mu.max(0.0) * (total - unscattered).max(0.0))
+                }
+            };
+            diffuse[k] = diffuse[k] * through + beam[k] * from_beam;
+            sky_factor[k] *= through;
+            beam[k] *= unscattered;
+        }
+    }
+    let open = 0.5 * (1.0 + normal.dot(up));
     for k in 0..n {
-        out[1][k] = model.ground_albedo[k] * (direct[k] + sky[k]);
+        direct[k] *= beam[k];
+        sky[k] = sky[k] * sky_factor[k] + e_light[k] * t_air[k] * diffuse[k] * open;
     }
 }

@@ -21,7 +21,7 @@ pub use camera::{Camera, PreparedCamera, Projection, Ray};
 pub use file::SceneFile;
 pub use light::{DiskProfile, Light};
 pub use surface::{Relief, Sphere, Surface, SurfaceHit};
-pub use volume::{HomogeneousSphere, Octaves, Volume};
+pub use volume::{DiffuseLight, HomogeneousSphere, Octaves, Volume};
 
 use crate::math::{direction_from_zenith_azimuth, Vec3};
 use crate::sky::SkyMethod;

@@ -55,6 +55,22 @@ pub trait Volume: Send + Sync {
         [0.0; 2]
     }
 
+    /// The renderer's estimate of the diffuse (multiply scattered) light at `point`, for a
+    /// light whose zenith cosine there is `mu_light` and towards which the volume's optical
+    /// depth is `tau_light` (of `channel`); the renderer then scatters it isotropically and
+    /// takes octave 0 for its single scattering and octave 1 for this light (the volume's
+    /// [`Volume::octaves`] says so, with no single scattering in octave 1). None (the
+    /// default): octaves and the ambient term.
+    fn diffuse_radiance(
+        &self,
+        _point: Vec3,
+        _mu_light: f64,
+        _tau_light: f64,
+        _channel: usize,
+    ) -> Option<DiffuseLight> {
+        None
+    }
+
     /// The scale (m) of the volume's smallest features: the renderer's march steps at about
     /// this length (growing with distance) instead of by optical depth; None: by optical
     /// depth.
@@ -96,6 +112,45 @@ impl<V: Volume + ?Sized> Volume for &V {
     fn feature_size_m(&self) -> Option<f64> {
         (**self).feature_size_m()
     }
+    fn diffuse_radiance(
+        &self,
+        point: Vec3,
+        mu_light: f64,
+        tau_light: f64,
+        channel: usize,
+    ) -> Option<DiffuseLight> {
+        (**self).diffuse_radiance(point, mu_light, tau_light, channel)
+    }
+}
+
+/// A volume's estimate of its diffuse light at a point ([`Volume::diffuse_radiance`]), per
+/// unit irradiance of what enters it: the light's beam (normal to it), diffuse light from
+/// above (the sky), diffuse light from below (the ground).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DiffuseLight {
+    /// The diffuse radiance's moments at the point (sr⁻¹): its mean over all directions
+    /// I₀ and its first moment I₁ (the radiance I₀ + I₁μ, μ from the upward vertical), per
+    /// unit beam irradiance,
+    pub from_light: [f64; 2],
+    /// per unit hemispheric irradiance entering from above,
+    pub from_above: [f64; 2],
+    /// and per unit hemispheric irradiance entering from below.
+    pub from_below: [f64; 2],
+    /// The asymmetry with which the diffuse field scatters: the in-scattered radiance
+    /// towards μ is I₀ + asymmetry·I₁·μ.
+    pub asymmetry: f64,
+    /// Under the point's column through the volume: the fraction of the beam that crosses
+    /// it unscattered,
+    pub base_direct: f64,
+    /// the diffuse flux leaving its base per unit beam irradiance,
+    pub base_from_light: f64,
+    /// and per unit hemispheric irradiance entering its top.
+    pub base_from_above: f64,
+    /// The fraction of the scattering coefficient that scatters this diffuse light (the
+    /// rest is the phase function's forward peak, counted as unscattered: δ-scaling). The
+    /// renderer carries the diffuse light along the view in the octave slot 1, whose
+    /// extinction gain the volume's [`Volume::octaves`] gives.
+    pub scattering_scale: f64,
 }
 
 /// Multiple scattering by octaves (Wrenninge 2015, "Art-directable multiple scattering";

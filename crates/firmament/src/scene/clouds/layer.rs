@@ -32,6 +32,17 @@ const WEATHER_CONTRAST: f64 = 1.2;
 /// How much the weather's precipitation raises the density (1 + gain·p).
 const PRECIPITATION_GAIN: f64 = 2.0;
 
+/// How the renderer estimates the light scattered more than once in a layer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum MultipleScattering {
+    /// The local plane-parallel δ-Eddington two-stream ([`super::two_stream`]).
+    #[default]
+    TwoStream,
+    /// Octaves (Wrenninge 2015; Hillaire 2016 §5.6), `octaves`, `octave_*`.
+    Octaves,
+}
+
 /// A `[[clouds]]` section. Values left out take the kind's defaults
 /// ([`CloudLayerConfig::resolved`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -86,6 +97,10 @@ pub struct CloudLayerConfig {
     /// it.
     #[serde(default)]
     pub wind_offset_m: [f64; 2],
+    /// How the light scattered more than once is estimated: `two-stream` (the default) or
+    /// `octaves`.
+    #[serde(default)]
+    pub multiple_scattering: MultipleScattering,
     /// Multiple scattering by octaves (Wrenninge 2015): the number of octaves.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub octaves: Option<u32>,
@@ -126,6 +141,8 @@ pub struct LayerParams {
     pub seed: u32,
     /// Wind offset (m).
     pub wind_offset_m: [f64; 2],
+    /// Two-stream or octaves.
+    pub multiple_scattering: MultipleScattering,
     /// Octaves: count, a, b, c.
     pub octaves: u32,
     /// a, b, c.
@@ -151,6 +168,7 @@ impl CloudLayerConfig {
             detail_tile_m: None,
             seed: 0,
             wind_offset_m: [0.0; 2],
+            multiple_scattering: MultipleScattering::TwoStream,
             octaves: None,
             octave_scattering: None,
             octave_extinction: None,
@@ -191,6 +209,7 @@ impl CloudLayerConfig {
             ],
             seed: self.seed,
             wind_offset_m: self.wind_offset_m,
+            multiple_scattering: self.multiple_scattering,
             octaves: self.octaves.unwrap_or(3),
             octave_gains: [
                 self.octave_scattering.unwrap_or(0.5),

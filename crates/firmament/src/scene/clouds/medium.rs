@@ -4,11 +4,12 @@
 //! marcher lights it with (the progressive march towards the light of Hillaire 2016, seed
 //! "Sun shadow sampling", and the vertical depths of the ambient light).
 
-use super::layer::CloudLayer;
+use super::layer::{CloudLayer, MultipleScattering};
+use super::two_stream::TwoStream;
 use crate::math::sphere::ray_sphere;
 use crate::math::Vec3;
 use crate::medium::PhaseFunction;
-use crate::scene::volume::{Octaves, Volume};
+use crate::scene::volume::{DiffuseLight, Octaves, Volume};
 use crate::scene::Ray;
 
 /// The quadrature step of [`Volume::optical_depth`] (m): the finest texel of the default
@@ -33,15 +34,21 @@ pub struct CloudMedium {
     pub layer: CloudLayer,
     /// Its phase function.
     pub phase: PhaseFunction,
+    /// The two-stream tables of its multiple scattering (None: octaves).
+    pub two_stream: Option<TwoStream>,
 }
 
 impl CloudMedium {
     /// The medium of `layer`.
     pub fn new(layer: CloudLayer) -> CloudMedium {
         let [g1, g2, weight] = layer.params.phase;
+        let phase = PhaseFunction::DualLobeHg { g1, g2, weight };
+        let two_stream = (layer.params.multiple_scattering == MultipleScattering::TwoStream)
+            .then(|| TwoStream::new(layer.params.albedo, phase.mean_cosine()));
         CloudMedium {
-            phase: PhaseFunction::DualLobeHg { g1, g2, weight },
+            phase,
             layer,
+            two_stream,
         }
     }
 
@@ -150,7 +157,69 @@ impl Volume for CloudMedium {
         })
     }
 
+    fn diffuse_radiance(
+        &self,
+        point: Vec3,
+        mu_light: f64,
+        tau_light: f64,
+        _channel: usize,
+    ) -> Option<DiffuseLight> {
+        let ts = self.two_stream.as_ref()?;
+        let r = point.length();
+        let [rb, rt] = self.layer.radii_m;
+        let [above, below] = if r < rb {
+            // Under the layer: its whole column above.
+            let up = Ray {
+                origin: point,
+                dir: point / r,
+            };
+            [self.light_optical_depth(&up, 0, 0.5), 0.0]
+        } else if r > rt {
+            return Some(DiffuseLight {
+                base_direct: 1.0,
+                scattering_scale: ts.scattering_scale,
+                ..DiffuseLight::default()
+            });
+        } else {
+            self.vertical_optical_depths(point, 0)
+        };
+        let thickness = above + below;
+        // The sun's depth into the equivalent slab: where its beam is as dimmed as the
+        // march towards it says (the vertical depth in a uniform slab).
+        let sun_depth = if mu_light > 0.0 {
+            (tau_light * mu_light).min(thickness)
+        } else {
+            thickness
+        };
+        let two_pi = 2.0 * std::f64::consts::PI;
+        Some(DiffuseLight {
+            from_light: ts.sun(thickness, sun_depth, mu_light),
+            from_above: ts.diffuse(thickness, above, true),
+            from_below: ts.diffuse(thickness, above, false),
+            base_direct: if mu_light > 0.0 {
+                (-thickness / mu_light).exp()
+            } else {
+                0.0
+            },
+            // At a black base F↑ = 0, so F↓ = 2π·I₀.
+            base_from_light: two_pi * ts.sun(thickness, thickness, mu_light)[0],
+            base_from_above: two_pi * ts.diffuse(thickness, thickness, true)[0],
+            asymmetry: ts.asymmetry,
+            scattering_scale: ts.scattering_scale,
+        })
+    }
+
     fn octaves(&self) -> Octaves {
+        if let Some(ts) = &self.two_stream {
+            // Octave 0: single scattering; octave 1: the two-stream's diffuse light, seen
+            // through the δ-scaled extinction, no single scattering of its own.
+            return Octaves {
+                count: 2,
+                scattering: 0.0,
+                extinction: ts.extinction_scale,
+                eccentricity: 1.0,
+            };
+        }
         let [a, b, c] = self.layer.params.octave_gains;
         Octaves {
             count: self.layer.params.octaves,

@@ -14,12 +14,13 @@ pub mod medium;
 pub mod noise;
 pub mod noise_volume;
 pub mod profile;
+pub mod two_stream;
 pub mod weather;
 
 use std::path::Path;
 use std::sync::Arc;
 
-pub use layer::{CloudLayer, CloudLayerConfig};
+pub use layer::{CloudLayer, CloudLayerConfig, MultipleScattering};
 pub use medium::CloudMedium;
 pub use noise_volume::{NoiseKind, NoiseVolume};
 pub use profile::CloudKind;

@@ -105,8 +105,8 @@ impl NoiseVolume {
         Ok((v, false))
     }
 
-    /// The texel (i, j, k), wrapped.
-    #[inline]
+    /// The texel (i, j, k).
+    #[cfg(test)]
     fn texel(&self, i: usize, j: usize, k: usize) -> f64 {
         self.data[(k * self.size + j) * self.size + i] as f64
     }
