@@ -9,6 +9,7 @@
 
 pub mod aerial_volume;
 pub mod air_volume;
+pub mod cloud_shadow;
 pub mod cube_layout;
 pub mod disk_edges;
 pub mod frame;
@@ -86,6 +87,9 @@ pub struct Shader<'s> {
     domes: Option<Arc<Vec<sky_dome::SkyDome>>>,
     /// The aerial-perspective volume per light ([`aerial_volume`]), when built.
     aerial: Vec<Option<aerial_volume::AerialVolume>>,
+    /// The volumes' shadow below them per light ([`cloud_shadow`]), when a volume is a
+    /// shell around the planet.
+    cloud_shadows: Vec<Option<cloud_shadow::CloudShadow>>,
 }
 
 /// Per-thread scratch space of [`Shader::shade`] (no allocation per pixel).
@@ -217,6 +221,12 @@ impl<'s> Shader<'s> {
             air: None,
             domes: None,
             aerial: Vec::new(),
+            cloud_shadows: match probe || scene.volumes.is_empty() {
+                true => Vec::new(),
+                false => (scene.lights.iter())
+                    .map(|l| cloud_shadow::CloudShadow::new(scene, l.direction))
+                    .collect(),
+            },
         })
     }
 
@@ -242,7 +252,7 @@ impl<'s> Shader<'s> {
                 };
                 let up = hit.position.normalize();
                 for (j, view) in self.views.iter().enumerate() {
-                    let (shadow, lit_at_end) = self.shadow(ray, view.light(), end, scratch);
+                    let (shadow, lit_at_end) = self.shadow(ray, j, end, scratch);
                     view.sun_and_sky_irradiance(hit.position, hit.normal, direct, sky);
                     if !lit_at_end {
                         direct.iter_mut().for_each(|v| *v = 0.0);
@@ -252,6 +262,7 @@ impl<'s> Shader<'s> {
                         view.transmittance_to_light(hit.position, share);
                         volumes::dim_surface_light(
                             scene,
+                            self.cloud_shadows.get(j).and_then(|m| m.as_ref()),
                             hit.position,
                             hit.normal,
                             light.direction,
@@ -292,7 +303,7 @@ impl<'s> Shader<'s> {
                     .any(|&(i, cos)| ray.dir.dot(scene.lights[i].direction) > cos);
                 let background = scene.background.as_ref();
                 for (j, view) in self.views.iter().enumerate() {
-                    let (shadow, _) = self.shadow(ray, view.light(), end, scratch);
+                    let (shadow, _) = self.shadow(ray, j, end, scratch);
                     // The transmittance along the ray (the same for every light) only for a
                     // disk in view or a background.
                     let t = if (disks || background.is_some()) && j == 0 {
@@ -324,28 +335,62 @@ impl<'s> Shader<'s> {
             }
         }
         if !scene.volumes.is_empty() {
-            volumes::composite(scene, &self.views, ray, end, &mut out[..n]);
+            let lit = |j: usize, d: f64, shadowed: &mut Vec<(f64, f64)>, lit: &mut Vec<(f64, f64)>| {
+                self.lit_before(ray, j, d, shadowed, lit)
+            };
+            volumes::composite(scene, &self.views, ray, end, &lit, &mut out[..n]);
         }
     }
 
-    /// The parts of `ray` up to `end` that `light` reaches, and whether it reaches `end`.
+    /// The parts of `ray` up to `end` that light `j` reaches (past the surfaces and under
+    /// the volumes' shadow map), and whether it reaches `end` past the surfaces (the
+    /// volumes' shadow on a surface is [`volumes::dim_surface_light`]'s).
     fn shadow<'b>(
         &self,
         ray: &Ray,
-        light: &crate::scene::Light,
+        j: usize,
         end: f64,
         scratch: &'b mut ShadeScratch,
     ) -> (Shadow<'b>, bool) {
         scratch.shadowed.clear();
+        let light = &self.scene.lights[j];
         self.scene
             .shadowed_intervals(ray, light.direction, end, &mut scratch.shadowed);
+        let lit_at_end = !(scratch.shadowed.iter()).any(|&(a, b)| a <= end && b >= end);
+        if let Some(Some(map)) = self.cloud_shadows.get(j) {
+            map.shadowed_intervals(ray, end, &mut scratch.shadowed);
+        }
         if scratch.shadowed.is_empty() {
             return (Shadow::None, true);
         }
         scratch.lit.clear();
         lit_intervals(&mut scratch.shadowed, end, &mut scratch.lit);
-        let lit_at_end = scratch.lit.last().is_some_and(|&(_, b)| b >= end);
         (Shadow::Lit(&scratch.lit), lit_at_end)
+    }
+
+    /// The lit stretches of `ray` before `end` for light `j` into `lit` (as
+    /// [`Shader::shadow`]), `shadowed` scratch; false when all of it is lit.
+    fn lit_before(
+        &self,
+        ray: &Ray,
+        j: usize,
+        end: f64,
+        shadowed: &mut Vec<(f64, f64)>,
+        lit: &mut Vec<(f64, f64)>,
+    ) -> bool {
+        shadowed.clear();
+        lit.clear();
+        let light = &self.scene.lights[j];
+        self.scene
+            .shadowed_intervals(ray, light.direction, end, shadowed);
+        if let Some(Some(map)) = self.cloud_shadows.get(j) {
+            map.shadowed_intervals(ray, end, shadowed);
+        }
+        if shadowed.is_empty() {
+            return false;
+        }
+        lit_intervals(shadowed, end, lit);
+        true
     }
 }
 

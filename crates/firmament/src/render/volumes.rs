@@ -31,6 +31,7 @@ use std::f64::consts::PI;
 
 use crate::math::hash::{lowbias32, unit};
 use crate::math::Vec3;
+use super::cloud_shadow::CloudShadow;
 use crate::scene::{DiffuseLight, Octaves, Ray, Scene, Volume};
 use crate::sky::{Shadow, SkyView};
 use crate::spectrum::MAX_CHANNELS;
@@ -67,12 +68,20 @@ struct Buffers {
     ambient: [[f64; MAX_CHANNELS]; 3],
 }
 
-/// Composite the volumes crossed by `ray` before `end` over `out` (the radiance behind).
+/// The lit stretches of the ray before a distance for light j: `lit(j, d, scratch, out)`
+/// fills `out` and says whether any of it is in shadow.
+pub(super) type LitBefore<'a> =
+    dyn Fn(usize, f64, &mut Vec<(f64, f64)>, &mut Vec<(f64, f64)>) -> bool + 'a;
+
+/// Composite the volumes crossed by `ray` before `end` over `out` (the radiance behind);
+/// `lit` gives the stretches of the ray each light reaches (the air in front of the
+/// volumes is lit only there).
 pub(super) fn composite(
     scene: &Scene,
     views: &[Box<dyn SkyView + '_>],
     ray: &Ray,
     end: f64,
+    lit: &LitBefore,
     out: &mut [f64],
 ) {
     let n = out.len();
@@ -205,8 +214,13 @@ pub(super) fn composite(
     let point = ray.origin + d_mean * ray.dir;
     let mut front = [0.0f64; MAX_CHANNELS];
     let mut l = [0.0f64; MAX_CHANNELS];
-    for view in views {
-        view.sky_radiance_to_point(point, Shadow::None, &mut l[..n], &mut [0.0; MAX_CHANNELS][..n]);
+    let (mut shadowed, mut lit_stretches) = (Vec::new(), Vec::new());
+    for (j, view) in views.iter().enumerate() {
+        let shadow = match lit(j, d_mean, &mut shadowed, &mut lit_stretches) {
+            true => Shadow::Lit(&lit_stretches),
+            false => Shadow::None,
+        };
+        view.sky_radiance_to_point(point, shadow, &mut l[..n], &mut [0.0; MAX_CHANNELS][..n]);
         for k in 0..n {
             front[k] += l[k];
         }
@@ -388,7 +402,8 @@ fn albedo_of(scene: &Scene, k: usize) -> f64 {
 /// the ground), for a light in `direction` of irradiance `e_light` (W·m⁻²·nm⁻¹ at the top
 /// of the atmosphere) with transmittance `t_air` through the air to it: `direct` (the beam
 /// on the surface, as the sky method gave it) is dimmed by the volumes' transmittance
-/// towards the light e^{−τ_l} (the march towards the light: the shadows' shapes), and the
+/// towards the light e^{−τ_l} (from the shadow `map` where it covers `x`, else the march
+/// towards the light: the shadows' shapes), and the
 /// beam the volumes scatter forward reaches the surface as diffuse light, added to `sky`
 /// (the sky's irradiance, itself dimmed by the volumes above), on a tilted surface by
 /// (1 + n·up)/2 like the sky's:
@@ -404,6 +419,7 @@ fn albedo_of(scene: &Scene, k: usize) -> f64 {
 #[allow(clippy::too_many_arguments)]
 pub(super) fn dim_surface_light(
     scene: &Scene,
+    map: Option<&CloudShadow>,
     x: Vec3,
     normal: Vec3,
     direction: Vec3,
@@ -423,6 +439,10 @@ pub(super) fn dim_surface_light(
     let mut beam = [1.0f64; MAX_CHANNELS];
     let mut sky_factor = [1.0f64; MAX_CHANNELS];
     let mut diffuse = [0.0f64; MAX_CHANNELS];
+    // The shadow map's depth towards the light (all volumes together; grey), where it
+    // covers the point, in place of each volume's march.
+    let mapped = map.and_then(|m| m.optical_depth(x));
+    let shells = scene.volumes.iter().filter(|v| v.radii_m().is_some()).count().max(1);
     for volume in &scene.volumes {
         let crosses = volume.bounds(&towards).is_some();
         let over = volume.bounds(&above).is_some();
@@ -435,7 +455,12 @@ pub(super) fn dim_surface_light(
             let (tau_l, tau_up, f) = match first {
                 Some(v) if volume.is_grey() => v,
                 _ => {
-                    let tau_l = if crosses { volume.light_optical_depth(&towards, k, 0.5) } else { 0.0 };
+                    let tau_l = match (mapped, volume.radii_m()) {
+                        // Shared between the shells the map sums.
+                        (Some(t), Some(_)) => t / shells as f64,
+                        _ if crosses => volume.light_optical_depth(&towards, k, 0.5),
+                        _ => 0.0,
+                    };
                     let f = volume.diffuse_radiance(x, mu, tau_l, k);
                     let tau_up = match f {
                         Some(_) => 0.0,

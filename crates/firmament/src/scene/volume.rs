@@ -71,6 +71,13 @@ pub trait Volume: Send + Sync {
         None
     }
 
+    /// The radii (m, planet-centred) of the spherical shell the volume lies in, when it is
+    /// one (a cloud layer): the renderer then maps its shadow below it
+    /// ([`crate::render::cloud_shadow`]); None: no such map.
+    fn radii_m(&self) -> Option<[f64; 2]> {
+        None
+    }
+
     /// The scale (m) of the volume's smallest features: the renderer's march steps at about
     /// this length (growing with distance) instead of by optical depth; None: by optical
     /// depth.
@@ -111,6 +118,9 @@ impl<V: Volume + ?Sized> Volume for &V {
     }
     fn feature_size_m(&self) -> Option<f64> {
         (**self).feature_size_m()
+    }
+    fn radii_m(&self) -> Option<[f64; 2]> {
+        (**self).radii_m()
     }
     fn diffuse_radiance(
         &self,

@@ -147,6 +147,10 @@ impl Volume for CloudMedium {
         true
     }
 
+    fn radii_m(&self) -> Option<[f64; 2]> {
+        Some(self.layer.radii_m)
+    }
+
     /// The erosion texture's texel: the finest detail the density has (the uniform slab: a
     /// 64th of its thickness).
     fn feature_size_m(&self) -> Option<f64> {

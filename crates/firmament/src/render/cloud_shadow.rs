@@ -1,0 +1,160 @@
+//! The clouds' shadow below them: the volumes' optical depth towards a light, tabulated over
+//! the sphere of their lowest base (a 2D transmittance map, as engines bake their clouds'
+//! shadow, Hillaire 2016 §5.7 "Other interactions"), so that any point below it finds its
+//! transmittance from where its ray to the light enters that sphere. It shadows the ground
+//! and terrain ([`super::volumes::dim_surface_light`]) and the air under the clouds: a view
+//! ray's stretches in shadow (transmittance below ½) are passed to the sky method as
+//! unlit, so the air beneath an overcast loses its single scattering and sunbeams fall
+//! through the gaps of a cumulus field (the terrain's light-shaft machinery).
+//!
+//! The map covers [`HALF_EXTENT_M`] around the observer's place in the layers' planar
+//! coordinates (the gnomonic projection of the +z cube face, as the clouds' weather);
+//! beyond it, and for points at or above the base, the caller marches towards the light.
+
+use rayon::prelude::*;
+
+use crate::math::sphere::ray_sphere;
+use crate::math::Vec3;
+use crate::scene::{Ray, Scene, Volume};
+
+/// Half the side of the mapped square (m).
+pub const HALF_EXTENT_M: f64 = 40_000.0;
+/// Texels per side.
+const TEXELS: usize = 640;
+/// Quadrature step through the volumes along the light (m).
+const MAP_STEP_M: f64 = 60.0;
+/// A point is in shadow where the light's transmittance is below this.
+const SHADOW_TRANSMITTANCE: f64 = 0.5;
+/// The farthest along a view ray the air's shadow is looked for (m).
+const MAX_SHADOW_DISTANCE_M: f64 = 80_000.0;
+
+/// The volumes' optical depth towards one light over their base sphere.
+pub struct CloudShadow {
+    /// The light's direction.
+    light: Vec3,
+    /// The base sphere's radius (m).
+    base_radius_m: f64,
+    /// The planet's radius (m): planar coordinates are gnomonic at this radius.
+    planet_radius_m: f64,
+    /// τ per texel, row-major from (−HALF, −HALF).
+    tau: Vec<f32>,
+}
+
+impl CloudShadow {
+    /// The map of `scene`'s volumes towards a light in `light` (None when no volume is a
+    /// shell around the planet or the light is below the horizon of the map's centre).
+    pub fn new(scene: &Scene, light: Vec3) -> Option<CloudShadow> {
+        let base = scene
+            .volumes
+            .iter()
+            .filter_map(|v| v.radii_m())
+            .map(|[b, _]| b)
+            .reduce(f64::min)?;
+        if light.z <= 0.0 {
+            return None;
+        }
+        let planet = scene.sky.model().bottom_radius_m;
+        let step = 2.0 * HALF_EXTENT_M / TEXELS as f64;
+        let mut tau = vec![0.0f32; TEXELS * TEXELS];
+        tau.par_chunks_mut(TEXELS).enumerate().for_each(|(j, row)| {
+            for (i, t) in row.iter_mut().enumerate() {
+                let x = -HALF_EXTENT_M + (i as f64 + 0.5) * step;
+                let y = -HALF_EXTENT_M + (j as f64 + 0.5) * step;
+                let entry = Vec3::new(x, y, planet).normalize() * base;
+                let ray = Ray {
+                    origin: entry,
+                    dir: light,
+                };
+                *t = scene
+                    .volumes
+                    .iter()
+                    .map(|v| optical_depth_coarse(v.as_ref(), &ray))
+                    .sum::<f64>() as f32;
+            }
+        });
+        Some(CloudShadow {
+            light,
+            base_radius_m: base,
+            planet_radius_m: planet,
+            tau,
+        })
+    }
+
+    /// The volumes' optical depth from `x` towards the light, when `x` lies below the base
+    /// sphere and its ray enters the sphere inside the map.
+    pub fn optical_depth(&self, x: Vec3) -> Option<f64> {
+        let (_, far) = ray_sphere(x, self.light, self.base_radius_m)?;
+        if far <= 0.0 || x.length_squared() >= self.base_radius_m * self.base_radius_m {
+            return None;
+        }
+        let e = x + far * self.light;
+        if e.z <= 0.0 {
+            return None;
+        }
+        let s = self.planet_radius_m / e.z;
+        let step = 2.0 * HALF_EXTENT_M / TEXELS as f64;
+        let fx = (e.x * s + HALF_EXTENT_M) / step - 0.5;
+        let fy = (e.y * s + HALF_EXTENT_M) / step - 0.5;
+        let max = (TEXELS - 1) as f64;
+        if !(0.0..max).contains(&fx) || !(0.0..max).contains(&fy) {
+            return None;
+        }
+        let (i, j) = (fx as usize, fy as usize);
+        let (tx, ty) = (fx - i as f64, fy - j as f64);
+        let at = |i: usize, j: usize| self.tau[j * TEXELS + i] as f64;
+        let lo = at(i, j) + (at(i + 1, j) - at(i, j)) * tx;
+        let hi = at(i, j + 1) + (at(i + 1, j + 1) - at(i, j + 1)) * tx;
+        Some(lo + (hi - lo) * ty)
+    }
+
+    /// Append the stretches of `ray` before `end` (and below the base) that the map puts
+    /// in shadow to `out`, sampled every max(150 m, t/25).
+    pub fn shadowed_intervals(&self, ray: &Ray, end: f64, out: &mut Vec<(f64, f64)>) {
+        // Where the ray is below the base sphere.
+        let limit = match ray_sphere(ray.origin, ray.dir, self.base_radius_m) {
+            Some((_, far)) if far > 0.0 => far.min(end).min(MAX_SHADOW_DISTANCE_M),
+            _ => return,
+        };
+        let mut t = 0.0;
+        let mut start: Option<f64> = None;
+        while t < limit {
+            let dt = (0.04 * t).max(150.0);
+            let mid = (t + 0.5 * dt).min(limit);
+            let shadowed = self
+                .optical_depth(ray.origin + mid * ray.dir)
+                .is_some_and(|tau| (-tau).exp() < SHADOW_TRANSMITTANCE);
+            match (shadowed, start) {
+                (true, None) => start = Some(t),
+                (false, Some(s)) => {
+                    out.push((s, t));
+                    start = None;
+                }
+                _ => {}
+            }
+            t += dt;
+        }
+        if let Some(s) = start {
+            out.push((s, limit));
+        }
+    }
+}
+
+/// A volume's optical depth along `ray` (to infinity) by the midpoint rule at
+/// [`MAP_STEP_M`], through the stretch its bounds give.
+fn optical_depth_coarse(volume: &dyn Volume, ray: &Ray) -> f64 {
+    let Some((a, b)) = volume.bounds(ray) else {
+        return 0.0;
+    };
+    let steps = ((b - a) / MAP_STEP_M).ceil().max(1.0) as usize;
+    let dt = (b - a) / steps as f64;
+    let (mut e, mut s) = ([0.0f64; 1], [0.0f64; 1]);
+    let mut tau = 0.0;
+    for i in 0..steps {
+        volume.coefficients(ray.origin + (a + (i as f64 + 0.5) * dt) * ray.dir, &mut e, &mut s);
+        tau += e[0] * dt;
+        if tau > 30.0 {
+            break;
+        }
+    }
+    tau
+}
