@@ -225,7 +225,11 @@ pub fn scene_clouds(
             if clouds.len() == 1 { "" } else { "s" },
             clouds
                 .iter()
-                .map(|c| format!("{:?} {:.0}–{:.0} m", c.layer.params.kind, c.layer.params.bottom_m, c.layer.params.top_m).to_lowercase())
+                .map(|c| format!(
+                    "{:?} {:.0}–{:.0} m",
+                    c.layer.params.kind, c.layer.params.bottom_m, c.layer.params.top_m
+                )
+                .to_lowercase())
                 .collect::<Vec<_>>()
                 .join(", "),
             started.elapsed().as_secs_f64()

@@ -60,7 +60,11 @@ fn main() -> firmament::Result<()> {
     let tables = match TableCache::from_env()? {
         Some(cache) => match cache.load(&model, &config) {
             Loaded::Hit { tables, .. } => *tables,
-            _ => *cache.store(&Tables::compute(&model, &config)?, &model, &config)?.tables,
+            _ => {
+                *cache
+                    .store(&Tables::compute(&model, &config)?, &model, &config)?
+                    .tables
+            }
         },
         None => Tables::compute(&model, &config)?,
     };
@@ -87,19 +91,49 @@ fn main() -> firmament::Result<()> {
                     ..CloudLayerConfig::of_kind(CloudKind::Uniform)
                 };
                 let views = vec![
-                    View { name: "ground, up", origin_alt_m: 2.0, up: true, cap_deg: 80.0 },
-                    View { name: "3 km, down", origin_alt_m: 3000.0, up: false, cap_deg: 75.0 },
-                    View { name: "500 m, down", origin_alt_m: 500.0, up: false, cap_deg: 60.0 },
+                    View {
+                        name: "ground, up",
+                        origin_alt_m: 2.0,
+                        up: true,
+                        cap_deg: 80.0,
+                    },
+                    View {
+                        name: "3 km, down",
+                        origin_alt_m: 3000.0,
+                        up: false,
+                        cap_deg: 75.0,
+                    },
+                    View {
+                        name: "500 m, down",
+                        origin_alt_m: 500.0,
+                        up: false,
+                        cap_deg: 60.0,
+                    },
                 ];
-                cases.push((format!("slab τ {tau}, sun zenith {sun_zenith}°"), slab, views, sun_zenith));
+                cases.push((
+                    format!("slab τ {tau}, sun zenith {sun_zenith}°"),
+                    slab,
+                    views,
+                    sun_zenith,
+                ));
             }
         }
     }
     if which == "all" || which == "cumulus" {
         for sun_zenith in [30.0, 70.0] {
             let views = vec![
-                View { name: "ground, up", origin_alt_m: 2.0, up: true, cap_deg: 80.0 },
-                View { name: "5 km, down", origin_alt_m: 5000.0, up: false, cap_deg: 60.0 },
+                View {
+                    name: "ground, up",
+                    origin_alt_m: 2.0,
+                    up: true,
+                    cap_deg: 80.0,
+                },
+                View {
+                    name: "5 km, down",
+                    origin_alt_m: 5000.0,
+                    up: false,
+                    cap_deg: 60.0,
+                },
             ];
             cases.push((
                 format!("cumulus (default), sun zenith {sun_zenith}°"),
@@ -135,16 +169,26 @@ fn main() -> firmament::Result<()> {
             {
                 Some(t) => t,
                 None => {
-                    let t: Vec<_> = reference::render_pixels(&model, &volumes, &[], &rays, 0, sun, &reference_settings, &|| {})
-                        .into_iter()
-                        .map(|e| (e.radiance, e.stderr))
-                        .collect();
+                    let t: Vec<_> = reference::render_pixels(
+                        &model,
+                        &volumes,
+                        &[],
+                        &rays,
+                        0,
+                        sun,
+                        &reference_settings,
+                        &|| {},
+                    )
+                    .into_iter()
+                    .map(|e| (e.radiance, e.stderr))
+                    .collect();
                     std::fs::write(&file, serde_json::to_vec(&t).unwrap()).ok();
                     t
                 }
             };
             let shader = Shader::new(&scene, origin)?;
-            let mut classes: std::collections::BTreeMap<&str, (Vec<f64>, Vec<f64>)> = Default::default();
+            let mut classes: std::collections::BTreeMap<&str, (Vec<f64>, Vec<f64>)> =
+                Default::default();
             for (d, e) in dirs.iter().zip(&truth) {
                 let ray = Ray { origin, dir: *d };
                 let mut l = [0.0; 3];
@@ -157,11 +201,32 @@ fn main() -> firmament::Result<()> {
                     .filter(|&(a, _)| a > 0.0)
                     .map(|(a, _)| origin + a * *d);
                 let class = match ground {
-                    Some(g) if media[0].optical_depth(&Ray { origin, dir: *d }, 0.0, (g - origin).length(), 0) < 0.1 => {
-                        let to_sun = media[0].optical_depth(&Ray { origin: g, dir: sun }, 0.0, f64::INFINITY, 0);
-                        if to_sun > 1.0 { "ground in cloud shadow" } else { "ground in sun" }
+                    Some(g)
+                        if media[0].optical_depth(
+                            &Ray { origin, dir: *d },
+                            0.0,
+                            (g - origin).length(),
+                            0,
+                        ) < 0.1 =>
+                    {
+                        let to_sun = media[0].optical_depth(
+                            &Ray {
+                                origin: g,
+                                dir: sun,
+                            },
+                            0.0,
+                            f64::INFINITY,
+                            0,
+                        );
+                        if to_sun > 1.0 {
+                            "ground in cloud shadow"
+                        } else {
+                            "ground in sun"
+                        }
                     }
-                    Some(_) if view.origin_alt_m < layer.resolved().bottom_m => "ground under the slab",
+                    Some(_) if view.origin_alt_m < layer.resolved().bottom_m => {
+                        "ground under the slab"
+                    }
                     _ if tau_view < 0.1 => "sky through a gap",
                     _ if view.up || view.origin_alt_m < layer.resolved().bottom_m => "cloud base",
                     _ => "cloud top",

@@ -5,10 +5,10 @@
 //!
 //! `cargo run --release -p firmament --example cloud_field [KIND] [COVERAGE] [SIDE_KM] [OUT.png]`
 
+use firmament::math::Vec3;
 use firmament::scene::clouds::{cloud_media, CloudKind, CloudLayerConfig, CloudNoise};
 use firmament::scene::clouds::{BASE_SHAPE_SIZE, EROSION_SIZE};
 use firmament::scene::{Ray, Volume};
-use firmament::math::Vec3;
 
 fn main() -> firmament::Result<()> {
     let args: Vec<String> = std::env::args().collect();
@@ -18,7 +18,10 @@ fn main() -> firmament::Result<()> {
     ))
     .expect("kind: cumulus, altostratus, cirrus or uniform");
     let coverage: Option<f64> = args.get(2).map(|s| s.parse().expect("coverage"));
-    let side_m = args.get(3).map_or(40.0, |s| s.parse::<f64>().expect("side (km)")) * 1000.0;
+    let side_m = args
+        .get(3)
+        .map_or(40.0, |s| s.parse::<f64>().expect("side (km)"))
+        * 1000.0;
     let out = args.get(4).map_or("cloud_field.png", |s| s.as_str());
     let radius = 6_360_000.0;
     let config = CloudLayerConfig {
@@ -42,7 +45,12 @@ fn main() -> firmament::Result<()> {
                 origin,
                 dir: -origin.normalize(),
             };
-            let tau = medium.optical_depth(&ray, 0.0, medium.layer.params.top_m - medium.layer.params.bottom_m + 20.0, 0);
+            let tau = medium.optical_depth(
+                &ray,
+                0.0,
+                medium.layer.params.top_m - medium.layer.params.bottom_m + 20.0,
+                0,
+            );
             cloudy += (tau > 0.1) as usize;
             sum += tau;
             pixels[j * n + i] = (255.0 * (tau / 10.0).min(1.0).powf(0.5)) as u8;

@@ -175,7 +175,14 @@ pub fn render_scene(
         ..render_settings(scene)
     };
     let frame = sky
-        .render(&settings, &sources, terrain, planet.as_ref(), &clouds, quiet)
+        .render(
+            &settings,
+            &sources,
+            terrain,
+            planet.as_ref(),
+            &clouds,
+            quiet,
+        )
         .context("rendering")?;
     let ev100 = ev100(scene, &frame);
     Ok((frame, ev100))

@@ -36,8 +36,16 @@ fn estimate_s(
         ..*settings
     };
     let t = Instant::now();
-    let (frame, _) =
-        reference::render_frame(model, volumes, surfaces, &pilot, sun, reference, &|_| {}, None)?;
+    let (frame, _) = reference::render_frame(
+        model,
+        volumes,
+        surfaces,
+        &pilot,
+        sun,
+        reference,
+        &|_| {},
+        None,
+    )?;
     let traced = frame.mask.iter().filter(|&&m| m).count().max(1);
     let per_pixel = t.elapsed().as_secs_f64() / traced as f64;
     let full = w * h * traced / (pw * ph);

@@ -150,7 +150,11 @@ fn optical_depth_coarse(volume: &dyn Volume, ray: &Ray) -> f64 {
     let (mut e, mut s) = ([0.0f64; 1], [0.0f64; 1]);
     let mut tau = 0.0;
     for i in 0..steps {
-        volume.coefficients(ray.origin + (a + (i as f64 + 0.5) * dt) * ray.dir, &mut e, &mut s);
+        volume.coefficients(
+            ray.origin + (a + (i as f64 + 0.5) * dt) * ray.dir,
+            &mut e,
+            &mut s,
+        );
         tau += e[0] * dt;
         if tau > 30.0 {
             break;

@@ -17,7 +17,7 @@ pub mod sky_dome;
 pub mod stars;
 pub mod terrain_air;
 pub mod tonemap;
-mod volumes;
+pub mod volumes;
 
 use std::f64::consts::PI;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -335,9 +335,10 @@ impl<'s> Shader<'s> {
             }
         }
         if !scene.volumes.is_empty() {
-            let lit = |j: usize, d: f64, shadowed: &mut Vec<(f64, f64)>, lit: &mut Vec<(f64, f64)>| {
-                self.lit_before(ray, j, d, shadowed, lit)
-            };
+            let lit =
+                |j: usize, d: f64, shadowed: &mut Vec<(f64, f64)>, lit: &mut Vec<(f64, f64)>| {
+                    self.lit_before(ray, j, d, shadowed, lit)
+                };
             volumes::composite(scene, &self.views, ray, end, &lit, &mut out[..n]);
         }
     }

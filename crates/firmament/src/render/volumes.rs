@@ -29,9 +29,9 @@
 
 use std::f64::consts::PI;
 
+use super::cloud_shadow::CloudShadow;
 use crate::math::hash::{lowbias32, unit};
 use crate::math::Vec3;
-use super::cloud_shadow::CloudShadow;
 use crate::scene::{DiffuseLight, Octaves, Ray, Scene, Volume};
 use crate::sky::{Shadow, SkyView};
 use crate::spectrum::MAX_CHANNELS;
@@ -291,7 +291,11 @@ fn light_sources(
             let phase = volume.phase(x);
             let cos = dir.dot(light.direction);
             let (mut gain_s, mut gain_t, mut gain_g) = (1.0, 1.0, 1.0);
-            for source in buf.source.iter_mut().take((octaves.count as usize).min(MAX_OCTAVES)) {
+            for source in buf
+                .source
+                .iter_mut()
+                .take((octaves.count as usize).min(MAX_OCTAVES))
+            {
                 let p = phase.eval_scaled(cos, gain_g);
                 for k in 0..n {
                     let t_vol = (-gain_t * buf.tau_light[k]).exp();
@@ -442,7 +446,12 @@ pub(super) fn dim_surface_light(
     // The shadow map's depth towards the light (all volumes together; grey), where it
     // covers the point, in place of each volume's march.
     let mapped = map.and_then(|m| m.optical_depth(x));
-    let shells = scene.volumes.iter().filter(|v| v.radii_m().is_some()).count().max(1);
+    let shells = scene
+        .volumes
+        .iter()
+        .filter(|v| v.radii_m().is_some())
+        .count()
+        .max(1);
     for volume in &scene.volumes {
         let crosses = volume.bounds(&towards).is_some();
         let over = volume.bounds(&above).is_some();

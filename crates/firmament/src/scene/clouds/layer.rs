@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 
 use super::noise::remap;
 use super::noise_volume::NoiseVolume;
-use super::profile::{CloudKind};
+use super::profile::CloudKind;
 use super::weather::WeatherMap;
 use crate::math::Vec3;
 use crate::{Error, Result};
@@ -240,17 +240,28 @@ impl CloudLayerConfig {
             }
         };
         if !(p.bottom_m.is_finite() && (0.0..=100_000.0).contains(&p.bottom_m)) {
-            return Err(Error::invalid(field("bottom_m"), p.bottom_m, "a number in [0, 100000] m"));
+            return Err(Error::invalid(
+                field("bottom_m"),
+                p.bottom_m,
+                "a number in [0, 100000] m",
+            ));
         }
         if !(p.top_m.is_finite() && p.top_m > p.bottom_m && p.top_m <= 100_000.0) {
             return Err(Error::invalid(
                 field("top_m"),
                 p.top_m,
-                format!("a number above bottom_m ({} m) and at most 100000 m", p.bottom_m),
+                format!(
+                    "a number above bottom_m ({} m) and at most 100000 m",
+                    p.bottom_m
+                ),
             ));
         }
         if !(0.0..=1.0).contains(&p.coverage) {
-            return Err(Error::invalid(field("coverage"), p.coverage, "a number in [0, 1]"));
+            return Err(Error::invalid(
+                field("coverage"),
+                p.coverage,
+                "a number in [0, 1]",
+            ));
         }
         if self.kind == CloudKind::Uniform && p.coverage != 1.0 {
             return Err(Error::invalid(
@@ -261,15 +272,26 @@ impl CloudLayerConfig {
         }
         positive("extinction_per_m", p.extinction_per_m)?;
         if !(0.0..=1.0).contains(&p.albedo) {
-            return Err(Error::invalid(field("albedo"), p.albedo, "a number in [0, 1]"));
+            return Err(Error::invalid(
+                field("albedo"),
+                p.albedo,
+                "a number in [0, 1]",
+            ));
         }
-        for (name, g) in [("phase_forward_g", p.phase[0]), ("phase_back_g", p.phase[1])] {
+        for (name, g) in [
+            ("phase_forward_g", p.phase[0]),
+            ("phase_back_g", p.phase[1]),
+        ] {
             if !(g.is_finite() && g.abs() < 1.0) {
                 return Err(Error::invalid(field(name), g, "a number in (-1, 1)"));
             }
         }
         if !(0.0..=1.0).contains(&p.phase[2]) {
-            return Err(Error::invalid(field("phase_forward_weight"), p.phase[2], "a number in [0, 1]"));
+            return Err(Error::invalid(
+                field("phase_forward_weight"),
+                p.phase[2],
+                "a number in [0, 1]",
+            ));
         }
         for (name, t) in [
             ("weather_tile_m", p.tiles_m[0]),
@@ -279,7 +301,11 @@ impl CloudLayerConfig {
             positive(name, t)?;
         }
         if !(1..=8).contains(&p.octaves) {
-            return Err(Error::invalid(field("octaves"), p.octaves, "an integer in [1, 8]"));
+            return Err(Error::invalid(
+                field("octaves"),
+                p.octaves,
+                "an integer in [1, 8]",
+            ));
         }
         let [a, b, c] = p.octave_gains;
         for (name, v) in [
@@ -299,10 +325,18 @@ impl CloudLayerConfig {
             ));
         }
         if self.kind == CloudKind::Uniform && self.weather.is_some() {
-            return Err(Error::invalid(field("weather"), "given", "none for a uniform layer"));
+            return Err(Error::invalid(
+                field("weather"),
+                "given",
+                "none for a uniform layer",
+            ));
         }
         if !self.wind_offset_m.iter().all(|v| v.is_finite()) {
-            return Err(Error::invalid(field("wind_offset_m"), format!("{:?}", self.wind_offset_m), "two finite numbers (m)"));
+            return Err(Error::invalid(
+                field("wind_offset_m"),
+                format!("{:?}", self.wind_offset_m),
+                "two finite numbers (m)",
+            ));
         }
         Ok(())
     }
@@ -343,10 +377,17 @@ impl CloudLayer {
                 params.tiles_m[0],
                 &format!("{prefix}.weather"),
             )?),
-            (None, false) => Some(WeatherMap::procedural(params.kind, params.seed, params.tiles_m[0])),
+            (None, false) => Some(WeatherMap::procedural(
+                params.kind,
+                params.seed,
+                params.tiles_m[0],
+            )),
         };
         Ok(CloudLayer {
-            radii_m: [planet_radius_m + params.bottom_m, planet_radius_m + params.top_m],
+            radii_m: [
+                planet_radius_m + params.bottom_m,
+                planet_radius_m + params.top_m,
+            ],
             planet_radius_m,
             weather,
             noise: (!uniform).then_some(noise),
@@ -389,7 +430,10 @@ impl CloudLayer {
             return 1.0;
         };
         let (x, y) = self.planar(point / r);
-        let (x, y) = (x + self.params.wind_offset_m[0], y + self.params.wind_offset_m[1]);
+        let (x, y) = (
+            x + self.params.wind_offset_m[0],
+            y + self.params.wind_offset_m[1],
+        );
         let [w, t, precipitation, warp_x, warp_y] = weather.sample(x, y);
         let c = (self.params.coverage + WEATHER_CONTRAST * (w - 0.5)).clamp(0.0, 1.0);
         let profile = self.params.kind.density(h, t);

@@ -248,7 +248,9 @@ impl Volume for CloudMedium {
         // The first stretch starting at the sample (the ray starts inside or below).
         let (a, b) = segs[0];
         let end = b.min(a + LIGHT_MARCH_MAX_M);
-        let total: f64 = (0..LIGHT_SAMPLES).map(|i| LIGHT_STEP_GROWTH.powi(i as i32)).sum();
+        let total: f64 = (0..LIGHT_SAMPLES)
+            .map(|i| LIGHT_STEP_GROWTH.powi(i as i32))
+            .sum();
         let mut step = (end - a) / total;
         let (mut t, mut tau) = (a, 0.0);
         for _ in 0..LIGHT_SAMPLES {

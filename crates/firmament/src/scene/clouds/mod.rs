@@ -46,8 +46,7 @@ impl CloudNoise {
     /// file holds them, else computed (and written there); the bool says whether both were
     /// read.
     pub fn new(sizes: [usize; 2], cache: Option<&Path>) -> Result<(CloudNoise, bool)> {
-        let (base, hit_a) =
-            NoiseVolume::cached(NoiseKind::BaseShape, sizes[0], NOISE_SALT, cache)?;
+        let (base, hit_a) = NoiseVolume::cached(NoiseKind::BaseShape, sizes[0], NOISE_SALT, cache)?;
         let (detail, hit_b) = NoiseVolume::cached(NoiseKind::Erosion, sizes[1], NOISE_SALT, cache)?;
         Ok((
             CloudNoise {
@@ -70,8 +69,13 @@ pub fn cloud_media(
         .iter()
         .enumerate()
         .map(|(i, c)| {
-            CloudLayer::new(c, planet_radius_m, noise.textures.clone(), &format!("clouds[{i}]"))
-                .map(CloudMedium::new)
+            CloudLayer::new(
+                c,
+                planet_radius_m,
+                noise.textures.clone(),
+                &format!("clouds[{i}]"),
+            )
+            .map(CloudMedium::new)
         })
         .collect()
 }

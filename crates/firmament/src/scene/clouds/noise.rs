@@ -95,11 +95,7 @@ pub fn worley(p: [f64; 3], period: u32, salt: u32) -> f64 {
                 let (i, j, k) = (c[0] + dx, c[1] + dy, c[2] + dz);
                 let h = hash3(salt, wrap(i, period), wrap(j, period), wrap(k, period));
                 let (h1, h2) = (lowbias32(h), lowbias32(h ^ 0x9e37_79b9));
-                let feature = [
-                    i as f64 + unit(h),
-                    j as f64 + unit(h1),
-                    k as f64 + unit(h2),
-                ];
+                let feature = [i as f64 + unit(h), j as f64 + unit(h1), k as f64 + unit(h2)];
                 let d2 = (0..3).map(|a| (feature[a] - p[a]).powi(2)).sum::<f64>();
                 nearest2 = nearest2.min(d2);
             }
@@ -171,7 +167,11 @@ mod tests {
         for &(x, y, z) in &[(0.3, 1.7, 2.2), (3.9, 0.1, 0.5), (2.5, 2.5, 3.99)] {
             for period in [4u32, 5] {
                 let p = [x, y, z];
-                let shifted = [x + period as f64, y - period as f64, z + 2.0 * period as f64];
+                let shifted = [
+                    x + period as f64,
+                    y - period as f64,
+                    z + 2.0 * period as f64,
+                ];
                 for f in [perlin, worley, perlin_worley, worley_fbm] {
                     assert!((f(p, period, 7) - f(shifted, period, 7)).abs() < 1e-12);
                 }
@@ -198,8 +198,14 @@ mod tests {
             let pw = perlin_worley(p, 8, 1);
             assert!((0.0..=1.0).contains(&pw));
         }
-        assert!(lo >= -1.05 && hi <= 1.05 && hi - lo > 1.0, "perlin [{lo}, {hi}]");
-        assert!(wlo >= 0.0 && whi <= 1.0 && whi - wlo > 0.6, "worley [{wlo}, {whi}]");
+        assert!(
+            lo >= -1.05 && hi <= 1.05 && hi - lo > 1.0,
+            "perlin [{lo}, {hi}]"
+        );
+        assert!(
+            wlo >= 0.0 && whi <= 1.0 && whi - wlo > 0.6,
+            "worley [{wlo}, {whi}]"
+        );
     }
 
     #[test]

@@ -166,7 +166,11 @@ fn equalise(data: &mut [f32]) {
 /// The cache file of a texture.
 fn cache_path(dir: &Path, kind: NoiseKind, size: usize, salt: u32) -> PathBuf {
     let key = fnv1a(
-        format!("{GENERATOR_VERSION} {kind:?} {size} {salt} {}", kind.cells_per_tile()).as_bytes(),
+        format!(
+            "{GENERATOR_VERSION} {kind:?} {size} {salt} {}",
+            kind.cells_per_tile()
+        )
+        .as_bytes(),
     );
     dir.join(format!("noise-{key:016x}.firmnoise"))
 }

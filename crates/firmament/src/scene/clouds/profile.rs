@@ -108,7 +108,11 @@ mod tests {
 
     #[test]
     fn profiles_vanish_outside_the_layer_and_peak_inside() {
-        for kind in [CloudKind::Cumulus, CloudKind::Altostratus, CloudKind::Cirrus] {
+        for kind in [
+            CloudKind::Cumulus,
+            CloudKind::Altostratus,
+            CloudKind::Cirrus,
+        ] {
             for t in [0.0, 0.25, 0.5, 0.75, 1.0] {
                 assert_eq!(kind.density(0.0, t), 0.0);
                 assert!(kind.density(1.0, t) < 1e-12);

@@ -72,14 +72,7 @@ fn fluxes(omega: f64, g: f64, tau: f64, mu0: f64, top: f64, depths: &[f64]) -> V
 }
 
 /// (F↑, F↓) at the depths, as [`fluxes`].
-fn flux_pairs(
-    omega: f64,
-    g: f64,
-    tau: f64,
-    mu0: f64,
-    top: f64,
-    depths: &[f64],
-) -> Vec<(f64, f64)> {
+fn flux_pairs(omega: f64, g: f64, tau: f64, mu0: f64, top: f64, depths: &[f64]) -> Vec<(f64, f64)> {
     let g1 = (7.0 - omega * (4.0 + 3.0 * g)) / 4.0;
     let g2 = -(1.0 - omega * (4.0 - 3.0 * g)) / 4.0;
     let k = (g1 * g1 - g2 * g2).max(1e-18).sqrt();
@@ -96,7 +89,11 @@ fn flux_pairs(
         let (inv, a11, a12, a21, a22) = (1.0 / m, g1 + 1.0 / m, -g2, g2, -(g1 - 1.0 / m));
         let (r1, r2) = (omega * g3 * s, -omega * g4 * s);
         let det = a11 * a22 - a12 * a21;
-        ((r1 * a22 - a12 * r2) / det, (a11 * r2 - a21 * r1) / det, inv)
+        (
+            (r1 * a22 - a12 * r2) / det,
+            (a11 * r2 - a21 * r1) / det,
+            inv,
+        )
     } else {
         (0.0, 0.0, 0.0)
     };
@@ -132,7 +129,9 @@ impl TwoStream {
     pub fn new(albedo: f64, g: f64) -> TwoStream {
         // ω = 1 exactly makes k = 0; the tables' albedo is kept just below.
         let (omega, g_scaled, scale) = delta_scaled(albedo.min(1.0 - 1e-6), g);
-        let depths: Vec<f64> = (0..DEPTHS).map(|i| i as f64 / (DEPTHS - 1) as f64).collect();
+        let depths: Vec<f64> = (0..DEPTHS)
+            .map(|i| i as f64 / (DEPTHS - 1) as f64)
+            .collect();
         let thickness = |j: usize| MAX_THICKNESS * (j as f64 / (THICKNESSES - 1) as f64).powi(2);
         let mut sun = Vec::with_capacity(COSINES * THICKNESSES * DEPTHS);
         for i in 0..COSINES {
@@ -162,7 +161,11 @@ impl TwoStream {
     fn axes(thickness: f64, depth: f64) -> (f64, f64) {
         let tau = thickness.clamp(0.0, MAX_THICKNESS);
         let s = (tau / MAX_THICKNESS).sqrt() * (THICKNESSES - 1) as f64;
-        let u = if tau > 0.0 { (depth / tau).clamp(0.0, 1.0) } else { 0.0 };
+        let u = if tau > 0.0 {
+            (depth / tau).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
         (s, u * (DEPTHS - 1) as f64)
     }
 
@@ -201,7 +204,11 @@ impl TwoStream {
     /// base, at `depth` below the top of a slab of `thickness` (I₁ from the upward
     /// vertical either way).
     pub fn diffuse(&self, thickness: f64, depth: f64, from_above: bool) -> [f64; 2] {
-        let depth = if from_above { depth } else { (thickness - depth).max(0.0) };
+        let depth = if from_above {
+            depth
+        } else {
+            (thickness - depth).max(0.0)
+        };
         let (s, u) = Self::axes(thickness, depth);
         let [i0, i1] = Self::plane(&self.diffuse, 0, s, u);
         [i0, if from_above { i1 } else { -i1 }]
@@ -234,7 +241,11 @@ mod tests {
                 // Midpoint (RK2) step.
                 let d_up = |u_: f64, d_: f64, b: f64| g1 * u_ - g2 * d_ - omega * g3 * b;
                 let d_down = |u_: f64, d_: f64, b: f64| g2 * u_ - g1 * d_ + omega * g4 * b;
-                let b0 = if mu0 > 0.0 { (-(t - 0.5 * h) / mu0).exp() } else { 0.0 };
+                let b0 = if mu0 > 0.0 {
+                    (-(t - 0.5 * h) / mu0).exp()
+                } else {
+                    0.0
+                };
                 let um = up + 0.5 * h * d_up(up, down, b0);
                 let dm = down + 0.5 * h * d_down(up, down, b0);
                 up += h * d_up(um, dm, beam);
@@ -254,14 +265,24 @@ mod tests {
 
     #[test]
     fn two_stream_solution_satisfies_its_equations() {
-        for &(omega, g, tau, mu0) in &[(0.99, 0.5, 3.0, 0.7), (0.9, 0.3, 8.0, 0.3), (0.999, 0.46, 10.0, 0.5)] {
+        for &(omega, g, tau, mu0) in &[
+            (0.99, 0.5, 3.0, 0.7),
+            (0.9, 0.3, 8.0, 0.3),
+            (0.999, 0.46, 10.0, 0.5),
+        ] {
             for u in [0.0, 0.3, 0.8] {
                 let analytic = fluxes(omega, g, tau, mu0, 0.0, &[u])[0];
                 let numeric = fluxes_numerically(omega, g, tau, mu0, 0.0, u);
-                assert!((analytic / numeric - 1.0).abs() < 1e-4, "{omega} {g} {tau} {mu0} {u}: {analytic} vs {numeric}");
+                assert!(
+                    (analytic / numeric - 1.0).abs() < 1e-4,
+                    "{omega} {g} {tau} {mu0} {u}: {analytic} vs {numeric}"
+                );
                 let analytic = fluxes(omega, g, tau, 0.0, 1.0, &[u])[0];
                 let numeric = fluxes_numerically(omega, g, tau, 0.0, 1.0, u);
-                assert!((analytic / numeric - 1.0).abs() < 1e-4, "diffuse {u}: {analytic} vs {numeric}");
+                assert!(
+                    (analytic / numeric - 1.0).abs() < 1e-4,
+                    "diffuse {u}: {analytic} vs {numeric}"
+                );
             }
         }
     }
@@ -278,7 +299,10 @@ mod tests {
             let base_sum = fluxes(omega, g, t, mu0, 0.0, &[1.0])[0]; // F↓(τ*) (F↑ = 0)
             let direct = mu0 * (-t / mu0).exp();
             let total = top_sum + base_sum + direct;
-            assert!((total - mu0).abs() < 1e-6 * mu0, "τ {tau} μ₀ {mu0}: {total} vs {mu0}");
+            assert!(
+                (total - mu0).abs() < 1e-6 * mu0,
+                "τ {tau} μ₀ {mu0}: {total} vs {mu0}"
+            );
         }
         // The tables' diffuse light vanishes without light and grows into the slab from a
         // lit top: in a thick slab the light near the top exceeds that near the base.

@@ -99,7 +99,9 @@ impl WeatherMap {
             .and_then(|e| e.to_str())
             .is_some_and(|e| e.eq_ignore_ascii_case("png"));
         if !is_png {
-            return Err(bad("a PNG file (.png): red coverage, green type, blue precipitation".into()));
+            return Err(bad(
+                "a PNG file (.png): red coverage, green type, blue precipitation".into(),
+            ));
         }
         let image = image::ImageReader::open(path)
             .map_err(|e| bad(format!("a readable PNG file ({e})")))?
@@ -113,7 +115,9 @@ impl WeatherMap {
             .map_err(|e| bad(format!("a decodable PNG file ({e})")))?;
         let (width, height) = (image.width() as usize, image.height() as usize);
         if width < 2 || height < 2 {
-            return Err(bad(format!("a PNG of at least 2×2 texels, not {width}×{height}")));
+            return Err(bad(format!(
+                "a PNG of at least 2×2 texels, not {width}×{height}"
+            )));
         }
         let grey = !image.color().has_color();
         let rgb = image.to_rgb32f();
@@ -202,7 +206,10 @@ mod tests {
         // Tiles: one tile over is the same, and across the seam it continues smoothly.
         let a = map.sample(1234.0, 5678.0);
         let b = map.sample(1234.0 + 10_000.0, 5678.0 - 20_000.0);
-        assert!(a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-9), "{a:?} {b:?}");
+        assert!(
+            a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-9),
+            "{a:?} {b:?}"
+        );
         let step = 10_000.0 / 256.0;
         let seam = (map.sample(-0.5 * step, 3000.0)[0] - map.sample(0.5 * step, 3000.0)[0]).abs();
         assert!(seam < 0.1, "seam {seam}");
@@ -218,13 +225,18 @@ mod tests {
         let err = WeatherMap::from_png(&not_png, CloudKind::Cumulus, 1e4, "clouds[0].weather")
             .unwrap_err()
             .to_string();
-        assert!(err.contains("clouds[0].weather") && err.contains("PNG"), "{err}");
+        assert!(
+            err.contains("clouds[0].weather") && err.contains("PNG"),
+            "{err}"
+        );
         let jpeg_name = dir.join("weather.jpg");
         std::fs::write(&jpeg_name, b"x").unwrap();
         assert!(WeatherMap::from_png(&jpeg_name, CloudKind::Cumulus, 1e4, "w").is_err());
         // A real 3×2 RGB PNG reads, rows flipped to south-first.
         let good = dir.join("good.png");
-        let img = image::RgbImage::from_fn(3, 2, |x, y| image::Rgb([(x * 100) as u8, (y * 255) as u8, 0]));
+        let img = image::RgbImage::from_fn(3, 2, |x, y| {
+            image::Rgb([(x * 100) as u8, (y * 255) as u8, 0])
+        });
         img.save(&good).unwrap();
         let map = WeatherMap::from_png(&good, CloudKind::Cumulus, 1e4, "w").unwrap();
         assert_eq!((map.width, map.height), (3, 2));
