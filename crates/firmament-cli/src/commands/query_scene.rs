@@ -1,6 +1,6 @@
 //! `firmament query --scene FILE`: the radiance a camera at the scene's observer sees in
 //! each `--view`, everything in the scene included (its terrain lit and shadowed, the light
-//! shafts, the ground, aerial perspective; the sun's disk excluded), from the tables through
+//! shafts, the ground, aerial perspective, the clouds; the sun's disk excluded), from the tables through
 //! the renderer's own shading or from the reference path tracer with the same surfaces. The
 //! JSON is `query`'s.
 
@@ -8,7 +8,7 @@ use anyhow::Result;
 use firmament::math::direction_from_zenith_azimuth;
 use firmament::reference::{self, ReferenceSettings};
 use firmament::render::{ShadeScratch, Shader};
-use firmament::scene::{Ray, Scene as RenderScene, SceneFile, Surface};
+use firmament::scene::{Ray, Scene as RenderScene, SceneFile, Surface, Volume};
 use serde_json::json;
 
 use super::provenance::provenance;
@@ -61,6 +61,7 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
         .as_ref()
         .map_or(model.bottom_radius_m, |t| t.radius_m);
     let planet = scene.build_surface(radius, &nm)?;
+    let clouds = crate::common::scene_clouds(&scene, radius, args.quiet)?;
     let mut render_scene = RenderScene::clear_sky(sky.method(), sources.lights[0].direction, false);
     render_scene.lights = sources.lights.clone();
     render_scene
@@ -74,6 +75,10 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
     if let Some(p) = &planet {
         render_scene.set_ground(p);
     }
+    for c in &clouds {
+        render_scene.volumes.push(Box::new(c));
+    }
+    let volumes: Vec<Box<dyn Volume + '_>> = clouds.iter().map(|c| Box::new(c) as _).collect();
     let shader = Shader::new(&render_scene, observer)?;
     let first_view = sky.method().view(observer, &render_scene.lights[0]);
     // The reference meets the terrain and the planet's map as Lambertian surfaces (the map's
@@ -104,7 +109,8 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
         };
         let mut radiance = vec![0.0; n];
         shader.shade(&ray, &mut scratch, &mut radiance);
-        // The air's transmittance to the first surface, or out of the atmosphere.
+        // The air's transmittance to the first surface, or out of the atmosphere (the
+        // clouds' not included).
         let mut transmittance = vec![0.0; n];
         match render_scene.nearest_hit(&ray, f64::INFINITY) {
             Some((_, hit)) => first_view.transmittance_to_point(hit.position, &mut transmittance),
@@ -119,7 +125,7 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
             let sun = render_scene.lights[0].direction;
             let truth = truth.as_ref().expect("the reference's model");
             let e =
-                reference::scene_radiance(truth, &[], &surfaces, observer, dir, sun, s, i as u64);
+                reference::scene_radiance(truth, &volumes, &surfaces, observer, dir, sun, s, i as u64);
             radiance.copy_from_slice(&e.radiance);
             e
         });
@@ -134,9 +140,9 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
     let sun = &render_scene.lights[0];
     let up = sun.direction.z.clamp(-1.0, 1.0);
     let method = match &settings {
-        None => format!("views: the renderer's shading of the scene with {} (terrain, shadows, light shafts, ground, aerial perspective; the sun's disk excluded)", sky.name()),
+        None => format!("views: the renderer's shading of the scene with {} (terrain, shadows, light shafts, ground, aerial perspective, clouds; the sun's disk excluded)", sky.name()),
         Some(s) => format!(
-            "views: spectral Monte Carlo reference path tracer through the same scene (the terrain intersected as a Lambertian surface), {} paths per wavelength and view, seed {} (view i uses stream key i); the sun's disk excluded",
+            "views: spectral Monte Carlo reference path tracer through the same scene (the terrain intersected as a Lambertian surface, the clouds by delta tracking), {} paths per wavelength and view, seed {} (view i uses stream key i); the sun's disk excluded",
             s.samples, s.seed
         ),
     };

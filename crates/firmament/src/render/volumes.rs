@@ -321,9 +321,10 @@ fn light_sources(
                             .unwrap_or(f0)
                     };
                     let beam = light.irradiance[k] * buf.t_light[k];
-                    let ground = ground_direct[k] * f.base_direct
+                    let ground = (ground_direct[k] * f.base_direct
                         + beam * f.base_from_light
-                        + ground_sky[k] * f.base_from_above;
+                        + ground_sky[k] * f.base_from_above)
+                        / (1.0 - albedo[k] * f.base_reflectance);
                     // The field's moments, then the radiance scattered towards the eye
                     // (travelling along −dir): I₀ + g′·I₁·μ.
                     let e = [beam, buf.ambient[0][k], albedo[k] * ground];
@@ -443,6 +444,7 @@ pub(super) fn dim_surface_light(
     let mut beam = [1.0f64; MAX_CHANNELS];
     let mut sky_factor = [1.0f64; MAX_CHANNELS];
     let mut diffuse = [0.0f64; MAX_CHANNELS];
+    let mut bounce = [1.0f64; MAX_CHANNELS];
     // The shadow map's depth towards the light (all volumes together; grey), where it
     // covers the point, in place of each volume's march.
     let mapped = map.and_then(|m| m.optical_depth(x));
@@ -482,7 +484,11 @@ pub(super) fn dim_surface_light(
             };
             let unscattered = (-tau_l).exp();
             let (through, from_beam) = match f {
-                Some(f) => (f.base_from_above, f.base_from_light),
+                Some(f) => {
+                    // The ground and the column's base light each other.
+                    bounce[k] /= 1.0 - albedo_of(scene, k) * f.base_reflectance;
+                    (f.base_from_above, f.base_from_light)
+                }
                 None => {
                     let total = 1.0 / (1.0 + one_minus_g * tau_up);
                     (total, mu.max(0.0) * (total - unscattered).max(0.0))
@@ -497,5 +503,8 @@ pub(super) fn dim_surface_light(
     for k in 0..n {
         direct[k] *= beam[k];
         sky[k] = sky[k] * sky_factor[k] + e_light[k] * t_air[k] * diffuse[k] * open;
+        // What the ground and the cloud base reflect between them comes back as diffuse
+        // light: the whole irradiance times 1/(1 − A·R).
+        sky[k] += (bounce[k] - 1.0) * (direct[k] + sky[k]);
     }
 }

@@ -154,8 +154,12 @@ pub struct DiffuseLight {
     pub base_direct: f64,
     /// the diffuse flux leaving its base per unit beam irradiance,
     pub base_from_light: f64,
-    /// and per unit hemispheric irradiance entering its top.
+    /// and per unit hemispheric irradiance entering its top;
     pub base_from_above: f64,
+    /// the fraction of diffuse light from below that the column reflects back down (the
+    /// ground and the cloud's base light each other: the ground's irradiance grows by
+    /// 1/(1 − A·this), A the ground's albedo).
+    pub base_reflectance: f64,
     /// The fraction of the scattering coefficient that scatters this diffuse light (the
     /// rest is the phase function's forward peak, counted as unscattered: δ-scaling). The
     /// renderer carries the diffuse light along the view in the octave slot 1, whose

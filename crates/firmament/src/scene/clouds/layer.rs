@@ -28,7 +28,7 @@ use crate::math::Vec3;
 use crate::{Error, Result};
 
 /// How far the weather moves the local coverage about the layer's: c_loc = c + k·(w − ½).
-const WEATHER_CONTRAST: f64 = 1.2;
+const WEATHER_CONTRAST: f64 = 0.7;
 /// How much the weather's precipitation raises the density (1 + gain·p).
 const PRECIPITATION_GAIN: f64 = 2.0;
 
@@ -178,7 +178,7 @@ impl CloudLayerConfig {
 
     /// The settings with the kind's defaults where none is given: cumulus 1.5–3.5 km,
     /// coverage 0.45, 0.05 m⁻¹ (Hillaire 2016's 0.04–0.12); altostratus 4–5.5 km, 0.8,
-    /// 0.01 m⁻¹; cirrus 8–9.5 km, 0.5, 3·10⁻⁴ m⁻¹ (optical depth ≈ 0.3, Sassen & Cho
+    /// 0.01 m⁻¹; cirrus 8–9.5 km, 0.5, 10⁻³ m⁻¹ (optical depth ≈ 0.5, Sassen & Cho
     /// 1992's thin cirrus); uniform 1–2 km, 0.01 m⁻¹ (optical thickness 10). Phase: g
     /// 0.8 / −0.5 weighted 0.8 / 0.2 (Hillaire 2016, fig. 39's balance of forward peak and
     /// back scatter); octaves 3 with a = b = c = 0.5 (Wrenninge 2015; Hillaire 2016).
@@ -186,7 +186,7 @@ impl CloudLayerConfig {
         let (bottom, top, coverage, extinction, tile) = match self.kind {
             CloudKind::Cumulus => (1500.0, 3500.0, 0.45, 0.05, 10_000.0),
             CloudKind::Altostratus => (4000.0, 5500.0, 0.8, 0.01, 20_000.0),
-            CloudKind::Cirrus => (8000.0, 9500.0, 0.5, 3e-4, 30_000.0),
+            CloudKind::Cirrus => (8000.0, 9500.0, 0.5, 1e-3, 30_000.0),
             CloudKind::Uniform => (1000.0, 2000.0, 1.0, 0.01, 6000.0),
         };
         LayerParams {

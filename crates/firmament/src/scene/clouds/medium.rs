@@ -25,6 +25,9 @@ const LIGHT_STEP_GROWTH: f64 = 1.8;
 /// The farthest the march towards the light looks (m): beyond, a cumulus layer's cells
 /// rarely line up.
 const LIGHT_MARCH_MAX_M: f64 = 6000.0;
+/// The most grazing light the equivalent slab of the two-stream is lit by (a cloud's sides
+/// face a low sun; a uniform slab's sun is never that low in the tests).
+const MIN_LIGHT_COSINE: f64 = 0.2;
 /// Samples of each vertical march of the ambient light.
 const AMBIENT_SAMPLES: usize = 2;
 
@@ -188,16 +191,24 @@ impl Volume for CloudMedium {
             self.vertical_optical_depths(point, 0)
         };
         let thickness = above + below;
-        // The sun's depth into the equivalent slab: where its beam is as dimmed as the
+        // A cloud's sides face a low light: the equivalent slab is never lit more grazingly
+        // than MIN_LIGHT_COSINE (a light at or just below the local horizon, which the air
+        // still lets through at altitude, lights the clouds from the side).
+        let mu_slab = if tau_light.is_finite() && mu_light > -0.1 {
+            mu_light.max(MIN_LIGHT_COSINE)
+        } else {
+            mu_light
+        };
+        // The light's depth into the equivalent slab: where its beam is as dimmed as the
         // march towards it says (the vertical depth in a uniform slab).
-        let sun_depth = if mu_light > 0.0 {
-            (tau_light * mu_light).min(thickness)
+        let sun_depth = if mu_slab > 0.0 {
+            (tau_light * mu_slab).min(thickness)
         } else {
             thickness
         };
         let two_pi = 2.0 * std::f64::consts::PI;
         Some(DiffuseLight {
-            from_light: ts.sun(thickness, sun_depth, mu_light),
+            from_light: ts.sun(thickness, sun_depth, mu_slab),
             from_above: ts.diffuse(thickness, above, true),
             from_below: ts.diffuse(thickness, above, false),
             base_direct: if mu_light > 0.0 {
@@ -208,6 +219,9 @@ impl Volume for CloudMedium {
             // At a black base F↑ = 0, so F↓ = 2π·I₀.
             base_from_light: two_pi * ts.sun(thickness, thickness, mu_light)[0],
             base_from_above: two_pi * ts.diffuse(thickness, thickness, true)[0],
+            // Diffuse light from above: F↓(0) = 1, F↑(0) = 2π·I₀(0) − 1; the slab
+            // reflects light from below alike.
+            base_reflectance: (two_pi * ts.diffuse(thickness, 0.0, true)[0] - 1.0).clamp(0.0, 1.0),
             asymmetry: ts.asymmetry,
             scattering_scale: ts.scattering_scale,
         })
