@@ -97,6 +97,9 @@ pub struct Shader<'s> {
 pub struct ShadeScratch {
     shadowed: Vec<(f64, f64)>,
     lit: Vec<(f64, f64)>,
+    /// The clouds' shadows along the ray and their complement.
+    clouded: Vec<(f64, f64)>,
+    air_lit: Vec<(f64, f64)>,
 }
 
 impl<'s> Shader<'s> {
@@ -335,17 +338,18 @@ impl<'s> Shader<'s> {
             }
         }
         if !scene.volumes.is_empty() {
-            let lit =
-                |j: usize, d: f64, shadowed: &mut Vec<(f64, f64)>, lit: &mut Vec<(f64, f64)>| {
-                    self.lit_before(ray, j, d, shadowed, lit)
-                };
-            volumes::composite(scene, &self.views, ray, end, &lit, &mut out[..n]);
+            let shadow_of = |j: usize, d: f64, s: &mut ShadeScratch| {
+                let (shadow, _) = self.shadow(ray, j, d, s);
+                shadow_owned(shadow)
+            };
+            volumes::composite(scene, &self.views, ray, end, &shadow_of, scratch, &mut out[..n]);
         }
     }
 
     /// The parts of `ray` up to `end` that light `j` reaches (past the surfaces and under
-    /// the volumes' shadow map), and whether it reaches `end` past the surfaces (the
-    /// volumes' shadow on a surface is [`volumes::dim_surface_light`]'s).
+    /// the volumes' shadow map, [`Shadow::Clouded`] when the map shadows some of it), and
+    /// whether it reaches `end` past the surfaces (the volumes' shadow on a surface is
+    /// [`volumes::dim_surface_light`]'s).
     fn shadow<'b>(
         &self,
         ray: &Ray,
@@ -354,44 +358,42 @@ impl<'s> Shader<'s> {
         scratch: &'b mut ShadeScratch,
     ) -> (Shadow<'b>, bool) {
         scratch.shadowed.clear();
+        scratch.clouded.clear();
         let light = &self.scene.lights[j];
         self.scene
             .shadowed_intervals(ray, light.direction, end, &mut scratch.shadowed);
         let lit_at_end = !(scratch.shadowed.iter()).any(|&(a, b)| a <= end && b >= end);
         if let Some(Some(map)) = self.cloud_shadows.get(j) {
-            map.shadowed_intervals(ray, end, &mut scratch.shadowed);
+            map.shadowed_intervals(ray, end, &mut scratch.clouded);
         }
-        if scratch.shadowed.is_empty() {
+        if scratch.shadowed.is_empty() && scratch.clouded.is_empty() {
             return (Shadow::None, true);
         }
         scratch.lit.clear();
+        if scratch.clouded.is_empty() {
+            lit_intervals(&mut scratch.shadowed, end, &mut scratch.lit);
+            return (Shadow::Lit(&scratch.lit), lit_at_end);
+        }
+        scratch.air_lit.clear();
+        lit_intervals(&mut scratch.clouded, end, &mut scratch.air_lit);
+        scratch.shadowed.extend_from_slice(&scratch.clouded);
         lit_intervals(&mut scratch.shadowed, end, &mut scratch.lit);
-        (Shadow::Lit(&scratch.lit), lit_at_end)
+        let shadow = Shadow::Clouded {
+            single: &scratch.lit,
+            multiple: &scratch.air_lit,
+        };
+        (shadow, lit_at_end)
     }
+}
 
-    /// The lit stretches of `ray` before `end` for light `j` into `lit` (as
-    /// [`Shader::shadow`]), `shadowed` scratch; false when all of it is lit.
-    fn lit_before(
-        &self,
-        ray: &Ray,
-        j: usize,
-        end: f64,
-        shadowed: &mut Vec<(f64, f64)>,
-        lit: &mut Vec<(f64, f64)>,
-    ) -> bool {
-        shadowed.clear();
-        lit.clear();
-        let light = &self.scene.lights[j];
-        self.scene
-            .shadowed_intervals(ray, light.direction, end, shadowed);
-        if let Some(Some(map)) = self.cloud_shadows.get(j) {
-            map.shadowed_intervals(ray, end, shadowed);
+/// A shadow's intervals copied out of the scratch that holds them.
+fn shadow_owned(shadow: Shadow) -> volumes::OwnedShadow {
+    match shadow {
+        Shadow::None | Shadow::Length(_) => volumes::OwnedShadow::None,
+        Shadow::Lit(l) => volumes::OwnedShadow::Lit(l.to_vec()),
+        Shadow::Clouded { single, multiple } => {
+            volumes::OwnedShadow::Clouded(single.to_vec(), multiple.to_vec())
         }
-        if shadowed.is_empty() {
-            return false;
-        }
-        lit_intervals(shadowed, end, lit);
-        true
     }
 }
 

@@ -30,6 +30,7 @@
 use std::f64::consts::PI;
 
 use super::cloud_shadow::CloudShadow;
+use super::ShadeScratch;
 use crate::math::hash::{lowbias32, unit};
 use crate::math::Vec3;
 use crate::scene::{DiffuseLight, Octaves, Ray, Scene, Volume};
@@ -68,20 +69,42 @@ struct Buffers {
     ambient: [[f64; MAX_CHANNELS]; 3],
 }
 
-/// The lit stretches of the ray before a distance for light j: `lit(j, d, scratch, out)`
-/// fills `out` and says whether any of it is in shadow.
-pub(super) type LitBefore<'a> =
-    dyn Fn(usize, f64, &mut Vec<(f64, f64)>, &mut Vec<(f64, f64)>) -> bool + 'a;
+/// A [`Shadow`] that owns its intervals.
+pub(super) enum OwnedShadow {
+    /// All lit.
+    None,
+    /// [`Shadow::Lit`].
+    Lit(Vec<(f64, f64)>),
+    /// [`Shadow::Clouded`]: single, multiple.
+    Clouded(Vec<(f64, f64)>, Vec<(f64, f64)>),
+}
+
+impl OwnedShadow {
+    fn as_shadow(&self) -> Shadow<'_> {
+        match self {
+            OwnedShadow::None => Shadow::None,
+            OwnedShadow::Lit(l) => Shadow::Lit(l),
+            OwnedShadow::Clouded(s, m) => Shadow::Clouded {
+                single: s,
+                multiple: m,
+            },
+        }
+    }
+}
+
+/// The shadow along the ray before a distance for light j: `shadow_of(j, d, scratch)`.
+pub(super) type ShadowOf<'a> = dyn Fn(usize, f64, &mut ShadeScratch) -> OwnedShadow + 'a;
 
 /// Composite the volumes crossed by `ray` before `end` over `out` (the radiance behind);
-/// `lit` gives the stretches of the ray each light reaches (the air in front of the
-/// volumes is lit only there).
+/// `shadow_of` gives the shadow of each light along the ray (the air in front of the
+/// volumes is lit only where the light reaches it).
 pub(super) fn composite(
     scene: &Scene,
     views: &[Box<dyn SkyView + '_>],
     ray: &Ray,
     end: f64,
-    lit: &LitBefore,
+    shadow_of: &ShadowOf,
+    scratch: &mut ShadeScratch,
     out: &mut [f64],
 ) {
     let n = out.len();
@@ -214,13 +237,14 @@ pub(super) fn composite(
     let point = ray.origin + d_mean * ray.dir;
     let mut front = [0.0f64; MAX_CHANNELS];
     let mut l = [0.0f64; MAX_CHANNELS];
-    let (mut shadowed, mut lit_stretches) = (Vec::new(), Vec::new());
     for (j, view) in views.iter().enumerate() {
-        let shadow = match lit(j, d_mean, &mut shadowed, &mut lit_stretches) {
-            true => Shadow::Lit(&lit_stretches),
-            false => Shadow::None,
-        };
-        view.sky_radiance_to_point(point, shadow, &mut l[..n], &mut [0.0; MAX_CHANNELS][..n]);
+        let shadow = shadow_of(j, d_mean, scratch);
+        view.sky_radiance_to_point(
+            point,
+            shadow.as_shadow(),
+            &mut l[..n],
+            &mut [0.0; MAX_CHANNELS][..n],
+        );
         for k in 0..n {
             front[k] += l[k];
         }

@@ -50,6 +50,16 @@ pub enum Shadow<'a> {
     /// surface hides of the sky is `render::terrain_air`'s). `Length` leaves both out, as
     /// the paper does.
     Lit(&'a [(f64, f64)]),
+    /// As `Lit` for the single scattering (the light reaches the `single` intervals), and
+    /// the multiple scattering taken over the `multiple` intervals only: the rest of the
+    /// ray lies in a cloud's shadow, where the air is lit neither by the light nor by the
+    /// sky above the cloud (the cloud's own light is the cloud's: `render::volumes`).
+    Clouded {
+        /// Where the light reaches (surfaces' and clouds' shadows left out).
+        single: &'a [(f64, f64)],
+        /// Where the air is lit at all (the clouds' shadows left out).
+        multiple: &'a [(f64, f64)],
+    },
 }
 
 /// A way of evaluating an atmosphere's light transport (the 4D tables, Hillaire 2020, the
