@@ -124,8 +124,9 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
         let estimate = settings.as_ref().map(|s| {
             let sun = render_scene.lights[0].direction;
             let truth = truth.as_ref().expect("the reference's model");
-            let e =
-                reference::scene_radiance(truth, &volumes, &surfaces, observer, dir, sun, s, i as u64);
+            let e = reference::scene_radiance(
+                truth, &volumes, &surfaces, observer, dir, sun, s, i as u64,
+            );
             radiance.copy_from_slice(&e.radiance);
             e
         });

@@ -22,11 +22,15 @@ pub const HALF_EXTENT_M: f64 = 40_000.0;
 /// Texels per side.
 const TEXELS: usize = 640;
 /// Quadrature step through the volumes along the light (m).
-const MAP_STEP_M: f64 = 60.0;
+const MAP_STEP_M: f64 = 80.0;
 /// A point is in shadow where the light's transmittance is below this.
 const SHADOW_TRANSMITTANCE: f64 = 0.5;
-/// The farthest along a view ray the air's shadow is looked for (m).
-const MAX_SHADOW_DISTANCE_M: f64 = 80_000.0;
+/// Shadowed stretches closer than this (m) are merged, so that a ray across a field of
+/// cumulus asks the sky method for a few intervals rather than many.
+const MERGE_GAP_M: f64 = 800.0;
+/// The farthest along a view ray the air's shadow is looked for (m): beyond, the steps
+/// would alias the cumulus' shadows into streaks, and the air is taken as lit.
+const MAX_SHADOW_DISTANCE_M: f64 = 30_000.0;
 
 /// The volumes' optical depth towards one light over their base sphere.
 pub struct CloudShadow {
@@ -108,17 +112,18 @@ impl CloudShadow {
     }
 
     /// Append the stretches of `ray` before `end` (and below the base) that the map puts
-    /// in shadow to `out`, sampled every max(150 m, t/25).
+    /// in shadow to `out`, sampled every max(250 m, t/50).
     pub fn shadowed_intervals(&self, ray: &Ray, end: f64, out: &mut Vec<(f64, f64)>) {
         // Where the ray is below the base sphere.
         let limit = match ray_sphere(ray.origin, ray.dir, self.base_radius_m) {
             Some((_, far)) if far > 0.0 => far.min(end).min(MAX_SHADOW_DISTANCE_M),
             _ => return,
         };
+        let first = out.len();
         let mut t = 0.0;
         let mut start: Option<f64> = None;
         while t < limit {
-            let dt = (0.04 * t).max(150.0);
+            let dt = (0.02 * t).max(250.0);
             let mid = (t + 0.5 * dt).min(limit);
             let shadowed = self
                 .optical_depth(ray.origin + mid * ray.dir)
@@ -136,7 +141,23 @@ impl CloudShadow {
         if let Some(s) = start {
             out.push((s, limit));
         }
+        merge_close(out, first, MERGE_GAP_M);
     }
+}
+
+/// Merge the intervals of `out[first..]` (increasing) whose gaps are under `gap`.
+fn merge_close(out: &mut Vec<(f64, f64)>, first: usize, gap: f64) {
+    let mut w = first;
+    for r in first..out.len() {
+        let iv = out[r];
+        if w > first && iv.0 - out[w - 1].1 < gap {
+            out[w - 1].1 = iv.1;
+        } else {
+            out[w] = iv;
+            w += 1;
+        }
+    }
+    out.truncate(w);
 }
 
 /// A volume's optical depth along `ray` (to infinity) by the midpoint rule at

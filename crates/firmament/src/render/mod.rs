@@ -243,6 +243,9 @@ impl<'s> Shader<'s> {
         out[..n].iter_mut().for_each(|v| *v = 0.0);
         let hit = scene.nearest_hit(ray, f64::INFINITY);
         let end = hit.map_or(f64::INFINITY, |(_, h)| h.distance_m);
+        // Each light's shadow along the ray, kept for the volumes in front.
+        let keep = !scene.volumes.is_empty();
+        let mut shadows: Vec<volumes::OwnedShadow> = Vec::new();
         match hit {
             Some((i, hit)) => with_channel_buffers(n, |[l, t, albedo, direct, sky, share]| {
                 let surface = &scene.surfaces[i];
@@ -256,6 +259,9 @@ impl<'s> Shader<'s> {
                 let up = hit.position.normalize();
                 for (j, view) in self.views.iter().enumerate() {
                     let (shadow, lit_at_end) = self.shadow(ray, j, end, scratch);
+                    if keep {
+                        shadows.push(shadow_owned(shadow));
+                    }
                     view.sun_and_sky_irradiance(hit.position, hit.normal, direct, sky);
                     if !lit_at_end {
                         direct.iter_mut().for_each(|v| *v = 0.0);
@@ -307,6 +313,9 @@ impl<'s> Shader<'s> {
                 let background = scene.background.as_ref();
                 for (j, view) in self.views.iter().enumerate() {
                     let (shadow, _) = self.shadow(ray, j, end, scratch);
+                    if keep {
+                        shadows.push(shadow_owned(shadow));
+                    }
                     // The transmittance along the ray (the same for every light) only for a
                     // disk in view or a background.
                     let t = if (disks || background.is_some()) && j == 0 {
@@ -337,12 +346,8 @@ impl<'s> Shader<'s> {
                 air.add(ray.dir, end, &mut out[..n]);
             }
         }
-        if !scene.volumes.is_empty() {
-            let shadow_of = |j: usize, d: f64, s: &mut ShadeScratch| {
-                let (shadow, _) = self.shadow(ray, j, d, s);
-                shadow_owned(shadow)
-            };
-            volumes::composite(scene, &self.views, ray, end, &shadow_of, scratch, &mut out[..n]);
+        if keep {
+            volumes::composite(scene, &self.views, ray, end, &shadows, &mut out[..n]);
         }
     }
 
@@ -388,7 +393,7 @@ impl<'s> Shader<'s> {
 
 /// A shadow's intervals copied out of the scratch that holds them.
 fn shadow_owned(shadow: Shadow) -> volumes::OwnedShadow {
-    match shadow {
+    match &shadow {
         Shadow::None | Shadow::Length(_) => volumes::OwnedShadow::None,
         Shadow::Lit(l) => volumes::OwnedShadow::Lit(l.to_vec()),
         Shadow::Clouded { single, multiple } => {

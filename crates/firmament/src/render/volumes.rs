@@ -19,7 +19,7 @@
 //!
 //! Steps: by optical depth (0.1 of the majorant per step, 32 to 1024 steps), or, for volumes
 //! that name a feature size (clouds), at that size growing with distance, skipping empty
-//! stretches in leaps of three steps, and stopping once the volumes are opaque. The steps
+//! stretches in leaps of six steps, and stopping once the volumes are opaque. The steps
 //! are jittered per ray (a hash of its direction).
 //!
 //! Composition: the air in front of the volumes' transmittance-weighted mean depth d̄ is left
@@ -30,10 +30,9 @@
 use std::f64::consts::PI;
 
 use super::cloud_shadow::CloudShadow;
-use super::ShadeScratch;
 use crate::math::hash::{lowbias32, unit};
 use crate::math::Vec3;
-use crate::scene::{DiffuseLight, Octaves, Ray, Scene, Volume};
+use crate::scene::{DiffuseLight, Octaves, Ray, Scene};
 use crate::sky::{Shadow, SkyView};
 use crate::spectrum::MAX_CHANNELS;
 
@@ -42,13 +41,16 @@ use crate::spectrum::MAX_CHANNELS;
 const STEP_OPTICAL_DEPTH: f64 = 0.1;
 const MIN_STEPS: usize = 32;
 const MAX_STEPS: usize = 1024;
-/// Adaptive steps grow with the distance t as max(feature, STEP_DISTANCE_FRACTION·t): a
-/// thousandth of a radian is about a pixel of a 1080p frame's 60° field.
-const STEP_DISTANCE_FRACTION: f64 = 0.003;
+/// Adaptive steps grow with the distance t as max(feature, STEP_DISTANCE_FRACTION·t): 250 m
+/// at 50 km, a quarter of a cumulus there.
+const STEP_DISTANCE_FRACTION: f64 = 0.005;
+/// Steps in a volume's feature size (its finest texel): a step per texel at the closest,
+/// jittered (1.5 texels shows as grain in thin cloud).
+const FEATURE_STEPS: f64 = 1.0;
 /// Empty samples in a row before the march leaps ahead.
-const EMPTY_BEFORE_LEAP: usize = 2;
+const EMPTY_BEFORE_LEAP: usize = 1;
 /// Steps in one leap over empty space.
-const LEAP_STEPS: f64 = 3.0;
+const LEAP_STEPS: f64 = 6.0;
 /// The march stops once the volumes' transmittance is below this in every channel and
 /// octave.
 const OPAQUE_TRANSMITTANCE: f64 = 1e-4;
@@ -59,7 +61,6 @@ pub const MAX_OCTAVES: usize = 8;
 struct Buffers {
     sigma_t: [f64; MAX_CHANNELS],
     e_v: [f64; MAX_CHANNELS],
-    s_v: [f64; MAX_CHANNELS],
     /// The source of each octave.
     source: [[f64; MAX_CHANNELS]; MAX_OCTAVES],
     t_light: [f64; MAX_CHANNELS],
@@ -67,7 +68,23 @@ struct Buffers {
     /// [E↓ of the sky at the sample, the direct and the sky irradiance of the clear
     /// ground below it].
     ambient: [[f64; MAX_CHANNELS]; 3],
+    /// The air's light at a sample (transmittance to the light and `ambient`), per light
+    /// (up to [`CACHED_LIGHTS`]), kept for the samples within [`AIR_LIGHT_REUSE_M`] of it.
+    air: [Option<(Vec3, AirLight)>; CACHED_LIGHTS],
 }
+
+/// The air's light at a point for one light.
+#[derive(Clone, Copy)]
+struct AirLight {
+    t_light: [f64; MAX_CHANNELS],
+    ambient: [[f64; MAX_CHANNELS]; 3],
+}
+
+/// Lights whose air light a march keeps.
+const CACHED_LIGHTS: usize = 4;
+/// How far (m) a sample may be from the one whose air light (the sky method's
+/// transmittance to the light and irradiances, which vary over kilometres) it reuses.
+const AIR_LIGHT_REUSE_M: f64 = 250.0;
 
 /// A [`Shadow`] that owns its intervals.
 pub(super) enum OwnedShadow {
@@ -92,19 +109,15 @@ impl OwnedShadow {
     }
 }
 
-/// The shadow along the ray before a distance for light j: `shadow_of(j, d, scratch)`.
-pub(super) type ShadowOf<'a> = dyn Fn(usize, f64, &mut ShadeScratch) -> OwnedShadow + 'a;
-
 /// Composite the volumes crossed by `ray` before `end` over `out` (the radiance behind);
-/// `shadow_of` gives the shadow of each light along the ray (the air in front of the
-/// volumes is lit only where the light reaches it).
+/// `shadows` holds each light's shadow along the ray (the air in front of the volumes is
+/// lit only where the light reaches it; the sky method clips the intervals to the point).
 pub(super) fn composite(
     scene: &Scene,
     views: &[Box<dyn SkyView + '_>],
     ray: &Ray,
     end: f64,
-    shadow_of: &ShadowOf,
-    scratch: &mut ShadeScratch,
+    shadows: &[OwnedShadow],
     out: &mut [f64],
 ) {
     let n = out.len();
@@ -141,7 +154,7 @@ pub(super) fn composite(
         }
     };
     let step_at = |t: f64| match feature {
-        Some(f) => f.max(STEP_DISTANCE_FRACTION * t),
+        Some(f) => (FEATURE_STEPS * f).max(STEP_DISTANCE_FRACTION * t),
         None => uniform_dt,
     };
     let jitter = ray_jitter(ray);
@@ -149,11 +162,11 @@ pub(super) fn composite(
     let mut buf = Buffers {
         sigma_t: [0.0; MAX_CHANNELS],
         e_v: [0.0; MAX_CHANNELS],
-        s_v: [0.0; MAX_CHANNELS],
         source: [[0.0; MAX_CHANNELS]; MAX_OCTAVES],
         t_light: [0.0; MAX_CHANNELS],
         tau_light: [0.0; MAX_CHANNELS],
         ambient: [[0.0; MAX_CHANNELS]; 3],
+        air: [None; CACHED_LIGHTS],
     };
     // Each volume's scattering coefficient at the current sample.
     let mut scattering = vec![[0.0f64; MAX_CHANNELS]; scene.volumes.len()];
@@ -186,13 +199,15 @@ pub(super) fn composite(
             empty_run += 1;
             if feature.is_some() && empty_run >= EMPTY_BEFORE_LEAP {
                 // Leap when the point a leap ahead is empty too.
+                // Leap where no volume can have medium at either end (a bound that ignores
+                // the fine noise, so the leaps do not depend on the jitter: no grain).
                 let leap = LEAP_STEPS * dt;
                 let probe = ray.origin + (t + leap + jitter * dt) * ray.dir;
                 if t + leap < b
                     && scene
                         .volumes
                         .iter()
-                        .all(|v| extinction_is_zero(v.as_ref(), probe, &mut buf, n))
+                        .all(|v| v.surely_empty(x) && v.surely_empty(probe))
                 {
                     t += leap;
                     continue;
@@ -238,13 +253,8 @@ pub(super) fn composite(
     let mut front = [0.0f64; MAX_CHANNELS];
     let mut l = [0.0f64; MAX_CHANNELS];
     for (j, view) in views.iter().enumerate() {
-        let shadow = shadow_of(j, d_mean, scratch);
-        view.sky_radiance_to_point(
-            point,
-            shadow.as_shadow(),
-            &mut l[..n],
-            &mut [0.0; MAX_CHANNELS][..n],
-        );
+        let shadow = shadows.get(j).map_or(Shadow::None, |s| s.as_shadow());
+        view.sky_radiance_to_point(point, shadow, &mut l[..n], &mut [0.0; MAX_CHANNELS][..n]);
         for k in 0..n {
             front[k] += l[k];
         }
@@ -275,12 +285,6 @@ fn ray_jitter(ray: &Ray) -> f64 {
     ))
 }
 
-/// Whether `volume` has no extinction at `p`.
-fn extinction_is_zero(volume: &dyn Volume, p: Vec3, buf: &mut Buffers, n: usize) -> bool {
-    volume.coefficients(p, &mut buf.e_v[..n], &mut buf.s_v[..n]);
-    buf.e_v[..n].iter().all(|&e| e == 0.0)
-}
-
 /// The in-scattered source at `x` seen along `dir` (W·m⁻³·sr⁻¹ per unit irradiance's
 /// channels) into `buf.source`: every light through the air and the volumes, by each
 /// scattering volume's octaves, and the ambient light from above and below; `scattering`
@@ -298,7 +302,7 @@ fn light_sources(
     buf.source
         .iter_mut()
         .for_each(|s| s[..n].iter_mut().for_each(|v| *v = 0.0));
-    for view in views {
+    for (j, view) in views.iter().enumerate() {
         let light = view.light();
         let mut lit = false;
         for (volume, s_v) in scene.volumes.iter().zip(scattering) {
@@ -306,9 +310,25 @@ fn light_sources(
                 continue;
             }
             if !lit {
-                view.transmittance_to_light(x, &mut buf.t_light[..n]);
+                let cached = buf.air.get(j).copied().flatten();
+                match cached {
+                    Some((at, air)) if (at - x).length_squared() < AIR_LIGHT_REUSE_M.powi(2) => {
+                        buf.t_light = air.t_light;
+                        buf.ambient = air.ambient;
+                    }
+                    _ => {
+                        view.transmittance_to_light(x, &mut buf.t_light[..n]);
+                        ambient_irradiance(scene, view.as_ref(), x, &mut buf.ambient, n);
+                        if let Some(slot) = buf.air.get_mut(j) {
+                            let air = AirLight {
+                                t_light: buf.t_light,
+                                ambient: buf.ambient,
+                            };
+                            *slot = Some((x, air));
+                        }
+                    }
+                }
                 light_optical_depth(scene, x, light.direction, jitter, &mut buf.tau_light[..n]);
-                ambient_irradiance(scene, view.as_ref(), x, &mut buf.ambient, n);
                 lit = true;
             }
             let octaves = volume.octaves();

@@ -71,6 +71,12 @@ pub trait Volume: Send + Sync {
         None
     }
 
+    /// Whether no medium can be at `point` whatever the volume's fine detail (the renderer
+    /// leaps over stretches empty at both ends); by default false (no leaps).
+    fn surely_empty(&self, _point: Vec3) -> bool {
+        false
+    }
+
     /// The radii (m, planet-centred) of the spherical shell the volume lies in, when it is
     /// one (a cloud layer): the renderer then maps its shadow below it
     /// ([`crate::render::cloud_shadow`]); None: no such map.
@@ -121,6 +127,9 @@ impl<V: Volume + ?Sized> Volume for &V {
     }
     fn radii_m(&self) -> Option<[f64; 2]> {
         (**self).radii_m()
+    }
+    fn surely_empty(&self, point: Vec3) -> bool {
+        (**self).surely_empty(point)
     }
     fn diffuse_radiance(
         &self,

@@ -20,6 +20,9 @@ const QUADRATURE_STEP_M: f64 = 10.0;
 const OPAQUE_DEPTH: f64 = 40.0;
 /// Samples of the march towards the light, at distances growing geometrically.
 pub const LIGHT_SAMPLES: usize = 6;
+/// The first samples of the march towards the light see the erosion detail (the cloud's
+/// self-shadowing at its surface); the farther ones skip it.
+const DETAILED_LIGHT_SAMPLES: usize = 2;
 /// The ratio of successive light-march steps.
 const LIGHT_STEP_GROWTH: f64 = 1.8;
 /// The farthest the march towards the light looks (m): beyond, a cumulus layer's cells
@@ -154,6 +157,12 @@ impl Volume for CloudMedium {
         Some(self.layer.radii_m)
     }
 
+    /// Outside the shell, or where the weather's coverage and the type's profile leave no
+    /// room for cloud whatever the noise.
+    fn surely_empty(&self, point: Vec3) -> bool {
+        self.layer.surely_empty(point)
+    }
+
     /// The erosion texture's texel: the finest detail the density has (the uniform slab: a
     /// 64th of its thickness).
     fn feature_size_m(&self) -> Option<f64> {
@@ -267,8 +276,10 @@ impl Volume for CloudMedium {
             .sum();
         let mut step = (end - a) / total;
         let (mut t, mut tau) = (a, 0.0);
-        for _ in 0..LIGHT_SAMPLES {
-            tau += self.extinction(ray.origin + (t + 0.5 * step) * ray.dir) * step;
+        let sigma = self.layer.params.extinction_per_m;
+        for i in 0..LIGHT_SAMPLES {
+            let x = ray.origin + (t + 0.5 * step) * ray.dir;
+            tau += sigma * self.layer.density_with(x, i < DETAILED_LIGHT_SAMPLES) * step;
             t += step;
             step *= LIGHT_STEP_GROWTH;
         }
@@ -276,7 +287,7 @@ impl Volume for CloudMedium {
     }
 
     /// The optical depths straight up to the layer's top and straight down to its base,
-    /// by [`AMBIENT_SAMPLES`] midpoint samples each.
+    /// by [`AMBIENT_SAMPLES`] midpoint samples each, without the erosion detail.
     fn vertical_optical_depths(&self, point: Vec3, _channel: usize) -> [f64; 2] {
         let r = point.length();
         let [rb, rt] = self.layer.radii_m;
@@ -291,7 +302,12 @@ impl Volume for CloudMedium {
             }
             let dt = (to - from) / AMBIENT_SAMPLES as f64;
             (0..AMBIENT_SAMPLES)
-                .map(|i| self.extinction(up * (from + (i as f64 + 0.5) * dt)) * dt.abs())
+                .map(|i| {
+                    let x = up * (from + (i as f64 + 0.5) * dt);
+                    self.layer.params.extinction_per_m
+                        * self.layer.density_with(x, false)
+                        * dt.abs()
+                })
                 .sum()
         };
         [depth(r, rt), depth(r, rb)]
