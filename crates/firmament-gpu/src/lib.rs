@@ -42,6 +42,7 @@
 //! nothing.
 
 pub mod bruneton4d;
+pub mod clouds;
 mod device;
 pub mod elek3d;
 mod error;
@@ -52,6 +53,7 @@ pub mod shader;
 pub mod terrain;
 
 pub use bruneton4d::{GpuSky, GpuTables, Precomputer};
+pub use clouds::GpuClouds;
 pub use device::{test_context, GpuContext};
 pub use elek3d::{GpuElek3d, GpuElek3dRenderer, GpuElek3dTables};
 pub use error::GpuError;

@@ -137,6 +137,20 @@ pub const RENDER: [Module; 7] = [
     module!("render/render.wgsl"),
 ];
 
+/// The clouds' modules (after [`RENDER`]): their types, noise, weather, layers, two-stream
+/// tables and medium, the shadow map, the march and the frame under them.
+pub const CLOUDS: [Module; 9] = [
+    module!("clouds/profile.wgsl"),
+    module!("clouds/noise_volume.wgsl"),
+    module!("clouds/weather.wgsl"),
+    module!("clouds/layer.wgsl"),
+    module!("clouds/two_stream.wgsl"),
+    module!("clouds/medium.wgsl"),
+    module!("render/cloud_shadow.wgsl"),
+    module!("render/volumes.wgsl"),
+    module!("render/cloud_frame.wgsl"),
+];
+
 /// Hillaire 2020's shared modules (after [`COMMON`] and [`BRUNETON4D`], whose lookups read
 /// its optical depth): its sizes and data, parameterisations, harmonics and the ray march.
 pub const HILLAIRE2020: [Module; 4] = [
@@ -261,6 +275,7 @@ pub fn prelude() -> String {
         "const DISK_EDGE_FOOTPRINTS: f32 = {:?};\n",
         disk_edges::EDGE_FOOTPRINTS as f32
     );
+    s += &clouds_prelude();
     // The orders' geometric tail (bruneton4d::precompute::order_tail_factors).
     s += &format!(
         "const ORDER_RATIO_CAP: f32 = {:?};\n",
@@ -283,6 +298,54 @@ pub fn prelude() -> String {
         f32_list(GL4.nodes),
         f32_list(GL4.weights)
     );
+    s
+}
+
+/// The clouds' constants (scene::clouds, render::volumes, render::cloud_shadow).
+fn clouds_prelude() -> String {
+    use crate::clouds as gc;
+    use firmament::render::{cloud_shadow as cs, volumes as rv};
+    use firmament::scene::clouds::{layer, medium, two_stream as ts};
+    let mut s = String::from("// Clouds (firmament_gpu::clouds).\n");
+    for (name, v) in [
+        ("MAX_CLOUD_LAYERS", gc::MAX_CLOUD_LAYERS),
+        ("CLOUD_CUMULUS", gc::CLOUD_CUMULUS as usize),
+        ("CLOUD_ALTOSTRATUS", gc::CLOUD_ALTOSTRATUS as usize),
+        ("CLOUD_CIRRUS", gc::CLOUD_CIRRUS as usize),
+        ("CLOUD_UNIFORM", gc::CLOUD_UNIFORM as usize),
+        ("WEATHER_CHANNELS", gc::WEATHER_CHANNELS),
+        ("TS_DEPTHS", ts::DEPTHS),
+        ("TS_THICKNESSES", ts::THICKNESSES),
+        ("TS_COSINES", ts::COSINES),
+        ("LIGHT_SAMPLES", medium::LIGHT_SAMPLES),
+        ("DETAILED_LIGHT_SAMPLES", medium::DETAILED_LIGHT_SAMPLES),
+        ("AMBIENT_SAMPLES", medium::AMBIENT_SAMPLES),
+        ("SHADOW_TEXELS", cs::TEXELS),
+        ("EMPTY_BEFORE_LEAP", rv::EMPTY_BEFORE_LEAP),
+        ("MAX_OCTAVES", rv::MAX_OCTAVES),
+        ("CACHED_LIGHTS", rv::CACHED_LIGHTS),
+    ] {
+        s += &format!("const {name}: u32 = {v}u;\n");
+    }
+    for (name, v) in [
+        ("WEATHER_CONTRAST", layer::WEATHER_CONTRAST),
+        ("PRECIPITATION_GAIN", layer::PRECIPITATION_GAIN),
+        ("TS_MAX_THICKNESS", ts::MAX_THICKNESS),
+        ("LIGHT_STEP_GROWTH", medium::LIGHT_STEP_GROWTH),
+        ("LIGHT_MARCH_MAX_M", medium::LIGHT_MARCH_MAX_M),
+        ("MIN_LIGHT_COSINE", medium::MIN_LIGHT_COSINE),
+        ("SHADOW_HALF_EXTENT_M", cs::HALF_EXTENT_M),
+        ("SHADOW_TRANSMITTANCE", cs::SHADOW_TRANSMITTANCE),
+        ("SHADOW_MERGE_GAP_M", cs::MERGE_GAP_M),
+        ("SHADOW_MAX_DISTANCE_M", cs::MAX_SHADOW_DISTANCE_M),
+        ("STEP_DISTANCE_FRACTION", rv::STEP_DISTANCE_FRACTION),
+        ("FEATURE_STEPS", rv::FEATURE_STEPS),
+        ("LEAP_STEPS", rv::LEAP_STEPS),
+        ("OPAQUE_TRANSMITTANCE", rv::OPAQUE_TRANSMITTANCE),
+        ("AIR_LIGHT_REUSE_M", rv::AIR_LIGHT_REUSE_M),
+    ] {
+        s += &format!("const {name}: f32 = {:?};\n", v as f32);
+    }
     s
 }
 
@@ -343,6 +406,7 @@ pub fn render_source(output_format: Option<&str>) -> String {
         .chain(&BRUNETON4D_VIEW)
         .chain(&TERRAIN)
         .chain(&RENDER)
+        .chain(&CLOUDS)
         .copied()
         .chain([output])
         .collect();
@@ -488,6 +552,7 @@ mod tests {
             .chain(&RENDER)
             .chain(&BRUNETON4D_VIEW)
             .chain(&TERRAIN)
+            .chain(&CLOUDS)
             .chain(&HILLAIRE2020)
             .chain(&HILLAIRE2020_VIEW)
             .chain(&HILLAIRE2020_RENDER)

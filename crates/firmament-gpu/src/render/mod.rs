@@ -56,6 +56,7 @@ use firmament::render::{Frame, RenderSettings};
 use firmament::scene::Light;
 
 use crate::bruneton4d::atmosphere::groups;
+use crate::clouds::{no_clouds_words, GpuClouds};
 use crate::device::{f32s, read_back, scoped, staging_buffer};
 use crate::passes::{init, workgroups, Pass, Slot, WORKGROUP};
 use crate::shader::render_source;
@@ -68,8 +69,8 @@ pub const PIXEL_BYTES: u64 = 16;
 /// Rows of a band are a multiple of this, so that every band's offset in the output buffer
 /// (rows × width × 16 bytes) is a multiple of 256, the largest storage-offset alignment.
 pub(crate) const BAND_ROW_ALIGN: usize = 16;
-/// Storage buffers the render pass binds: data, five tables, output, slice, terrain.
-const STORAGE_BUFFERS_NEEDED: u32 = 9;
+/// Storage buffers the render pass binds: data, five tables, output, slice, terrain, clouds.
+const STORAGE_BUFFERS_NEEDED: u32 = 10;
 
 /// Where a frame goes.
 #[derive(Clone, Copy, Debug)]
@@ -97,14 +98,20 @@ pub struct RenderInputs<'a> {
     /// ambient occlusion and the change of the air's light it was given), and ignores
     /// `shadow_lengths`.
     pub terrain: Option<&'a GpuTerrain>,
+    /// Cloud layers (uploaded for the frame's lights): the frame then renders
+    /// `firmament::render::render` of a scene with those clouds and no terrain (the ground
+    /// under their shadows and light, the air's shafts through their gaps, the clouds
+    /// composited at their mean depth), and ignores `shadow_lengths`. Not with a terrain.
+    pub clouds: Option<&'a GpuClouds>,
 }
 
 /// A render pipeline (for one output), its `camera_slice` entry point, and its
-/// `main_terrain` entry point (compiled on first use).
+/// `main_terrain` and `main_clouds` entry points (compiled on first use).
 struct Pipelines {
     pass: Pass,
     slice: wgpu::ComputePipeline,
     terrain: OnceLock<wgpu::ComputePipeline>,
+    clouds: OnceLock<wgpu::ComputePipeline>,
 }
 
 /// The render pipelines, compiled once per context (the texture outputs on first use).
@@ -118,6 +125,8 @@ pub struct GpuRenderer {
     no_shadow_lengths: wgpu::TextureView,
     /// Binding 17 when no terrain is given (one word).
     no_terrain: wgpu::Buffer,
+    /// Binding 19 when no clouds are given (one word).
+    no_clouds: wgpu::Buffer,
     /// Cap on the output bytes one dispatch writes (None: the device's binding limit).
     max_band_bytes: Option<u64>,
 }
@@ -156,12 +165,15 @@ fn compile(ctx: &GpuContext, output: Slot, format: Option<&str>) -> Pipelines {
             (16, Texture),
             (17, Read),
             (18, Uniform),
+            (19, Read),
+            (20, Uniform),
         ],
     );
     Pipelines {
         slice: pass.entry_point(device, "camera_slice"),
         pass,
         terrain: OnceLock::new(),
+        clouds: OnceLock::new(),
     }
 }
 
@@ -201,6 +213,7 @@ impl GpuRenderer {
                 unused_params: init(device, "unused", &[0; 16], wgpu::BufferUsages::UNIFORM),
                 no_shadow_lengths: texture.create_view(&Default::default()),
                 no_terrain: init(device, "no terrain", &[0; 16], wgpu::BufferUsages::STORAGE),
+                no_clouds: init(device, "no clouds", &[0; 16], wgpu::BufferUsages::STORAGE),
                 max_band_bytes: None,
             })
         })
@@ -461,17 +474,31 @@ impl GpuRenderer {
             ));
         }
         let pipelines = self.pipelines(ctx, &target)?;
-        let main = match inputs.terrain {
-            None => &pipelines.pass.pipeline,
-            Some(_) => match pipelines.terrain.get() {
-                Some(p) => p,
-                None => {
-                    let p = scoped(ctx, "render shader compilation (terrain)", || {
-                        Ok(pipelines.pass.entry_point(ctx.device(), "main_terrain"))
-                    })?;
-                    pipelines.terrain.get_or_init(|| p)
-                }
-            },
+        let entry = |cell: &'p OnceLock<wgpu::ComputePipeline>, name: &str| match cell.get() {
+            Some(p) => Ok(p),
+            None => {
+                let p = scoped(ctx, &format!("render shader compilation ({name})"), || {
+                    Ok(pipelines.pass.entry_point(ctx.device(), name))
+                })?;
+                Ok::<_, GpuError>(cell.get_or_init(|| p))
+            }
+        };
+        let main = match (inputs.terrain, inputs.clouds) {
+            (None, None) => &pipelines.pass.pipeline,
+            (Some(_), None) => entry(&pipelines.terrain, "main_terrain")?,
+            (None, Some(_)) => entry(&pipelines.clouds, "main_clouds")?,
+            (Some(_), Some(_)) => {
+                return Err(firmament::Error::invalid(
+                    "RenderInputs",
+                    "a terrain and clouds",
+                    "a terrain or clouds on the GPU (both: the CPU renderer)",
+                )
+                .into())
+            }
+        };
+        let cloud_words = match inputs.clouds {
+            Some(c) => c.uniform_words(lights, settings)?,
+            None => no_clouds_words(),
         };
         let terrain_words = match inputs.terrain {
             Some(t) => t.uniform_words(sky, lights, settings)?,
@@ -492,6 +519,8 @@ impl GpuRenderer {
             let light_uniform = uniform("lights", &light_words(sky, lights, inputs.background));
             let terrain_uniform = uniform("terrain", &terrain_words);
             let terrain_data = inputs.terrain.map_or(&self.no_terrain, |t| t.data());
+            let cloud_uniform = uniform("clouds", &cloud_words);
+            let cloud_data = inputs.clouds.map_or(&self.no_clouds, |c| c.data());
             let slice_uniform = uniform("slice coordinates", &slice_words(sky, lights, settings));
             let shadow = inputs.shadow_lengths.unwrap_or(&self.no_shadow_lengths);
             let tables = sky.tables();
@@ -529,6 +558,8 @@ impl GpuRenderer {
                     (16, wgpu::BindingResource::TextureView(shadow)),
                     (17, terrain_data.as_entire_binding()),
                     (18, terrain_uniform.as_entire_binding()),
+                    (19, cloud_data.as_entire_binding()),
+                    (20, cloud_uniform.as_entire_binding()),
                 ];
                 let entries: Vec<wgpu::BindGroupEntry> = entries
                     .into_iter()

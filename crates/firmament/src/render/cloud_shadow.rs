@@ -20,17 +20,17 @@ use crate::scene::{Ray, Scene, Volume};
 /// Half the side of the mapped square (m).
 pub const HALF_EXTENT_M: f64 = 40_000.0;
 /// Texels per side.
-const TEXELS: usize = 640;
+pub const TEXELS: usize = 640;
 /// Quadrature step through the volumes along the light (m).
 const MAP_STEP_M: f64 = 80.0;
 /// A point is in shadow where the light's transmittance is below this.
-const SHADOW_TRANSMITTANCE: f64 = 0.5;
+pub const SHADOW_TRANSMITTANCE: f64 = 0.5;
 /// Shadowed stretches closer than this (m) are merged, so that a ray across a field of
 /// cumulus asks the sky method for a few intervals rather than many.
-const MERGE_GAP_M: f64 = 800.0;
+pub const MERGE_GAP_M: f64 = 800.0;
 /// The farthest along a view ray the air's shadow is looked for (m): beyond, the steps
 /// would alias the cumulus' shadows into streaks, and the air is taken as lit.
-const MAX_SHADOW_DISTANCE_M: f64 = 30_000.0;
+pub const MAX_SHADOW_DISTANCE_M: f64 = 30_000.0;
 
 /// The volumes' optical depth towards one light over their base sphere.
 pub struct CloudShadow {
@@ -82,6 +82,16 @@ impl CloudShadow {
             planet_radius_m: planet,
             tau,
         })
+    }
+
+    /// The base sphere's radius (m).
+    pub fn base_radius_m(&self) -> f64 {
+        self.base_radius_m
+    }
+
+    /// τ per texel, [`TEXELS`]² row-major from (−[`HALF_EXTENT_M`], −[`HALF_EXTENT_M`]).
+    pub fn texels(&self) -> &[f32] {
+        &self.tau
     }
 
     /// The volumes' optical depth from `x` towards the light, when `x` lies below the base

@@ -124,6 +124,12 @@ impl<'s> Shader<'s> {
         self.air.as_ref()
     }
 
+    /// The volumes' shadow map of each light (None for a light without one), what a GPU
+    /// frame of the same scene samples (`firmament_gpu`).
+    pub fn cloud_shadows(&self) -> &[Option<cloud_shadow::CloudShadow>] {
+        &self.cloud_shadows
+    }
+
     /// The sky domes, one per light, when the shader has them ([`Shader::with_sky_domes`]).
     pub fn sky_domes(&self) -> Option<&[sky_dome::SkyDome]> {
         self.domes.as_deref().map(Vec::as_slice)

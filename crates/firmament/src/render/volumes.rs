@@ -43,17 +43,17 @@ const MIN_STEPS: usize = 32;
 const MAX_STEPS: usize = 1024;
 /// Adaptive steps grow with the distance t as max(feature, STEP_DISTANCE_FRACTION·t): 250 m
 /// at 50 km, a quarter of a cumulus there.
-const STEP_DISTANCE_FRACTION: f64 = 0.005;
+pub const STEP_DISTANCE_FRACTION: f64 = 0.005;
 /// Steps in a volume's feature size (its finest texel): a step per texel at the closest,
 /// jittered (1.5 texels shows as grain in thin cloud).
-const FEATURE_STEPS: f64 = 1.0;
+pub const FEATURE_STEPS: f64 = 1.0;
 /// Empty samples in a row before the march leaps ahead.
-const EMPTY_BEFORE_LEAP: usize = 1;
+pub const EMPTY_BEFORE_LEAP: usize = 1;
 /// Steps in one leap over empty space.
-const LEAP_STEPS: f64 = 6.0;
+pub const LEAP_STEPS: f64 = 6.0;
 /// The march stops once the volumes' transmittance is below this in every channel and
 /// octave.
-const OPAQUE_TRANSMITTANCE: f64 = 1e-4;
+pub const OPAQUE_TRANSMITTANCE: f64 = 1e-4;
 /// The most octaves of multiple scattering.
 pub const MAX_OCTAVES: usize = 8;
 
@@ -81,10 +81,10 @@ struct AirLight {
 }
 
 /// Lights whose air light a march keeps.
-const CACHED_LIGHTS: usize = 4;
+pub const CACHED_LIGHTS: usize = 4;
 /// How far (m) a sample may be from the one whose air light (the sky method's
 /// transmittance to the light and irradiances, which vary over kilometres) it reuses.
-const AIR_LIGHT_REUSE_M: f64 = 250.0;
+pub const AIR_LIGHT_REUSE_M: f64 = 250.0;
 
 /// A [`Shadow`] that owns its intervals.
 pub(super) enum OwnedShadow {

@@ -28,9 +28,9 @@ use crate::math::Vec3;
 use crate::{Error, Result};
 
 /// How far the weather moves the local coverage about the layer's: c_loc = c + k·(w − ½).
-const WEATHER_CONTRAST: f64 = 0.7;
+pub const WEATHER_CONTRAST: f64 = 0.7;
 /// How much the weather's precipitation raises the density (1 + gain·p).
-const PRECIPITATION_GAIN: f64 = 2.0;
+pub const PRECIPITATION_GAIN: f64 = 2.0;
 
 /// How the renderer estimates the light scattered more than once in a layer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]

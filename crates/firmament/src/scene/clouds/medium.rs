@@ -22,17 +22,17 @@ const OPAQUE_DEPTH: f64 = 40.0;
 pub const LIGHT_SAMPLES: usize = 6;
 /// The first samples of the march towards the light see the erosion detail (the cloud's
 /// self-shadowing at its surface); the farther ones skip it.
-const DETAILED_LIGHT_SAMPLES: usize = 2;
+pub const DETAILED_LIGHT_SAMPLES: usize = 2;
 /// The ratio of successive light-march steps.
-const LIGHT_STEP_GROWTH: f64 = 1.8;
+pub const LIGHT_STEP_GROWTH: f64 = 1.8;
 /// The farthest the march towards the light looks (m): beyond, a cumulus layer's cells
 /// rarely line up.
-const LIGHT_MARCH_MAX_M: f64 = 6000.0;
+pub const LIGHT_MARCH_MAX_M: f64 = 6000.0;
 /// The most grazing light the equivalent slab of the two-stream is lit by (a cloud's sides
 /// face a low sun; a uniform slab's sun is never that low in the tests).
-const MIN_LIGHT_COSINE: f64 = 0.2;
+pub const MIN_LIGHT_COSINE: f64 = 0.2;
 /// Samples of each vertical march of the ambient light.
-const AMBIENT_SAMPLES: usize = 2;
+pub const AMBIENT_SAMPLES: usize = 2;
 
 /// A cloud layer's medium with its phase function.
 pub struct CloudMedium {

@@ -21,13 +21,13 @@
 //! relative depth and the thickness (light from below is the same read upside down).
 
 /// Relative depths (0 top … 1 base) in the tables.
-const DEPTHS: usize = 33;
+pub const DEPTHS: usize = 33;
 /// Slab optical thicknesses, τ* = MAX_THICKNESS·s², s uniform.
-const THICKNESSES: usize = 48;
+pub const THICKNESSES: usize = 48;
 /// The thickest slab tabulated (thicker reads as this).
 pub const MAX_THICKNESS: f64 = 400.0;
 /// Cosines of the sun's zenith angle, μ₀ = (i + ½)/n... uniform in (0, 1].
-const COSINES: usize = 24;
+pub const COSINES: usize = 24;
 
 /// The two-stream tables of one medium.
 #[derive(Clone, Debug)]
@@ -154,6 +154,16 @@ impl TwoStream {
             sun,
             diffuse,
         }
+    }
+
+    /// The sun's table, (I₀, I₁) per unit beam irradiance: [cosine][thickness][depth].
+    pub fn sun_table(&self) -> &[[f64; 2]] {
+        &self.sun
+    }
+
+    /// The table of diffuse light entering the top: [thickness][depth].
+    pub fn diffuse_table(&self) -> &[[f64; 2]] {
+        &self.diffuse
     }
 
     /// Fractional indices into the thickness and depth axes.

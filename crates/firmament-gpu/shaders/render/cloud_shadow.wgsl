@@ -1,0 +1,96 @@
+// The clouds' shadow below them (firmament::render::cloud_shadow::CloudShadow, computed on
+// the CPU and uploaded): each light's map of the layers' optical depth towards it over
+// their lowest base sphere, SHADOW_TEXELS² texels over ±SHADOW_HALF_EXTENT_M of planar
+// coordinates around the observer's place, in cloud_data from clouds.shadow_at[light]; and
+// the stretches of a view ray the map puts in shadow, for the air's light shafts.
+
+// The most shadowed stretches a ray keeps (more merge into the last).
+const MAX_SHADOWED: u32 = 16u;
+
+struct ShadowList {
+    n: u32,
+    s: array<vec2<f32>, MAX_SHADOWED>,
+}
+
+// CloudShadow::optical_depth: the layers' depth from local `x` towards light `l` (< 0: the
+// map does not cover the point, or it lies at or above the base).
+fn map_optical_depth(l: u32, x: vec3<f32>, dir: vec3<f32>) -> f32 {
+    let at = clouds.shadow_at[l];
+    if (at == NONE) {
+        return -1.0;
+    }
+    if (cloud_point(x).alt_m >= clouds.shadow_base_m) {
+        return -1.0;
+    }
+    let far = shell_sphere(x, dir, clouds.shadow_base_m).y;
+    if (far <= 0.0) {
+        return -1.0;
+    }
+    let e = x + far * dir;
+    let ez = clouds.planet_radius_m + e.z;
+    if (ez <= 0.0) {
+        return -1.0;
+    }
+    let step = 2.0 * SHADOW_HALF_EXTENT_M / f32(SHADOW_TEXELS);
+    let f = (e.xy * (clouds.planet_radius_m / ez) + SHADOW_HALF_EXTENT_M) / step - 0.5;
+    let max_f = f32(SHADOW_TEXELS - 1u);
+    if (f.x < 0.0 || f.y < 0.0 || f.x >= max_f || f.y >= max_f) {
+        return -1.0;
+    }
+    let i = vec2<u32>(f);
+    let t = f - vec2<f32>(i);
+    let row0 = at + i.y * SHADOW_TEXELS + i.x;
+    let row1 = row0 + SHADOW_TEXELS;
+    let lo = mix(cloud_data[row0], cloud_data[row0 + 1u], t.x);
+    let hi = mix(cloud_data[row1], cloud_data[row1 + 1u], t.x);
+    return mix(lo, hi, t.y);
+}
+
+// Append [a, b] to the list, merging it into the last stretch across a gap under
+// SHADOW_MERGE_GAP_M (CloudShadow's merge_close), or when the list is full.
+fn push_shadowed(list: ptr<function, ShadowList>, a: f32, b: f32) {
+    let n = (*list).n;
+    if (n > 0u && (a - (*list).s[n - 1u].y < SHADOW_MERGE_GAP_M || n == MAX_SHADOWED)) {
+        (*list).s[n - 1u].y = b;
+        return;
+    }
+    (*list).s[n] = vec2<f32>(a, b);
+    (*list).n = n + 1u;
+}
+
+// CloudShadow::shadowed_intervals: the stretches of the ray from local `q` along `dir`
+// before `end_m` (and below the base) in light l's shadow, sampled every max(250 m, t/50).
+fn shadowed_intervals(l: u32, light_dir: vec3<f32>, q: vec3<f32>, dir: vec3<f32>, end_m: f32) -> ShadowList {
+    var list: ShadowList;
+    list.n = 0u;
+    if (clouds.shadow_at[l] == NONE) {
+        return list;
+    }
+    let far = shell_sphere(q, dir, clouds.shadow_base_m);
+    if (far.x > far.y || far.y <= 0.0) {
+        return list;
+    }
+    let limit = min(min(far.y, end_m), SHADOW_MAX_DISTANCE_M);
+    var t = 0.0;
+    var start = -1.0;
+    loop {
+        if (t >= limit) {
+            break;
+        }
+        let dt = max(0.02 * t, 250.0);
+        let mid = min(t + 0.5 * dt, limit);
+        let tau = map_optical_depth(l, q + mid * dir, light_dir);
+        let shadowed = tau >= 0.0 && exp(-tau) < SHADOW_TRANSMITTANCE;
+        if (shadowed && start < 0.0) {
+            start = t;
+        } else if (!shadowed && start >= 0.0) {
+            push_shadowed(&list, start, t);
+            start = -1.0;
+        }
+        t += dt;
+    }
+    if (start >= 0.0) {
+        push_shadowed(&list, start, limit);
+    }
+    return list;
+}
