@@ -19,7 +19,7 @@ use firmament::sky::bruneton4d::{Bruneton4d, TableConfig};
 use firmament::sky::SkyMethod;
 use firmament_gpu::elek3d::{GpuElek3d, GpuElek3dRenderer};
 use firmament_gpu::hillaire2020::{GpuHillaire, GpuHillaireRenderer, HillairePrecomputer};
-use firmament_gpu::{GpuError, GpuRenderer, GpuSky, GpuTerrain, RenderInputs};
+use firmament_gpu::{GpuClouds, GpuError, GpuRenderer, GpuSky, GpuTerrain, RenderInputs};
 
 use super::{gpu_failure, on_gpu, Backend, Gpu};
 use crate::common::{cancel_flag, progress_bar, spinner, AtmosphereArgs};
@@ -195,9 +195,14 @@ impl<'a> RenderSky<'a> {
         clouds: &[CloudMedium],
         quiet: bool,
     ) -> Result<Frame> {
-        if !clouds.is_empty() && !matches!(self, RenderSky::Cpu(..)) {
+        if !clouds.is_empty() && !matches!(self, RenderSky::Cpu(..) | RenderSky::Gpu { .. }) {
             anyhow::bail!(
-                "clouds ([[clouds]]) render on the CPU only so far: use `--backend cpu` (or `auto`)"
+                "clouds ([[clouds]]) render on the CPU or with `--method bruneton4d` on the GPU so far: use `--backend cpu` (or `auto`)"
+            );
+        }
+        if !clouds.is_empty() && terrain.is_some() && matches!(self, RenderSky::Gpu { .. }) {
+            anyhow::bail!(
+                "clouds ([[clouds]]) over a terrain render on the CPU only so far: use `--backend cpu` (or `auto`)"
             );
         }
         if terrain.is_some() && matches!(self, RenderSky::GpuHillaire { .. }) {
@@ -244,9 +249,14 @@ impl<'a> RenderSky<'a> {
                     Some(t) => Some(self.gpu_terrain(t, settings, sources, quiet)?),
                     None => None,
                 };
+                let gpu_clouds = match clouds {
+                    [] => None,
+                    media => Some(self.gpu_clouds(media, settings, sources, quiet)?),
+                };
                 let inputs = RenderInputs {
                     background: sources.background.as_ref(),
                     terrain: gpu_terrain.as_ref(),
+                    clouds: gpu_clouds.as_ref(),
                     ..RenderInputs::default()
                 };
                 gpu_frame(sources, settings, sky_model, terrain, quiet, |lights| {
@@ -284,17 +294,17 @@ impl<'a> RenderSky<'a> {
         }
     }
 
-    /// `terrain` on the device for a GPU frame: its shadow fields for the frame's lights,
-    /// the sky's radiance under its horizons and, when it changes the air's light, the
-    /// observer's air volume, all computed on the CPU (the tables read back from the device
-    /// for them, once).
-    fn gpu_terrain(
+    /// The CPU twin of the GPU's 4D tables (read back from the device once), with the
+    /// observer at the camera: the CPU computes the terrain's and the clouds' shadow fields
+    /// from it for the GPU frame.
+    fn with_cpu_shader<T>(
         &self,
-        terrain: &Heightfield,
         settings: &RenderSettings,
         sources: &SkySources,
-        quiet: bool,
-    ) -> Result<GpuTerrain> {
+        terrain: Option<&Heightfield>,
+        clouds: &[CloudMedium],
+        then: impl FnOnce(&firmament::render::Shader) -> Result<T>,
+    ) -> Result<T> {
         let RenderSky::Gpu {
             gpu,
             sky,
@@ -304,9 +314,8 @@ impl<'a> RenderSky<'a> {
             ..
         } = self
         else {
-            unreachable!("gpu_terrain is called for GPU skies")
+            unreachable!("with_cpu_shader is called for the GPU's 4D tables")
         };
-        let bar = spinner("the terrain's shadows, sky and air light (CPU)", quiet);
         let cpu = match cpu_sky.get() {
             Some(c) => c,
             None => {
@@ -318,15 +327,58 @@ impl<'a> RenderSky<'a> {
                 cpu_sky.get().expect("just set")
             }
         };
-        let scene = cpu_scene(cpu, sources, Some(terrain), None);
+        let mut scene = cpu_scene(cpu, sources, terrain, None);
+        for c in clouds {
+            scene.volumes.push(Box::new(c));
+        }
         let observer = Vec3::new(
             0.0,
             0.0,
             sky_model.bottom_radius_m + settings.camera.altitude_m,
         );
         let shader = firmament::render::Shader::new(&scene, observer)?;
-        let uploaded = GpuTerrain::new(&gpu.ctx, sky, terrain, &shader)
-            .map_err(|e| gpu_failure("uploading the terrain", e));
+        then(&shader)
+    }
+
+    /// `terrain` on the device for a GPU frame: its shadow fields for the frame's lights,
+    /// the sky's radiance under its horizons and, when it changes the air's light, the
+    /// observer's air volume, all computed on the CPU.
+    fn gpu_terrain(
+        &self,
+        terrain: &Heightfield,
+        settings: &RenderSettings,
+        sources: &SkySources,
+        quiet: bool,
+    ) -> Result<GpuTerrain> {
+        let RenderSky::Gpu { gpu, sky, .. } = self else {
+            unreachable!("gpu_terrain is called for GPU skies")
+        };
+        let bar = spinner("the terrain's shadows, sky and air light (CPU)", quiet);
+        let uploaded = self.with_cpu_shader(settings, sources, Some(terrain), &[], |shader| {
+            GpuTerrain::new(&gpu.ctx, sky, terrain, shader)
+                .map_err(|e| gpu_failure("uploading the terrain", e))
+        });
+        bar.finish_and_clear();
+        uploaded
+    }
+
+    /// The cloud layers on the device for a GPU frame: their noise, weather and two-stream
+    /// tables, and each light's cloud-shadow map computed on the CPU.
+    fn gpu_clouds(
+        &self,
+        media: &[CloudMedium],
+        settings: &RenderSettings,
+        sources: &SkySources,
+        quiet: bool,
+    ) -> Result<GpuClouds> {
+        let RenderSky::Gpu { gpu, sky, .. } = self else {
+            unreachable!("gpu_clouds is called for GPU skies")
+        };
+        let bar = spinner("the clouds' shadow maps (CPU)", quiet);
+        let uploaded = self.with_cpu_shader(settings, sources, None, media, |shader| {
+            GpuClouds::new(&gpu.ctx, sky, media, shader)
+                .map_err(|e| gpu_failure("uploading the clouds", e))
+        });
         bar.finish_and_clear();
         uploaded
     }
