@@ -92,6 +92,7 @@ pub fn frame_timings(sky: &Bruneton4d, runs: usize) -> Result<CpuFrames> {
         )?),
         cpu_frame_1080p_night_s: Some(night_seconds(sky, runs)?),
         cpu_frame_1080p_terrain_s: Some(terrain_seconds(sky, runs)?),
+        cpu_frame_1080p_clouds_s: None,
     })
 }
 

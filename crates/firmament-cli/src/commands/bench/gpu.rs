@@ -13,6 +13,7 @@ use firmament::sky::bruneton4d::{Bruneton4d, TableConfig};
 use firmament_gpu::Precomputer;
 use firmament_gpu::{GpuRenderer, GpuSky, GpuTerrain, RenderInputs};
 
+use super::clouds::CloudFrame;
 use super::report::GpuTimings;
 use super::scenes;
 use super::timing::{median, time_runs};
@@ -22,14 +23,15 @@ use crate::backend::{gpu_failure, Gpu};
 const PRECOMPUTE_METHOD: &str = "wall clock per run: GpuSky::precompute (atmosphere upload, table buffer allocation, encoding, submit) until the device is idle; tables left on the device (no readback); pipelines compiled once beforehand (gpu_pipeline_creation_s)";
 
 /// Time the precomputation of `model` (and of `spectral`, at most 3 runs, when given) and
-/// the 1080p frame from those tables, `runs` times each; `progress` prints a line per step
-/// on stderr.
+/// the 1080p frames from those tables (the cloudy one when `clouds`), `runs` times each;
+/// `progress` prints a line per step on stderr.
 pub fn timings(
     gpu: &Gpu,
     model: &Model,
     config: &TableConfig,
     spectral: Option<&Model>,
     runs: usize,
+    clouds: bool,
     progress: bool,
 ) -> Result<GpuTimings> {
     let ctx = &gpu.ctx;
@@ -110,10 +112,25 @@ pub fn timings(
     })?;
     timings.gpu_frame_1080p_perspective_with_readback_s = Some(median(seconds));
 
+    // The CPU's parts of the terrain and cloud frames (shadow fields and maps, the air's
+    // light) read the GPU's tables.
+    let tables = sky
+        .tables()
+        .read_back(ctx, model, config)
+        .map_err(|e| gpu_failure("reading the tables back", e))?;
+    let cpu_sky = Bruneton4d::new(model.clone(), tables)?;
     step("1920×1080 terrain frame (the default scene)");
-    let (dispatch, whole) = terrain_timings(gpu, &renderer, &sky, model, config, runs)?;
+    let (dispatch, whole) = terrain_timings(gpu, &renderer, &sky, &cpu_sky, runs)?;
     timings.gpu_frame_1080p_terrain_s = Some(dispatch);
     timings.gpu_frame_1080p_terrain_with_cpu_parts_s = Some(whole);
+    if clouds {
+        step("1920×1080 cloudy frame (scenes/clouds-cumulus-noon.toml)");
+        let frame = CloudFrame::new(&cpu_sky)?;
+        let (dispatch, whole) =
+            super::clouds::gpu_seconds(gpu, &renderer, &sky, &cpu_sky, &frame, runs)?;
+        timings.gpu_frame_1080p_clouds_s = Some(dispatch);
+        timings.gpu_frame_1080p_clouds_with_cpu_parts_s = Some(whole);
+    }
     Ok(timings)
 }
 
@@ -125,20 +142,15 @@ fn terrain_timings(
     gpu: &Gpu,
     renderer: &GpuRenderer,
     sky: &GpuSky,
-    model: &Model,
-    config: &TableConfig,
+    cpu_sky: &Bruneton4d,
     runs: usize,
 ) -> Result<(f64, f64)> {
     let ctx = &gpu.ctx;
+    let model = &cpu_sky.model;
     let default = firmament::scene::SceneFile::default();
     let terrain = default
         .build_terrain(model)?
         .expect("the default scene has a terrain");
-    let tables = sky
-        .tables()
-        .read_back(ctx, model, config)
-        .map_err(|e| gpu_failure("reading the tables back", e))?;
-    let cpu_sky = Bruneton4d::new(model.clone(), tables)?;
     let camera = default.camera_over(Some(&terrain), model.bottom_radius_m);
     let settings = RenderSettings {
         camera: &camera,
@@ -150,7 +162,7 @@ fn terrain_timings(
     let lights = [Light::sun(model, sun, true)];
     let observer = Vec3::new(0.0, 0.0, model.bottom_radius_m + camera.altitude_m);
     let upload = |terrain: &Heightfield| -> Result<GpuTerrain> {
-        let mut scene = Scene::clear_sky(&cpu_sky, sun, true);
+        let mut scene = Scene::clear_sky(cpu_sky, sun, true);
         scene.add_terrain(terrain, terrain.radius_m);
         let shader = Shader::new(&scene, observer)?;
         GpuTerrain::new(ctx, sky, terrain, &shader)

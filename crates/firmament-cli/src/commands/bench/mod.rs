@@ -5,6 +5,7 @@
 //! measure with them and take plain values, not the arguments; this module chooses what to
 //! measure and prints the report.
 
+mod clouds;
 mod cpu;
 mod gpu;
 mod gpu_methods;
@@ -69,6 +70,10 @@ pub struct BenchArgs {
     /// Repetitions per GPU measurement (default: --runs).
     #[arg(long, value_name = "N")]
     pub gpu_runs: Option<usize>,
+    /// Also time the cloudy 1080p frame (`scenes/clouds-cumulus-noon.toml`): about 30 s a
+    /// run on two cores, at most 3 runs on the CPU.
+    #[arg(long)]
+    pub clouds: bool,
 }
 
 /// Run the benchmarks.
@@ -145,6 +150,14 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             cpu::precompute_timings(&model, &config, args.runs, spectral_model.as_ref())?;
         let tables = args.atmosphere.sky(true)?;
         report.cpu_frames = cpu::frame_timings(&tables, args.runs)?;
+        if args.clouds {
+            if !args.json {
+                eprintln!("cpu: the 1080p cloudy frame");
+            }
+            let frame = clouds::CloudFrame::new(&tables)?;
+            report.cpu_frames.cpu_frame_1080p_clouds_s =
+                Some(clouds::cpu_seconds(&tables, &frame, args.runs)?);
+        }
         report.cpu_reference = cpu::reference_timings(&model, args.runs)?;
         if wanted.contains(&Method::Hillaire2020) {
             methods::hillaire_timings(&model, &tables, args.runs, &mut report.cpu_methods)?;
@@ -161,6 +174,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             &config,
             spectral_model.as_ref(),
             runs,
+            args.clouds,
             !args.json,
         )?;
         if wanted.contains(&Method::Hillaire2020) {

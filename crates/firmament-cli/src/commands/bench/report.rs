@@ -62,6 +62,10 @@ pub struct CpuFrames {
     /// The default scene (the valley at golden hour, light shafts), 1920×1080: the shadow
     /// field of the sun and the frame; the terrain built once beforehand.
     pub cpu_frame_1080p_terrain_s: Option<f64>,
+    /// With `--clouds`: the cumulus scene (`scenes/clouds-cumulus-noon.toml`: fair-weather
+    /// cumulus, the sun 55° high) at 1920×1080, converged, its shadow maps included (the
+    /// noise volumes made or read from the cache once before); at most 3 runs.
+    pub cpu_frame_1080p_clouds_s: Option<f64>,
 }
 
 /// The fast methods on the CPU (seconds, medians): Hillaire 2020's tables (all of them, and
@@ -119,6 +123,12 @@ pub struct GpuTimings {
     /// light on the CPU, the upload, the dispatch, the readback and the tone mapping (the
     /// terrain built and the tables read back once beforehand).
     pub gpu_frame_1080p_terrain_with_cpu_parts_s: Option<f64>,
+    /// With `--clouds`: the cumulus scene (`scenes/clouds-cumulus-noon.toml`) at 1920×1080,
+    /// the render dispatch alone.
+    pub gpu_frame_1080p_clouds_s: Option<f64>,
+    /// The same frame whole: each light's cloud-shadow map on the CPU, the upload, the
+    /// dispatch, the readback and the tone mapping (the noise volumes made once before).
+    pub gpu_frame_1080p_clouds_with_cpu_parts_s: Option<f64>,
 }
 
 /// The fast methods on the GPU (seconds, medians, `--method`): Hillaire 2020's passes
