@@ -7,7 +7,7 @@
 
 use rayon::prelude::*;
 
-use super::march::{Lighting, MarchRay, Marcher};
+use super::march::{Lighting, MarchRay, Marcher, RayProfile};
 use super::params::altitude_mu_s_of_texel;
 use crate::math::lattice::band_directions;
 use crate::math::sphere::distance_to_top_atmosphere_boundary;
@@ -33,32 +33,51 @@ pub(crate) fn compute(
     let mut table = Table2::new(nmu_s, nr, n);
     table
         .data
-        .par_chunks_mut(n)
+        .par_chunks_mut(nmu_s * n)
         .enumerate()
-        .for_each(|(i, out)| {
-            let (r, mu_s) = altitude_mu_s_of_texel(i % nmu_s, i / nmu_s, bottom, top, nmu_s, nr);
-            let sun = Vec3::new((1.0 - mu_s * mu_s).max(0.0).sqrt(), 0.0, mu_s);
-            let mut phases = Vec::new();
-            with_channel_buffers(n, |[e, l, t]| {
-                for d in &dirs {
-                    let nu = d.dot(sun);
-                    marcher.medium.phases(nu, &mut phases);
+        .for_each(|(row, out_row)| {
+            // A direction's geometry is the same at every μ_s of the row: one profile each.
+            let (r, _) = altitude_mu_s_of_texel(0, row, bottom, top, nmu_s, nr);
+            let profiles: Vec<RayProfile> = dirs
+                .iter()
+                .map(|d| {
                     let ray = MarchRay {
                         r,
                         mu: d.z,
-                        mu_s,
-                        nu,
+                        mu_s: 1.0,
+                        nu: 0.0,
                         length: distance_to_top_atmosphere_boundary(r, d.z, top),
                     };
-                    marcher.march(&ray, steps, &phases, &Lighting::ALL, l, t, &mut []);
-                    for k in 0..n {
-                        e[k] += l[k] * d.z * weight;
+                    let mut p = RayProfile::default();
+                    marcher.profile_steps_into(&ray, steps, &mut p);
+                    p
+                })
+                .collect();
+            let mut phases = Vec::new();
+            for (col, out) in out_row.chunks_mut(n).enumerate() {
+                let (_, mu_s) = altitude_mu_s_of_texel(col, row, bottom, top, nmu_s, nr);
+                let sun = Vec3::new((1.0 - mu_s * mu_s).max(0.0).sqrt(), 0.0, mu_s);
+                with_channel_buffers(n, |[e, l]| {
+                    for (d, profile) in dirs.iter().zip(&profiles) {
+                        let nu = d.dot(sun);
+                        marcher.medium.phases(nu, &mut phases);
+                        let ray = MarchRay {
+                            r,
+                            mu: d.z,
+                            mu_s,
+                            nu,
+                            length: distance_to_top_atmosphere_boundary(r, d.z, top),
+                        };
+                        marcher.march_profile(&ray, profile, &phases, &Lighting::ALL, l, |_, _| {});
+                        for k in 0..n {
+                            e[k] += l[k] * d.z * weight;
+                        }
                     }
-                }
-                for k in 0..n {
-                    out[k] = e[k] as f32;
-                }
-            });
+                    for k in 0..n {
+                        out[k] = e[k] as f32;
+                    }
+                });
+            }
         });
     table
 }

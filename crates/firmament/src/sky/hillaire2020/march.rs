@@ -182,7 +182,103 @@ pub(crate) fn step_end(i: usize, steps: usize, length: f64) -> f64 {
     length * f * f
 }
 
+/// The part of a march that depends only on the ray's geometry (its start's radius, its
+/// zenith cosine and its step ends), not on the light: per step the radius at its middle,
+/// the constituents' densities there, the throughput before it and its analytic length
+/// (1 − e^{−σ_t Δ})/σ_t per channel. Rays that differ only in the light's direction (a row
+/// of the sky-view table, one gather direction's μ at one altitude for every μ_s of the
+/// multiple-scattering and irradiance tables) share one: the densities and exponentials
+/// are paid once, and each light pays only its lookups.
+#[derive(Default)]
+pub(crate) struct RayProfile {
+    /// Per step: its start and end (m from the ray's start), its middle and the radius
+    /// there (m).
+    steps: Vec<[f64; 4]>,
+    /// Per step, each constituent's density at its middle.
+    densities: Vec<f64>,
+    /// Per step and channel: the throughput before the step.
+    throughput: Vec<f64>,
+    /// Per step and channel: the step's analytic length (m).
+    lengths: Vec<f64>,
+    /// The ray's throughput per channel.
+    pub transmittance: Vec<f64>,
+    /// ∫ T·σ_s dt along the ray per channel (Hillaire's eq. 8 integrand before its phase
+    /// function: what f_ms sums).
+    pub scattered: Vec<f64>,
+}
+
+thread_local! {
+    /// The profile [`Marcher::march_over`] reuses on each thread.
+    static SCRATCH: std::cell::RefCell<RayProfile> = std::cell::RefCell::default();
+}
+
 impl Marcher<'_> {
+    /// The geometry-only part of a march of `ray` (its `r`, `mu` and `length`; the light's
+    /// fields are not read) over the steps ending at `ends` (m from the ray's start,
+    /// increasing, up to `ray.length`; no steps when that is not positive), into `p`.
+    pub fn profile_into(
+        &self,
+        ray: &MarchRay,
+        ends: impl Iterator<Item = f64>,
+        p: &mut RayProfile,
+    ) {
+        let model = self.medium.model;
+        let n = model.channels();
+        p.steps.clear();
+        p.densities.clear();
+        p.throughput.clear();
+        p.lengths.clear();
+        p.transmittance.clear();
+        p.transmittance.resize(n, 1.0);
+        p.scattered.clear();
+        p.scattered.resize(n, 0.0);
+        if ray.length <= 0.0 {
+            return;
+        }
+        let bottom = model.bottom_radius_m;
+        let mut densities = [0.0; 8];
+        let mut densities_vec;
+        let densities: &mut [f64] = if model.constituents.len() <= densities.len() {
+            &mut densities[..model.constituents.len()]
+        } else {
+            densities_vec = vec![0.0; model.constituents.len()];
+            &mut densities_vec
+        };
+        with_channel_buffers(n, |[sigma_t, sigma_s, phased]| {
+            let mut t0 = 0.0;
+            for t1 in ends {
+                let dt = t1 - t0;
+                let t_mid = 0.5 * (t0 + t1);
+                let (r_t, _) = ray.at(t_mid);
+                self.medium
+                    .coefficients(r_t - bottom, &[], sigma_t, sigma_s, phased, densities);
+                p.steps.push([t0, t1, t_mid, r_t]);
+                p.densities.extend_from_slice(densities);
+                for k in 0..n {
+                    let tau = sigma_t[k] * dt;
+                    let step_t = (-tau).exp();
+                    // (S − S·e^{−σ_t Δ})/σ_t, → S·Δ as σ_t → 0.
+                    let length = if tau > 1e-9 {
+                        (1.0 - step_t) / sigma_t[k]
+                    } else {
+                        dt
+                    };
+                    let before = p.transmittance[k];
+                    p.throughput.push(before);
+                    p.lengths.push(length);
+                    p.scattered[k] += before * sigma_s[k] * length;
+                    p.transmittance[k] = before * step_t;
+                }
+                t0 = t1;
+            }
+        });
+    }
+
+    /// [`Marcher::profile_into`] of the `steps` quadratic steps of [`step_end`].
+    pub fn profile_steps_into(&self, ray: &MarchRay, steps: usize, p: &mut RayProfile) {
+        self.profile_into(ray, (1..=steps).map(|i| step_end(i, steps, ray.length)), p);
+    }
+
     /// Σ over the ray's steps of the throughput so far times the step's analytic integral,
     /// into `radiance` (per unit light irradiance), and the ray's throughput into
     /// `transmittance` (both per channel, overwritten). `phases` holds each constituent's
@@ -226,17 +322,38 @@ impl Marcher<'_> {
         radiance: &mut [f64],
         transmittance: &mut [f64],
         scattered: &mut [f64],
+        at_end: impl FnMut(usize, &[f64]),
+    ) {
+        SCRATCH.with(|cell| {
+            let mut profile = cell.borrow_mut();
+            self.profile_into(ray, ends, &mut profile);
+            self.march_profile(ray, &profile, phases, lighting, radiance, at_end);
+            transmittance.copy_from_slice(&profile.transmittance);
+            if !scattered.is_empty() {
+                scattered.copy_from_slice(&profile.scattered);
+            }
+        });
+    }
+
+    /// The light's part of a march: Σ over `profile`'s steps (marched along `ray`, whose
+    /// `mu_s` and `nu` give the light) of the throughput so far times the step's analytic
+    /// integral of the light scattered once (`phases`: each constituent's phase function
+    /// at ν, none for no single scattering) and the multiple scattering, into `radiance`
+    /// (overwritten), calling `at_end(i, radiance)` after step i.
+    pub fn march_profile(
+        &self,
+        ray: &MarchRay,
+        profile: &RayProfile,
+        phases: &[f64],
+        lighting: &Lighting,
+        radiance: &mut [f64],
         mut at_end: impl FnMut(usize, &[f64]),
     ) {
-        scattered.iter_mut().for_each(|v| *v = 0.0);
         let n = radiance.len();
         let model = self.medium.model;
+        let constituents = model.constituents.len();
         let (bottom, top) = (model.bottom_radius_m, model.top_radius_m);
         radiance.iter_mut().for_each(|v| *v = 0.0);
-        transmittance.iter_mut().for_each(|v| *v = 1.0);
-        if ray.length <= 0.0 {
-            return;
-        }
         // The multiple-scattering field's coefficients at a step, and its harmonics there.
         let (coefficients, degree) = match self.multiple {
             Some(ms) => (harmonics::coefficient_count(ms.degree), ms.degree),
@@ -244,21 +361,22 @@ impl Marcher<'_> {
         };
         let mut field = vec![0.0; coefficients * n];
         let mut y = vec![0.0; coefficients];
-        let mut densities = vec![0.0; model.constituents.len()];
-        with_channel_buffers(n, |[sigma_t, sigma_s, phased, t_sun, psi, by_degree]| {
-            let mut t0 = 0.0;
-            for (i, t1) in ends.enumerate() {
-                let dt = t1 - t0;
-                let t_mid = 0.5 * (t0 + t1);
-                let (r_t, mu_s_t) = ray.at(t_mid);
-                self.medium.coefficients(
-                    r_t - bottom,
-                    phases,
-                    sigma_t,
-                    sigma_s,
-                    phased,
-                    &mut densities,
-                );
+        with_channel_buffers(n, |[phased, t_sun, psi, by_degree]| {
+            for (i, &[t0, t1, t_mid, r_t]) in profile.steps.iter().enumerate() {
+                let densities = &profile.densities[i * constituents..(i + 1) * constituents];
+                let mu_s_t = ((ray.r * ray.mu_s + t_mid * ray.nu) / r_t.max(1.0)).clamp(-1.0, 1.0);
+                phased.iter_mut().for_each(|v| *v = 0.0);
+                if !phases.is_empty() {
+                    for (ci, con) in model.constituents.iter().enumerate() {
+                        if densities[ci] <= 0.0 || !self.medium.scatters(ci) {
+                            continue;
+                        }
+                        let w = densities[ci] * phases[ci];
+                        for k in 0..n {
+                            phased[k] += w * con.scattering[k];
+                        }
+                    }
+                }
                 let lit_single = lighting.single.fraction(t0, t1);
                 let lit_multiple = lighting.multiple.fraction(t0, t1);
                 if lit_single > 0.0 {
@@ -313,24 +431,15 @@ impl Marcher<'_> {
                         }
                     }
                 }
+                let (throughput, lengths) = (
+                    &profile.throughput[i * n..(i + 1) * n],
+                    &profile.lengths[i * n..(i + 1) * n],
+                );
                 for k in 0..n {
                     let source = lit_single * phased[k] * t_sun[k] + lit_multiple * psi[k];
-                    let tau = sigma_t[k] * dt;
-                    let step_t = (-tau).exp();
-                    // (S − S·e^{−σ_t Δ})/σ_t, → S·Δ as σ_t → 0.
-                    let length = if tau > 1e-9 {
-                        (1.0 - step_t) / sigma_t[k]
-                    } else {
-                        dt
-                    };
-                    radiance[k] += transmittance[k] * source * length;
-                    if !scattered.is_empty() {
-                        scattered[k] += transmittance[k] * sigma_s[k] * length;
-                    }
-                    transmittance[k] *= step_t;
+                    radiance[k] += throughput[k] * source * lengths[k];
                 }
                 at_end(i, radiance);
-                t0 = t1;
             }
         });
     }

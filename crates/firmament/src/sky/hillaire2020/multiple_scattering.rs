@@ -23,7 +23,7 @@
 use rayon::prelude::*;
 
 use super::harmonics::{coefficient_count, eval, phase_moments};
-use super::march::{Lighting, Lit, MarchRay, Marcher, Medium};
+use super::march::{Lighting, Lit, MarchRay, Marcher, Medium, RayProfile};
 use super::params::{altitude_mu_s_of_texel, altitude_mu_s_uv};
 use crate::math::quadrature::GaussLegendreRule;
 use crate::math::sphere::{
@@ -136,8 +136,11 @@ struct Gathered {
     up_irradiance: Vec<f64>,
 }
 
+/// One texel's gather: its field's coefficients, f_ms and its upward irradiance.
+type TexelGather = (Vec<f64>, Vec<f64>, Vec<f64>);
+
 /// The radiance arriving along a gather ray (see [`Grid::gather`]).
-type Incoming<'a> = dyn Fn(&MarchRay, bool, &mut [f64], &mut [f64]) + Sync + 'a;
+type Incoming<'a> = dyn Fn(&MarchRay, &RayProfile, bool, &mut [f64]) + Sync + 'a;
 
 /// The texels' geometry and the gather rule.
 #[derive(Clone, Copy)]
@@ -159,65 +162,73 @@ impl Grid {
     /// Gather `incoming(ray, ground, l, scattered)` (the radiance arriving at a texel's
     /// point from the ray's direction, into `l`; ∫T·σ_s along it into `scattered` when that
     /// is not empty) over every texel's directions; `with_f_ms` sums f_ms too.
-    fn gather(&self, with_f_ms: bool, incoming: &Incoming) -> Gathered {
+    fn gather(
+        &self,
+        marcher: &Marcher,
+        steps: usize,
+        with_f_ms: bool,
+        incoming: &Incoming,
+    ) -> Gathered {
         let n = self.channels;
         let coefficients = coefficient_count(self.degree);
         let p_u = PhaseFunction::Isotropic.eval(1.0);
-        let per_texel: Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> = (0..self.texels())
+        let n_phi = self.directions.1;
+        let per_row: Vec<Vec<TexelGather>> = (0..self.nr)
             .into_par_iter()
-            .map(|i| {
-                let (r, mu_s) = altitude_mu_s_of_texel(
-                    i % self.nmu_s,
-                    i / self.nmu_s,
-                    self.bottom,
-                    self.top,
-                    self.nmu_s,
-                    self.nr,
-                );
-                let sun = Vec3::new((1.0 - mu_s * mu_s).max(0.0).sqrt(), 0.0, mu_s);
-                let mut l = vec![0.0; n];
-                let mut scattered = vec![0.0; if with_f_ms { n } else { 0 }];
-                let mut f_ms = vec![0.0; if with_f_ms { n } else { 0 }];
-                let mut up = vec![0.0; n];
-                let mut field = vec![0.0; coefficients * n];
-                let mut y = vec![0.0; coefficients];
-                for g in gather_directions(r, self.bottom, self.directions.0, self.directions.1) {
-                    let d = g.dir;
-                    let mu = d.z;
-                    let ground = ray_intersects_ground(r, mu, self.bottom);
-                    let ray = MarchRay {
-                        r,
-                        mu,
-                        mu_s,
-                        nu: d.dot(sun),
-                        length: distance_to_nearest_atmosphere_boundary(
+            .map(|row| {
+                let (r, _) =
+                    altitude_mu_s_of_texel(0, row, self.bottom, self.top, self.nmu_s, self.nr);
+                let dirs = gather_directions(r, self.bottom, self.directions.0, n_phi);
+                // The directions of one μ share their geometry at every μ_s of the row: one
+                // profile each.
+                let profiles: Vec<RayProfile> = dirs
+                    .chunks(n_phi)
+                    .map(|same_mu| {
+                        let mu = same_mu[0].dir.z;
+                        let ground = ray_intersects_ground(r, mu, self.bottom);
+                        let ray = MarchRay {
                             r,
                             mu,
+                            mu_s: 1.0,
+                            nu: 0.0,
+                            length: distance_to_nearest_atmosphere_boundary(
+                                r,
+                                mu,
+                                self.bottom,
+                                self.top,
+                                ground,
+                            ),
+                        };
+                        let mut p = RayProfile::default();
+                        marcher.profile_steps_into(&ray, steps, &mut p);
+                        p
+                    })
+                    .collect();
+                (0..self.nmu_s)
+                    .map(|col| {
+                        let (_, mu_s) = altitude_mu_s_of_texel(
+                            col,
+                            row,
                             self.bottom,
                             self.top,
-                            ground,
-                        ),
-                    };
-                    incoming(&ray, ground, &mut l, &mut scattered);
-                    let s = (1.0 - mu * mu).max(0.0).sqrt();
-                    eval(self.degree, mu, if s > 0.0 { d.x / s } else { 1.0 }, &mut y);
-                    for (c, yc) in y.iter().enumerate() {
-                        for k in 0..n {
-                            field[c * n + k] += g.weight * yc * l[k];
-                        }
-                    }
-                    if mu > 0.0 {
-                        for k in 0..n {
-                            up[k] += g.weight * mu * l[k];
-                        }
-                    }
-                    for k in 0..f_ms.len() {
-                        f_ms[k] += g.weight * p_u * scattered[k];
-                    }
-                }
-                (field, f_ms, up)
+                            self.nmu_s,
+                            self.nr,
+                        );
+                        self.gather_texel(
+                            r,
+                            mu_s,
+                            &dirs,
+                            &profiles,
+                            with_f_ms,
+                            p_u,
+                            coefficients,
+                            incoming,
+                        )
+                    })
+                    .collect()
             })
             .collect();
+        let per_texel = per_row.into_iter().flatten();
         let mut out = Gathered {
             field: Vec::with_capacity(self.texels() * coefficients * n),
             f_ms: Vec::new(),
@@ -229,6 +240,67 @@ impl Grid {
             out.up_irradiance.extend(up);
         }
         out
+    }
+
+    /// The gather at one texel (radius `r`, the light at `mu_s`) over `dirs`, whose
+    /// geometry `profiles` hold (one per μ node): its field's coefficients, f_ms when
+    /// `with_f_ms` and its upward irradiance.
+    #[allow(clippy::too_many_arguments)]
+    fn gather_texel(
+        &self,
+        r: f64,
+        mu_s: f64,
+        dirs: &[GatherDirection],
+        profiles: &[RayProfile],
+        with_f_ms: bool,
+        p_u: f64,
+        coefficients: usize,
+        incoming: &Incoming,
+    ) -> TexelGather {
+        let n = self.channels;
+        let sun = Vec3::new((1.0 - mu_s * mu_s).max(0.0).sqrt(), 0.0, mu_s);
+        let mut l = vec![0.0; n];
+        let mut f_ms = vec![0.0; if with_f_ms { n } else { 0 }];
+        let mut up = vec![0.0; n];
+        let mut field = vec![0.0; coefficients * n];
+        let mut y = vec![0.0; coefficients];
+        for (gi, g) in dirs.iter().enumerate() {
+            let profile = &profiles[gi / self.directions.1];
+            let d = g.dir;
+            let mu = d.z;
+            let ground = ray_intersects_ground(r, mu, self.bottom);
+            let ray = MarchRay {
+                r,
+                mu,
+                mu_s,
+                nu: d.dot(sun),
+                length: distance_to_nearest_atmosphere_boundary(
+                    r,
+                    mu,
+                    self.bottom,
+                    self.top,
+                    ground,
+                ),
+            };
+            incoming(&ray, profile, ground, &mut l);
+            let scattered = &profile.scattered;
+            let s = (1.0 - mu * mu).max(0.0).sqrt();
+            eval(self.degree, mu, if s > 0.0 { d.x / s } else { 1.0 }, &mut y);
+            for (c, yc) in y.iter().enumerate() {
+                for k in 0..n {
+                    field[c * n + k] += g.weight * yc * l[k];
+                }
+            }
+            if mu > 0.0 {
+                for k in 0..n {
+                    up[k] += g.weight * mu * l[k];
+                }
+            }
+            for k in 0..f_ms.len() {
+                f_ms[k] += g.weight * p_u * scattered[k];
+            }
+        }
+        (field, f_ms, up)
     }
 
     /// A table of the field's coefficients.
@@ -293,14 +365,14 @@ pub(crate) fn compute(
     };
     // Order 1: the light scattered once towards the point, and the Lambertian ground lit by
     // the light (eq. 6), with f_ms (eq. 8).
-    let first = grid.gather(true, &|ray, ground, l, scattered| {
+    let first = grid.gather(marcher, steps, true, &|ray, profile, ground, l| {
         let mut phases = Vec::new();
         match model_kind {
             MultipleScatteringModel::Isotropic => marcher.medium.isotropic_phases(&mut phases),
             MultipleScatteringModel::Harmonics(_) => marcher.medium.phases(ray.nu, &mut phases),
         }
-        let mut t = vec![0.0; n];
-        marcher.march(ray, steps, &phases, &Lighting::ALL, l, &mut t, scattered);
+        marcher.march_profile(ray, profile, &phases, &Lighting::ALL, l, |_, _| {});
+        let t = &profile.transmittance;
         if ground {
             let (r_g, mu_s_g) = ray.at(ray.length);
             let mut t_sun = vec![0.0; n];
@@ -345,9 +417,9 @@ pub(crate) fn compute(
             single: Lit::Intervals(&[]),
             multiple: Lit::All,
         };
-        let next = next_grid.gather(false, &|ray, ground, l, _| {
-            let mut t = vec![0.0; n];
-            through.march(ray, steps, &[], &unlit, l, &mut t, &mut []);
+        let next = next_grid.gather(marcher, steps, false, &|ray, profile, ground, l| {
+            through.march_profile(ray, profile, &[], &unlit, l, |_, _| {});
+            let t = &profile.transmittance;
             if ground {
                 let (r_g, mu_s_g) = ray.at(ray.length);
                 let (u, _) = altitude_mu_s_uv(r_g, bottom, top, mu_s_g, nmu_s, nr);

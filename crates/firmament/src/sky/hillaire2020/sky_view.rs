@@ -6,7 +6,7 @@
 
 use rayon::prelude::*;
 
-use super::march::{Lighting, MarchRay, Marcher};
+use super::march::{Lighting, MarchRay, Marcher, RayProfile};
 use super::params::{sky_view_mu_cos_phi, sky_view_uv};
 use crate::math::sphere::{
     distance_to_nearest_atmosphere_boundary, ray_intersects_ground, safe_sqrt,
@@ -33,32 +33,29 @@ pub(crate) fn compute(
         .par_chunks_mut(nu * n)
         .enumerate()
         .for_each(|(y, row)| {
+            // The row's rays share their zenith cosine, hence their geometry: one profile,
+            // then each column's light.
+            let v = (y as f64 + 0.5) / nv as f64;
+            let (mu, _) = sky_view_mu_cos_phi(r, bottom, 0.5 / nu as f64, v, nu, nv);
+            let ground = ray_intersects_ground(r, mu, bottom);
+            let mut ray = MarchRay {
+                r,
+                mu,
+                mu_s,
+                nu: 0.0,
+                length: distance_to_nearest_atmosphere_boundary(r, mu, bottom, top, ground),
+            };
+            let mut profile = RayProfile::default();
+            marcher.profile_steps_into(&ray, steps, &mut profile);
             let mut phases = Vec::new();
             let mut l = vec![0.0; n];
-            let mut t = vec![0.0; n];
             for x in 0..nu {
                 let u = (x as f64 + 0.5) / nu as f64;
-                let v = (y as f64 + 0.5) / nv as f64;
-                let (mu, cos_phi) = sky_view_mu_cos_phi(r, bottom, u, v, nu, nv);
+                let (_, cos_phi) = sky_view_mu_cos_phi(r, bottom, u, v, nu, nv);
                 let view_nu = mu * mu_s + safe_sqrt(1.0 - mu * mu) * sin_s * cos_phi;
                 marcher.medium.phases(view_nu, &mut phases);
-                let ground = ray_intersects_ground(r, mu, bottom);
-                let ray = MarchRay {
-                    r,
-                    mu,
-                    mu_s,
-                    nu: view_nu.clamp(-1.0, 1.0),
-                    length: distance_to_nearest_atmosphere_boundary(r, mu, bottom, top, ground),
-                };
-                marcher.march(
-                    &ray,
-                    steps,
-                    &phases,
-                    &Lighting::ALL,
-                    &mut l,
-                    &mut t,
-                    &mut [],
-                );
+                ray.nu = view_nu.clamp(-1.0, 1.0);
+                marcher.march_profile(&ray, &profile, &phases, &Lighting::ALL, &mut l, |_, _| {});
                 for k in 0..n {
                     row[x * n + k] = l[k] as f32;
                 }
