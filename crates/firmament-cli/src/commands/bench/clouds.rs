@@ -11,6 +11,7 @@ use firmament::scene::{sun_direction, Light, Scene, SceneFile};
 use firmament::sky::bruneton4d::Bruneton4d;
 use firmament_gpu::{GpuClouds, GpuRenderer, GpuSky, RenderInputs};
 
+use super::gpu::dispatch_and_whole;
 use super::timing::{median, time_runs};
 use crate::backend::{gpu_failure, Gpu};
 use crate::common::scene_clouds;
@@ -90,34 +91,25 @@ pub fn gpu_seconds(
     frame: &CloudFrame,
     runs: usize,
 ) -> Result<(f64, f64)> {
-    let ctx = &gpu.ctx;
     let settings = frame.settings();
     let lights = [Light::sun(&sky.model, frame.sun, true)];
     let upload = || -> Result<GpuClouds> {
         let scene = frame.scene(sky);
         let shader = Shader::new(&scene, frame.observer(sky))?;
-        GpuClouds::new(ctx, gpu_sky, &frame.media, &shader)
+        GpuClouds::new(&gpu.ctx, gpu_sky, &frame.media, &shader)
             .map_err(|e| gpu_failure("uploading the clouds", e))
     };
-    let clouds = upload()?;
-    let inputs = RenderInputs {
-        clouds: Some(&clouds),
-        ..RenderInputs::default()
-    };
-    let dispatch = renderer
-        .time_render_with(ctx, gpu_sky, &lights, &settings, inputs, runs)
-        .map_err(|e| gpu_failure("timing cloudy frames", e))?;
-    let seconds = time_runs(runs.clamp(1, 3), || {
-        let clouds = upload()?;
-        let inputs = RenderInputs {
-            clouds: Some(&clouds),
+    dispatch_and_whole(
+        gpu,
+        renderer,
+        gpu_sky,
+        &lights,
+        &settings,
+        runs,
+        upload,
+        |c| RenderInputs {
+            clouds: Some(c),
             ..RenderInputs::default()
-        };
-        let image = renderer
-            .render_with(ctx, gpu_sky, &lights, &settings, inputs)
-            .map_err(|e| gpu_failure("rendering", e))?;
-        let _ = image.to_srgb8(1e-4, ToneCurve::Aces);
-        Ok(())
-    })?;
-    Ok((dispatch.seconds, median(seconds)))
+        },
+    )
 }

@@ -7,7 +7,6 @@ use anyhow::Result;
 use firmament::atmosphere::Model;
 use firmament::math::Vec3;
 use firmament::render::{RenderSettings, Shader, ToneCurve};
-use firmament::scene::terrain::Heightfield;
 use firmament::scene::{sun_direction, Light, Scene};
 use firmament::sky::bruneton4d::{Bruneton4d, TableConfig};
 use firmament_gpu::Precomputer;
@@ -161,30 +160,47 @@ fn terrain_timings(
     let sun = sun_direction(default.sun.zenith_deg, default.sun.azimuth_deg);
     let lights = [Light::sun(model, sun, true)];
     let observer = Vec3::new(0.0, 0.0, model.bottom_radius_m + camera.altitude_m);
-    let upload = |terrain: &Heightfield| -> Result<GpuTerrain> {
+    let upload = || -> Result<GpuTerrain> {
+        // Without its shadow fields, so that each upload computes them as a frame would.
+        let terrain = terrain.clone_without_shadows();
         let mut scene = Scene::clear_sky(cpu_sky, sun, true);
-        scene.add_terrain(terrain, terrain.radius_m);
+        scene.add_terrain(&terrain, terrain.radius_m);
         let shader = Shader::new(&scene, observer)?;
-        GpuTerrain::new(ctx, sky, terrain, &shader)
+        GpuTerrain::new(ctx, sky, &terrain, &shader)
             .map_err(|e| gpu_failure("uploading the terrain", e))
     };
-    let uploaded = upload(&terrain)?;
-    let inputs = RenderInputs {
-        terrain: Some(&uploaded),
-        ..RenderInputs::default()
-    };
+    dispatch_and_whole(gpu, renderer, sky, &lights, &settings, runs, upload, |t| {
+        RenderInputs {
+            terrain: Some(t),
+            ..RenderInputs::default()
+        }
+    })
+}
+
+/// A frame whose inputs the CPU prepares and uploads (`upload`; `inputs` says what they
+/// are to the renderer): the render dispatch alone (median of `runs` after a warm-up,
+/// timestamp queries on a hardware adapter), and the whole frame (at most 3 runs): the
+/// upload with its CPU parts, the dispatch, the readback and the tone mapping.
+#[allow(clippy::too_many_arguments)]
+pub fn dispatch_and_whole<T>(
+    gpu: &Gpu,
+    renderer: &GpuRenderer,
+    sky: &GpuSky,
+    lights: &[Light],
+    settings: &RenderSettings,
+    runs: usize,
+    upload: impl Fn() -> Result<T>,
+    inputs: impl for<'a> Fn(&'a T) -> RenderInputs<'a>,
+) -> Result<(f64, f64)> {
+    let ctx = &gpu.ctx;
+    let uploaded = upload()?;
     let dispatch = renderer
-        .time_render_with(ctx, sky, &lights, &settings, inputs, runs)
+        .time_render_with(ctx, sky, lights, settings, inputs(&uploaded), runs)
         .map_err(|e| gpu_failure("timing frames", e))?;
     let seconds = time_runs(runs.clamp(1, 3), || {
-        let terrain = terrain.clone_without_shadows();
-        let uploaded = upload(&terrain)?;
-        let inputs = RenderInputs {
-            terrain: Some(&uploaded),
-            ..RenderInputs::default()
-        };
+        let uploaded = upload()?;
         let image = renderer
-            .render_with(ctx, sky, &lights, &settings, inputs)
+            .render_with(ctx, sky, lights, settings, inputs(&uploaded))
             .map_err(|e| gpu_failure("rendering", e))?;
         let _ = image.to_srgb8(1e-4, ToneCurve::Aces);
         Ok(())
