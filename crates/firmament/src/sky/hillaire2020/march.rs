@@ -38,22 +38,17 @@ impl<'a> Medium<'a> {
     }
 
     /// At `altitude_m`: the extinction σ_t (m⁻¹) into `sigma_t`, the scattering σ_s (m⁻¹)
-    /// into `sigma_s`, and Σ_c ρ_c·β_c·p_c into `phased` where `phases[c]` is constituent
-    /// c's phase function at the ray's scattering angle (skipped when `phases` is empty);
-    /// each constituent's density into `densities`.
+    /// into `sigma_s`, each constituent's density into `densities`.
     #[inline]
     pub fn coefficients(
         &self,
         altitude_m: f64,
-        phases: &[f64],
         sigma_t: &mut [f64],
         sigma_s: &mut [f64],
-        phased: &mut [f64],
         densities: &mut [f64],
     ) {
         sigma_t.iter_mut().for_each(|v| *v = 0.0);
         sigma_s.iter_mut().for_each(|v| *v = 0.0);
-        phased.iter_mut().for_each(|v| *v = 0.0);
         let n = sigma_t.len();
         for (i, c) in self.model.constituents.iter().enumerate() {
             let rho = c.density.density(altitude_m);
@@ -68,12 +63,26 @@ impl<'a> Medium<'a> {
                 for k in 0..n {
                     sigma_s[k] += rho * c.scattering[k];
                 }
-                if !phases.is_empty() {
-                    let w = rho * phases[i];
-                    for k in 0..n {
-                        phased[k] += w * c.scattering[k];
-                    }
-                }
+            }
+        }
+    }
+
+    /// Σ_c ρ_c·β_c·p_c into `phased` (overwritten) for the constituents' `densities` where
+    /// `phases[c]` is constituent c's phase function at the ray's scattering angle (0 when
+    /// `phases` is empty: no single scattering).
+    #[inline]
+    pub fn phased(&self, densities: &[f64], phases: &[f64], phased: &mut [f64]) {
+        phased.iter_mut().for_each(|v| *v = 0.0);
+        if phases.is_empty() {
+            return;
+        }
+        for (i, c) in self.model.constituents.iter().enumerate() {
+            if densities[i] <= 0.0 || !self.scatters[i] {
+                continue;
+            }
+            let w = densities[i] * phases[i];
+            for (p, b) in phased.iter_mut().zip(&c.scattering) {
+                *p += w * b;
             }
         }
     }
@@ -244,14 +253,14 @@ impl Marcher<'_> {
             densities_vec = vec![0.0; model.constituents.len()];
             &mut densities_vec
         };
-        with_channel_buffers(n, |[sigma_t, sigma_s, phased]| {
+        with_channel_buffers(n, |[sigma_t, sigma_s]| {
             let mut t0 = 0.0;
             for t1 in ends {
                 let dt = t1 - t0;
                 let t_mid = 0.5 * (t0 + t1);
                 let (r_t, _) = ray.at(t_mid);
                 self.medium
-                    .coefficients(r_t - bottom, &[], sigma_t, sigma_s, phased, densities);
+                    .coefficients(r_t - bottom, sigma_t, sigma_s, densities);
                 p.steps.push([t0, t1, t_mid, r_t]);
                 p.densities.extend_from_slice(densities);
                 for k in 0..n {
@@ -365,18 +374,7 @@ impl Marcher<'_> {
             for (i, &[t0, t1, t_mid, r_t]) in profile.steps.iter().enumerate() {
                 let densities = &profile.densities[i * constituents..(i + 1) * constituents];
                 let mu_s_t = ((ray.r * ray.mu_s + t_mid * ray.nu) / r_t.max(1.0)).clamp(-1.0, 1.0);
-                phased.iter_mut().for_each(|v| *v = 0.0);
-                if !phases.is_empty() {
-                    for (ci, con) in model.constituents.iter().enumerate() {
-                        if densities[ci] <= 0.0 || !self.medium.scatters(ci) {
-                            continue;
-                        }
-                        let w = densities[ci] * phases[ci];
-                        for k in 0..n {
-                            phased[k] += w * con.scattering[k];
-                        }
-                    }
-                }
+                self.medium.phased(densities, phases, phased);
                 let lit_single = lighting.single.fraction(t0, t1);
                 let lit_multiple = lighting.multiple.fraction(t0, t1);
                 if lit_single > 0.0 {
