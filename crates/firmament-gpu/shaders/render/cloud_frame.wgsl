@@ -48,6 +48,10 @@ fn clouded_air(v: View, vl: ViewLight, pray: PointRay, list: ptr<function, Shado
 }
 
 // Shader::shade under the clouds, summed to linear sRGB over the lights and channel groups.
+// The clouds are marched first; then per light the air's light is summed over the whole ray
+// and, where the ray meets a cloud, again to the cloud's mean depth (its aerial perspective),
+// both from one call of clouded_air in a loop: every call site of a function is inlined
+// whole by the driver, and lavapipe's compile grows faster than the code.
 fn shade_clouds(dir: vec3<f32>) -> vec3<f32> {
     let o = observer();
     var v: View;
@@ -61,84 +65,81 @@ fn shade_clouds(dir: vec3<f32>) -> vec3<f32> {
     }
     let x = q + end_m * dir;
     let up = cloud_point(x).up;
+    // The clouds in front, seen through the air to their mean depth under the same shadows.
+    var l_vol: array<vec4<f32>, MAX_CHANNEL_GROUPS>;
+    let m = march_clouds(q, dir, end_m, &l_vol);
+    let spans = select(1u, 2u, m.depth_m >= 0.0);
     var rgb = vec3<f32>(0.0);
-    var lists: array<ShadowList, MAX_LIGHTS>;
+    var front = vec3<f32>(0.0);
+    var seen = vec3<f32>(0.0);
     var acc: array<vec4<f32>, MAX_CHANNEL_GROUPS>;
     for (var light = 0u; light < frame.lights; light++) {
         let vl = view_light(light);
         var list = shadowed_intervals(light, vl.direction, q, dir, end_m);
-        lists[light] = list;
-        let d_km = select(-1.0, end_m * 1e-3, hit);
-        let pray = point_ray(o, vl, dir, d_km);
-        clouded_air(v, vl, pray, &list, end_m, &acc);
-        var endp: Piece;
-        if (pray.in_atmosphere) {
-            endp = piece_at(v, pray, vl, pray.end_km, false);
-        }
-        if (hit) {
-            let g = point_light(vl, 0.0, up, up);
+        for (var span = 0u; span < spans; span++) {
+            // Span 0: the whole ray; span 1: the air in front of the clouds.
+            let to_cloud = span == 1u;
+            let span_m = select(end_m, m.depth_m, to_cloud);
+            let d_km = select(select(-1.0, end_m * 1e-3, hit), m.depth_m * 1e-3, to_cloud);
+            let pray = point_ray(o, vl, dir, d_km);
+            clouded_air(v, vl, pray, &list, span_m, &acc);
+            var endp: Piece;
+            if (pray.in_atmosphere) {
+                endp = piece_at(v, pray, vl, pray.end_km, false);
+            }
+            if (to_cloud) {
+                for (var k = 0u; k < atm.groups; k++) {
+                    front += to_srgb(acc[k] * light_scale(light, k), k);
+                    if (light == 0u) {
+                        seen += to_srgb(point_transmittance(pray, endp, k) * l_vol[k], k);
+                    }
+                }
+                continue;
+            }
+            if (hit) {
+                let g = point_light(vl, 0.0, up, up);
+                for (var k = 0u; k < atm.groups; k++) {
+                    let scale = light_scale(light, k);
+                    let e = point_irradiance(g, k);
+                    var s: SurfaceLight;
+                    s.direct = e.direct * light_irradiance(light, k);
+                    s.sky = e.sky * scale;
+                    let t_air = sample_transmittance(g.to_light, k) * g.fraction;
+                    s = dim_surface_light(light, x, up, vl.direction, k, t_air, s);
+                    let t = point_transmittance(pray, endp, k);
+                    let l = acc[k] * scale + ground_albedo(k) / PI * (s.direct + s.sky) * t;
+                    rgb += to_srgb(l, k);
+                }
+                continue;
+            }
+            let disk = light_disk(light, dir);
+            let background = light == 0u && lights.background.x > 0.0;
+            var background_f = 0.0;
+            if (background) {
+                background_f = background_factor(o.r_km, dir.z);
+            }
+            var t_top: Filter2;
+            if (pray.in_atmosphere) {
+                t_top = transmittance_filter(pray.s.r_km, pray.s.rho_km, pray.s.mu);
+            }
             for (var k = 0u; k < atm.groups; k++) {
-                let scale = light_scale(light, k);
-                let e = point_irradiance(g, k);
-                var s: SurfaceLight;
-                s.direct = e.direct * light_irradiance(light, k);
-                s.sky = e.sky * scale;
-                let t_air = sample_transmittance(g.to_light, k) * g.fraction;
-                s = dim_surface_light(light, x, up, vl.direction, k, t_air, s);
-                let t = point_transmittance(pray, endp, k);
-                let l = acc[k] * scale + ground_albedo(k) / PI * (s.direct + s.sky) * t;
+                var l = acc[k] * light_scale(light, k);
+                var t = vec4<f32>(1.0);
+                if (pray.in_atmosphere) {
+                    t = select(sample_transmittance(t_top, k), vec4<f32>(0.0), pray.ground);
+                }
+                if (disk.inside) {
+                    l += light_disk_radiance(light, disk, dir, k) * t;
+                }
+                if (background) {
+                    l += lights.background_radiance[k] * background_f * t;
+                }
                 rgb += to_srgb(l, k);
             }
-            continue;
-        }
-        let disk = light_disk(light, dir);
-        let background = light == 0u && lights.background.x > 0.0;
-        var background_f = 0.0;
-        if (background) {
-            background_f = background_factor(o.r_km, dir.z);
-        }
-        var t_top: Filter2;
-        if (pray.in_atmosphere) {
-            t_top = transmittance_filter(pray.s.r_km, pray.s.rho_km, pray.s.mu);
-        }
-        for (var k = 0u; k < atm.groups; k++) {
-            var l = acc[k] * light_scale(light, k);
-            var t = vec4<f32>(1.0);
-            if (pray.in_atmosphere) {
-                t = select(sample_transmittance(t_top, k), vec4<f32>(0.0), pray.ground);
-            }
-            if (disk.inside) {
-                l += light_disk_radiance(light, disk, dir, k) * t;
-            }
-            if (background) {
-                l += lights.background_radiance[k] * background_f * t;
-            }
-            rgb += to_srgb(l, k);
         }
     }
-    // The clouds in front, seen through the air to their mean depth under the same shadows.
-    var l_vol: array<vec4<f32>, MAX_CHANNEL_GROUPS>;
-    let m = march_clouds(q, dir, end_m, &l_vol);
     if (m.depth_m < 0.0) {
         return rgb;
-    }
-    var front = vec3<f32>(0.0);
-    var seen = vec3<f32>(0.0);
-    for (var light = 0u; light < frame.lights; light++) {
-        let vl = view_light(light);
-        let pray = point_ray(o, vl, dir, m.depth_m * 1e-3);
-        var list = lists[light];
-        clouded_air(v, vl, pray, &list, m.depth_m, &acc);
-        var endp: Piece;
-        if (pray.in_atmosphere) {
-            endp = piece_at(v, pray, vl, pray.end_km, false);
-        }
-        for (var k = 0u; k < atm.groups; k++) {
-            front += to_srgb(acc[k] * light_scale(light, k), k);
-            if (light == 0u) {
-                seen += to_srgb(point_transmittance(pray, endp, k) * l_vol[k], k);
-            }
-        }
     }
     return front + seen + m.t_vol * (rgb - front);
 }
@@ -154,17 +155,15 @@ fn main_clouds(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     var out = vec4<f32>(0.0);
     if (p.ray.valid) {
         var rgb = vec3<f32>(0.0);
-        if (straddles_disk_edge(p.x, p.y, p.ray.dir)) {
-            for (var k = 0u; k < DISK_SUBSAMPLES * DISK_SUBSAMPLES; k++) {
-                let r = camera_ray(f32(p.x) + subpixel(k).x, f32(p.y) + subpixel(k).y);
-                if (r.valid) {
-                    rgb += shade_clouds(r.dir);
-                }
+        // One ray, or DISK_SUBSAMPLES² over the footprint of a pixel on a disk's edge.
+        let n = pixel_rays(p);
+        for (var k = 0u; k < n; k++) {
+            let r = pixel_ray(p, k, n);
+            if (r.valid) {
+                rgb += shade_clouds(r.dir);
             }
-            rgb /= f32(DISK_SUBSAMPLES * DISK_SUBSAMPLES);
-        } else {
-            rgb = shade_clouds(p.ray.dir);
         }
+        rgb /= f32(n);
         out = vec4<f32>(rgb * frame.balance.xyz, 1.0);
     }
     write_pixel(p.i, p.x, p.y, out);

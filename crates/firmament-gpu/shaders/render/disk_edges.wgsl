@@ -47,3 +47,19 @@ fn subpixel(k: u32) -> vec2<f32> {
     let n = DISK_SUBSAMPLES;
     return vec2<f32>((f32(k % n) + 0.5) / f32(n), (f32(k / n) + 0.5) / f32(n));
 }
+
+// How many rays pixel `p` is the mean of: DISK_SUBSAMPLES² where it straddles a disk's
+// edge, else 1. Entry points loop over pixel_ray(p, k, n) for k < n with their shading
+// called once in the loop: each call site of a shading function is inlined whole by the
+// driver, and a second one doubles a compile that grows faster than the code (lavapipe).
+fn pixel_rays(p: Pixel) -> u32 {
+    return select(1u, DISK_SUBSAMPLES * DISK_SUBSAMPLES, straddles_disk_edge(p.x, p.y, p.ray.dir));
+}
+
+// Ray k of the n of pixel `p` (its centre ray when n is 1).
+fn pixel_ray(p: Pixel, k: u32, n: u32) -> CameraRay {
+    if (n == 1u) {
+        return p.ray;
+    }
+    return camera_ray(f32(p.x) + subpixel(k).x, f32(p.y) + subpixel(k).y);
+}

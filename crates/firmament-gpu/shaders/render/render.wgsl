@@ -142,18 +142,15 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
             shadow_km = textureLoad(shadow_lengths, vec2<u32>(p.x, p.y), 0).x * 1e-3;
         }
         var rgb = vec3<f32>(0.0);
-        if (straddles_disk_edge(p.x, p.y, p.ray.dir)) {
-            // A disk's edge: the mean over the pixel's footprint.
-            for (var k = 0u; k < DISK_SUBSAMPLES * DISK_SUBSAMPLES; k++) {
-                let r = camera_ray(f32(p.x) + subpixel(k).x, f32(p.y) + subpixel(k).y);
-                if (r.valid) {
-                    rgb += shade(r.dir, shadow_km);
-                }
+        // One ray, or DISK_SUBSAMPLES² over the footprint of a pixel on a disk's edge.
+        let n = pixel_rays(p);
+        for (var k = 0u; k < n; k++) {
+            let r = pixel_ray(p, k, n);
+            if (r.valid) {
+                rgb += shade(r.dir, shadow_km);
             }
-            rgb /= f32(DISK_SUBSAMPLES * DISK_SUBSAMPLES);
-        } else {
-            rgb = shade(p.ray.dir, shadow_km);
         }
+        rgb /= f32(n);
         out = vec4<f32>(rgb * frame.balance.xyz, 1.0);
     }
     write_pixel(p.i, p.x, p.y, out);
@@ -170,17 +167,15 @@ fn main_terrain(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     var out = vec4<f32>(0.0);
     if (p.ray.valid) {
         var rgb = vec3<f32>(0.0);
-        if (straddles_disk_edge(p.x, p.y, p.ray.dir)) {
-            for (var k = 0u; k < DISK_SUBSAMPLES * DISK_SUBSAMPLES; k++) {
-                let r = camera_ray(f32(p.x) + subpixel(k).x, f32(p.y) + subpixel(k).y);
-                if (r.valid) {
-                    rgb += shade_scene(r.dir);
-                }
+        // One ray, or DISK_SUBSAMPLES² over the footprint of a pixel on a disk's edge.
+        let n = pixel_rays(p);
+        for (var k = 0u; k < n; k++) {
+            let r = pixel_ray(p, k, n);
+            if (r.valid) {
+                rgb += shade_scene(r.dir);
             }
-            rgb /= f32(DISK_SUBSAMPLES * DISK_SUBSAMPLES);
-        } else {
-            rgb = shade_scene(p.ray.dir);
         }
+        rgb /= f32(n);
         out = vec4<f32>(rgb * frame.balance.xyz, 1.0);
     }
     write_pixel(p.i, p.x, p.y, out);
