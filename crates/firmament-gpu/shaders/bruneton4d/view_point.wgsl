@@ -197,14 +197,3 @@ fn point_irradiance(g: PointLight, k: u32) -> Irradiance {
     }
     return e;
 }
-
-// Bruneton4dView::lit_radiance of one lit interval [a, b] for the multiple scattering
-// (Shadow::Clouded: the air in a cloud's shadow loses it too), channel group k, before the
-// light's scale.
-fn lit_multiple(a: Piece, b: Piece, b_subtracts: bool, k: u32) -> vec4<f32> {
-    var m = piece_multiple(a, k);
-    if (b_subtracts) {
-        m = max(m - piece_multiple(b, k), vec4<f32>(0.0));
-    }
-    return m;
-}

@@ -1,19 +1,26 @@
 // A frame's pixel under clouds (firmament::render::Shader::shade with the scene's volumes,
 // no terrain): the planet's ground lit by each light under the clouds (their shadow map,
 // their diffuse light and the ground–cloud interreflection: render/volumes.wgsl), the sky
-// and the lights' disks, the air's light summed over the stretches of the ray outside the
-// clouds' shadow (Shadow::Clouded: single and multiple scattering both), and the clouds in
-// front composited at their mean depth, their own aerial perspective under the same shadows.
+// and the lights' disks, the air's light (its single scattering over the stretches of the
+// ray outside the clouds' shadow, its multiple over the whole ray), and the clouds in front
+// composited at their mean depth, their own aerial perspective under the same shadows.
 
-// Σ over the stretches of the ray outside the shadowed ones (the complement of `list` in
-// [0, end_m], scene::lit_intervals) of the single and multiple scattering, per channel group
-// into acc (before the light's scale). `pray` ends at end_m (or is open towards the sky).
-fn clouded_air(v: View, vl: ViewLight, pray: PointRay, list: ptr<function, ShadowList>, end_m: f32, acc: ptr<function, array<vec4<f32>, MAX_CHANNEL_GROUPS>>) {
+// The air's light along `pray` up to end_m (Shadow::Lit, as the CPU's renderer gives it
+// under clouds): the multiple scattering over the whole ray (the sky still lights the air in
+// a cloud's shadow; `endp` is the ray's end piece) and the single scattering over the
+// stretches outside the shadowed ones (the complement of `list` in [0, end_m],
+// scene::lit_intervals), per channel group into acc (before the light's scale). `pray` ends
+// at end_m (or is open towards the sky).
+fn clouded_air(v: View, vl: ViewLight, pray: PointRay, list: ptr<function, ShadowList>, end_m: f32, endp: Piece, acc: ptr<function, array<vec4<f32>, MAX_CHANNEL_GROUPS>>) {
     for (var k = 0u; k < atm.groups; k++) {
         (*acc)[k] = vec4<f32>(0.0);
     }
     if (!pray.in_atmosphere) {
         return;
+    }
+    let start = piece_at(v, pray, vl, 0.0, false);
+    for (var k = 0u; k < atm.groups; k++) {
+        (*acc)[k] = whole_multiple(pray, start, endp, k);
     }
     let offset_km = pray.s.offset_km;
     var lit_from = 0.0;
@@ -38,7 +45,7 @@ fn clouded_air(v: View, vl: ViewLight, pray: PointRay, list: ptr<function, Shado
             let pb = piece_at(v, pray, vl, b_km, true);
             let b_subtracts = !at_end || !pray.open_end;
             for (var k = 0u; k < atm.groups; k++) {
-                (*acc)[k] += lit_single(v, pray, pa, pb, b_subtracts, k) + lit_multiple(pa, pb, b_subtracts, k);
+                (*acc)[k] += lit_single(v, pray, pa, pb, b_subtracts, k);
             }
         }
         if (lit_from >= end_m) {
@@ -82,11 +89,11 @@ fn shade_clouds(dir: vec3<f32>) -> vec3<f32> {
             let span_m = select(end_m, m.depth_m, to_cloud);
             let d_km = select(select(-1.0, end_m * 1e-3, hit), m.depth_m * 1e-3, to_cloud);
             let pray = point_ray(o, vl, dir, d_km);
-            clouded_air(v, vl, pray, &list, span_m, &acc);
             var endp: Piece;
             if (pray.in_atmosphere) {
                 endp = piece_at(v, pray, vl, pray.end_km, false);
             }
+            clouded_air(v, vl, pray, &list, span_m, endp, &acc);
             if (to_cloud) {
                 for (var k = 0u; k < atm.groups; k++) {
                     front += to_srgb(acc[k] * light_scale(light, k), k);

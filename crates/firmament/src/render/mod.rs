@@ -97,9 +97,8 @@ pub struct Shader<'s> {
 pub struct ShadeScratch {
     shadowed: Vec<(f64, f64)>,
     lit: Vec<(f64, f64)>,
-    /// The clouds' shadows along the ray and their complement.
+    /// The clouds' shadows along the ray.
     clouded: Vec<(f64, f64)>,
-    air_lit: Vec<(f64, f64)>,
 }
 
 impl<'s> Shader<'s> {
@@ -358,9 +357,12 @@ impl<'s> Shader<'s> {
     }
 
     /// The parts of `ray` up to `end` that light `j` reaches (past the surfaces and under
-    /// the volumes' shadow map, [`Shadow::Clouded`] when the map shadows some of it), and
-    /// whether it reaches `end` past the surfaces (the volumes' shadow on a surface is
-    /// [`volumes::dim_surface_light`]'s).
+    /// the volumes' shadow map), and whether it reaches `end` past the surfaces (the
+    /// volumes' shadow on a surface is [`volumes::dim_surface_light`]'s). In a cloud's
+    /// shadow, as in a mountain's, the air loses its single scattering and keeps its
+    /// multiple: the sky beside the cloud still lights it (broken cloud), and under an
+    /// overcast the cloud's base lights it instead, of the order of the clear sky's light
+    /// (docs/accuracy.md, "Clouds").
     fn shadow<'b>(
         &self,
         ray: &Ray,
@@ -385,15 +387,9 @@ impl<'s> Shader<'s> {
             lit_intervals(&mut scratch.shadowed, end, &mut scratch.lit);
             return (Shadow::Lit(&scratch.lit), lit_at_end);
         }
-        scratch.air_lit.clear();
-        lit_intervals(&mut scratch.clouded, end, &mut scratch.air_lit);
         scratch.shadowed.extend_from_slice(&scratch.clouded);
         lit_intervals(&mut scratch.shadowed, end, &mut scratch.lit);
-        let shadow = Shadow::Clouded {
-            single: &scratch.lit,
-            multiple: &scratch.air_lit,
-        };
-        (shadow, lit_at_end)
+        (Shadow::Lit(&scratch.lit), lit_at_end)
     }
 }
 
@@ -402,9 +398,6 @@ fn shadow_owned(shadow: Shadow) -> volumes::OwnedShadow {
     match &shadow {
         Shadow::None | Shadow::Length(_) => volumes::OwnedShadow::None,
         Shadow::Lit(l) => volumes::OwnedShadow::Lit(l.to_vec()),
-        Shadow::Clouded { single, multiple } => {
-            volumes::OwnedShadow::Clouded(single.to_vec(), multiple.to_vec())
-        }
     }
 }
 

@@ -92,8 +92,6 @@ pub(super) enum OwnedShadow {
     None,
     /// [`Shadow::Lit`].
     Lit(Vec<(f64, f64)>),
-    /// [`Shadow::Clouded`]: single, multiple.
-    Clouded(Vec<(f64, f64)>, Vec<(f64, f64)>),
 }
 
 impl OwnedShadow {
@@ -101,10 +99,6 @@ impl OwnedShadow {
         match self {
             OwnedShadow::None => Shadow::None,
             OwnedShadow::Lit(l) => Shadow::Lit(l),
-            OwnedShadow::Clouded(s, m) => Shadow::Clouded {
-                single: s,
-                multiple: m,
-            },
         }
     }
 }

@@ -45,21 +45,11 @@ pub enum Shadow<'a> {
     Length(f64),
     /// The lit intervals [start, end] (m from the observer along the ray), increasing and
     /// disjoint; the rest of the ray is in shadow. Exact light shafts from the CPU's lit
-    /// segments: the single scattering is taken over the lit intervals only, the multiple
-    /// over the whole ray (the air in a shadow is still lit by the sky; what the shadowing
-    /// surface hides of the sky is `render::terrain_air`'s). `Length` leaves both out, as
-    /// the paper does.
+    /// segments (the terrain's and the clouds' shadows): the single scattering is taken
+    /// over the lit intervals only, the multiple over the whole ray (the air in a shadow is
+    /// still lit by the sky; what the shadowing surface hides of the sky is
+    /// `render::terrain_air`'s). `Length` leaves both out, as the paper does.
     Lit(&'a [(f64, f64)]),
-    /// As `Lit` for the single scattering (the light reaches the `single` intervals), and
-    /// the multiple scattering taken over the `multiple` intervals only: the rest of the
-    /// ray lies in a cloud's shadow, where the air is lit neither by the light nor by the
-    /// sky above the cloud (the cloud's own light is the cloud's: `render::volumes`).
-    Clouded {
-        /// Where the light reaches (surfaces' and clouds' shadows left out).
-        single: &'a [(f64, f64)],
-        /// Where the air is lit at all (the clouds' shadows left out).
-        multiple: &'a [(f64, f64)],
-    },
 }
 
 /// A way of evaluating an atmosphere's light transport (the 4D tables, Hillaire 2020, the

@@ -294,8 +294,6 @@ impl<'a> Bruneton4dView<'a> {
         &self,
         ray: &RayGeometry,
         lit: impl IntoIterator<Item = (f64, f64)>,
-        multiple_lit: Option<&[(f64, f64)]>,
-        offset: f64,
         end: f64,
         open_end: bool,
         t_end: &[f64],
@@ -304,14 +302,9 @@ impl<'a> Bruneton4dView<'a> {
     ) {
         let n = self.channels();
         with_channel_buffers(n, |[multiple]| {
-            let whole = [(0.0, end)];
-            let intervals: Vec<(f64, f64)> = match multiple_lit {
-                Some(m) => m.iter().map(|&(a, b)| (a - offset, b - offset)).collect(),
-                None => whole.to_vec(),
-            };
             self.lit_radiance(
                 ray,
-                intervals,
+                [(0.0, end)],
                 end,
                 open_end,
                 t_end,
@@ -385,23 +378,7 @@ impl SkyView for Bruneton4dView<'_> {
                 let offset = start.offset_m(self.observer);
                 let shifted = intervals.iter().map(|&(a, b)| (a - offset, b - offset));
                 let length = self.boundary_distance(&ray);
-                self.shafted_radiance(&ray, shifted, None, 0.0, length, true, &[], 1.0, radiance)
-            }
-            Shadow::Clouded { single, multiple } => {
-                let offset = start.offset_m(self.observer);
-                let shifted = single.iter().map(|&(a, b)| (a - offset, b - offset));
-                let length = self.boundary_distance(&ray);
-                self.shafted_radiance(
-                    &ray,
-                    shifted,
-                    Some(multiple),
-                    offset,
-                    length,
-                    true,
-                    &[],
-                    1.0,
-                    radiance,
-                )
+                self.shafted_radiance(&ray, shifted, length, true, &[], 1.0, radiance)
             }
             _ => self.lit_radiance(
                 &ray,
@@ -471,22 +448,7 @@ impl SkyView for Bruneton4dView<'_> {
             Shadow::Lit(intervals) => {
                 let offset = start.offset_m(self.observer);
                 let shifted = intervals.iter().map(|&(a, b)| (a - offset, b - offset));
-                self.shafted_radiance(&ray, shifted, None, 0.0, d_total, false, t, fade, radiance)
-            }
-            Shadow::Clouded { single, multiple } => {
-                let offset = start.offset_m(self.observer);
-                let shifted = single.iter().map(|&(a, b)| (a - offset, b - offset));
-                self.shafted_radiance(
-                    &ray,
-                    shifted,
-                    Some(multiple),
-                    offset,
-                    d_total,
-                    false,
-                    t,
-                    fade,
-                    radiance,
-                )
+                self.shafted_radiance(&ray, shifted, d_total, false, t, fade, radiance)
             }
         }
     }

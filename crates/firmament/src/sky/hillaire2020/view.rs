@@ -230,15 +230,6 @@ impl SkyView for Hillaire2020View<'_> {
                 };
                 self.march(&start, dir, None, &lighting, radiance)
             }
-            (Shadow::Clouded { single, multiple }, _) => {
-                let offset = start.offset_m(self.observer);
-                let mut buffer_m = Vec::new();
-                let lighting = Lighting {
-                    single: Lit::Intervals(shifted(single, offset, &mut buffer)),
-                    multiple: Lit::Intervals(shifted(multiple, offset, &mut buffer_m)),
-                };
-                self.march(&start, dir, None, &lighting, radiance)
-            }
         }
     }
 
@@ -269,7 +260,6 @@ impl SkyView for Hillaire2020View<'_> {
             .lookup
             .transmittance(start.r, mu, d, ground, &mut transmittance[..n]);
         let mut buffer = Vec::new();
-        let mut buffer_m = Vec::new();
         let lit_length;
         let lighting = match shadow {
             Shadow::None => Lighting::ALL,
@@ -289,13 +279,6 @@ impl SkyView for Hillaire2020View<'_> {
                 )),
                 multiple: Lit::All,
             },
-            Shadow::Clouded { single, multiple } => {
-                let offset = start.offset_m(self.observer);
-                Lighting {
-                    single: Lit::Intervals(shifted(single, offset, &mut buffer)),
-                    multiple: Lit::Intervals(shifted(multiple, offset, &mut buffer_m)),
-                }
-            }
         };
         self.march(&start, dir, Some(d), &lighting, radiance);
     }
