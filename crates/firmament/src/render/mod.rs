@@ -383,10 +383,6 @@ impl<'s> Shader<'s> {
             return (Shadow::None, true);
         }
         scratch.lit.clear();
-        if scratch.clouded.is_empty() {
-            lit_intervals(&mut scratch.shadowed, end, &mut scratch.lit);
-            return (Shadow::Lit(&scratch.lit), lit_at_end);
-        }
         scratch.shadowed.extend_from_slice(&scratch.clouded);
         lit_intervals(&mut scratch.shadowed, end, &mut scratch.lit);
         (Shadow::Lit(&scratch.lit), lit_at_end)
