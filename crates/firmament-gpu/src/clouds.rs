@@ -24,6 +24,7 @@ use firmament::scene::clouds::{CloudKind, CloudMedium};
 use firmament::scene::Light;
 use firmament::scene::Volume;
 
+use crate::bruneton4d::atmosphere::{groups, GROUP};
 use crate::device::{check_buffers, scoped};
 use crate::passes::init;
 use crate::render::frame::MAX_LIGHTS;
@@ -204,13 +205,30 @@ impl GpuClouds {
             layer_words.extend(words);
         }
         layer_words.resize(MAX_CLOUD_LAYERS * LAYER_WORDS, 0);
-        // The shadow maps, from the CPU's shader.
+        // The shadow maps, from the CPU's shader: per light the texels, the coarse map's
+        // blocks and the shadowed air's weights (channel groups of 4 per texel, padded
+        // with 1), one after another from shadow_at[light].
         let mut shadow_at = [NONE; MAX_LIGHTS];
         let mut shadow_base_m = 0.0;
-        for (j, map) in shader.cloud_shadows().iter().enumerate().take(MAX_LIGHTS) {
-            if let Some(map) = map {
+        let maps = shader.cloud_shadows().iter().zip(shader.shadowed_air());
+        for (j, (map, air)) in maps.enumerate().take(MAX_LIGHTS) {
+            if let (Some(map), Some(air)) = (map, air) {
                 shadow_at[j] = data.len() as u32;
                 data.extend_from_slice(map.texels());
+                data.extend_from_slice(map.coarse_texels());
+                let n = air.channels();
+                let padded = GROUP * groups(sky.channels);
+                if n != sky.channels {
+                    return Err(invalid(
+                        "shader",
+                        format!("a CPU shader of {n} channels"),
+                        format!("the tables' {} channels", sky.channels),
+                    ));
+                }
+                for texel in air.texels().chunks(n) {
+                    data.extend_from_slice(texel);
+                    data.extend(std::iter::repeat_n(1.0, padded - n));
+                }
                 shadow_base_m = map.base_radius_m() - planet;
             }
         }

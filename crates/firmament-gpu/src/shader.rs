@@ -139,7 +139,7 @@ pub const RENDER: [Module; 7] = [
 
 /// The clouds' modules (after [`RENDER`]): their types, noise, weather, layers, two-stream
 /// tables and medium, the shadow map, the march and the frame under them.
-pub const CLOUDS: [Module; 9] = [
+pub const CLOUDS: [Module; 10] = [
     module!("clouds/profile.wgsl"),
     module!("clouds/noise_volume.wgsl"),
     module!("clouds/weather.wgsl"),
@@ -147,6 +147,7 @@ pub const CLOUDS: [Module; 9] = [
     module!("clouds/two_stream.wgsl"),
     module!("clouds/medium.wgsl"),
     module!("render/cloud_shadow.wgsl"),
+    module!("render/shadowed_air.wgsl"),
     module!("render/volumes.wgsl"),
     module!("render/cloud_frame.wgsl"),
 ];
@@ -304,7 +305,7 @@ pub fn prelude() -> String {
 /// The clouds' constants (scene::clouds, render::volumes, render::cloud_shadow).
 fn clouds_prelude() -> String {
     use crate::clouds as gc;
-    use firmament::render::{cloud_shadow as cs, volumes as rv};
+    use firmament::render::{cloud_shadow as cs, shadowed_air as sa, volumes as rv};
     use firmament::scene::clouds::{layer, medium, two_stream as ts};
     let mut s = String::from("// Clouds (firmament_gpu::clouds).\n");
     for (name, v) in [
@@ -321,6 +322,8 @@ fn clouds_prelude() -> String {
         ("DETAILED_LIGHT_SAMPLES", medium::DETAILED_LIGHT_SAMPLES),
         ("AMBIENT_SAMPLES", medium::AMBIENT_SAMPLES),
         ("SHADOW_TEXELS", cs::TEXELS),
+        ("COARSE_TEXELS", cs::COARSE_TEXELS),
+        ("AIR_TEXELS", sa::AIR_TEXELS),
         ("EMPTY_BEFORE_LEAP", rv::EMPTY_BEFORE_LEAP),
         ("MAX_OCTAVES", rv::MAX_OCTAVES),
         ("CACHED_LIGHTS", rv::CACHED_LIGHTS),

@@ -1,5 +1,5 @@
-//! Clouds: the closed forms they must meet (Beer–Lambert through a uniform slab, the
-//! energy-conserving step, the octaves' albedo), the refusal of bad settings with the field
+//! Clouds: the closed forms they must meet (Beer–Lambert through a uniform slab, the dark
+//! air under a black deck, the energy-conserving step, the octaves' albedo), the refusal of bad settings with the field
 //! named, and the renderer's fast path against the reference path tracer through a thin
 //! uniform slab.
 
@@ -11,6 +11,7 @@ use firmament::math::sphere::ray_sphere;
 use firmament::math::Vec3;
 use firmament::reference::{self, ReferenceSettings};
 use firmament::render::volumes::step_integral;
+use firmament::render::{ShadeScratch, Shader};
 use firmament::scene::clouds::{
     cloud_media, CloudKind, CloudLayerConfig, CloudMedium, CloudNoise, MultipleScattering,
 };
@@ -45,7 +46,9 @@ fn a_uniform_slab_transmits_by_beer_lambert() {
     // towards the sun, e^{−0.4/cos 40°} = 0.59, is above the shadow map's ½).
     let sigma = 0.0004;
     let medium = &media(slab(sigma, 0.0))[0];
-    let origin = Vec3::new(0.0, 0.0, radius + 2.0);
+    // From inside the slab, above its base: these rays up meet no air below the base, whose
+    // multiple scattering the slab dims (render::shadowed_air: its own test below).
+    let origin = Vec3::new(0.0, 0.0, radius + 1200.0);
     let sun = sun_direction(40.0, 180.0);
     let mut with = Scene::clear_sky(sky, sun, false);
     with.volumes.push(Box::new(medium));
@@ -55,7 +58,7 @@ fn a_uniform_slab_transmits_by_beer_lambert() {
         let dir = Vec3::new(z.sin(), 0.0, z.cos());
         let ray = Ray { origin, dir };
         // The chord through the shell from the spheres, and τ = σ·chord.
-        let (_, enter) = ray_sphere(origin, dir, radius + 1000.0).unwrap();
+        let enter = 0.0;
         let (_, leave) = ray_sphere(origin, dir, radius + 2000.0).unwrap();
         let tau = sigma * (leave - enter);
         let got = medium.optical_depth(&ray, 0.0, f64::INFINITY, 0);
@@ -84,6 +87,48 @@ fn a_uniform_slab_transmits_by_beer_lambert() {
                 l_with[k]
             );
         }
+    }
+}
+
+/// Under an opaque, black deck covering the sky (τ 50, albedo 0) nothing lights the air
+/// below it: no beam (its single scattering, the shadow), no sky and no ground (its
+/// multiple scattering, render::shadowed_air's weights), so every ray from the ground is
+/// dark, the horizon's too, where the ray stays under the deck for a hundred kilometres.
+/// With the clear sky's multiple scattering kept there the zenith read 7.7 % of the clear sky.
+#[test]
+fn the_air_under_a_black_deck_is_dark() {
+    let sky = sky();
+    let medium = &media(slab(0.05, 0.0))[0];
+    let origin = Vec3::new(0.0, 0.0, sky.model.bottom_radius_m + 2.0);
+    let sun = sun_direction(40.0, 180.0);
+    let mut deck = Scene::clear_sky(sky, sun, false);
+    deck.volumes.push(Box::new(medium));
+    let clear = Scene::clear_sky(sky, sun, false);
+    let (under, open) = (
+        Shader::new(&deck, origin).unwrap(),
+        Shader::new(&clear, origin).unwrap(),
+    );
+    let colour = sky.model.colour_matrix();
+    let mut scratch = ShadeScratch::default();
+    for zenith_deg in [0.0f64, 45.0, 80.0, 88.0, 89.5, 120.0] {
+        let z = zenith_deg.to_radians();
+        let ray = Ray {
+            origin,
+            dir: Vec3::new(z.sin(), 0.0, z.cos()),
+        };
+        let (mut l_under, mut l_open) = ([0.0; 3], [0.0; 3]);
+        under.shade(&ray, &mut scratch, &mut l_under);
+        open.shade(&ray, &mut scratch, &mut l_open);
+        let ratio = colour.to_xyz(&l_under)[1] / colour.to_xyz(&l_open)[1];
+        println!(
+            "view zenith {zenith_deg}°: {:.2} % of the clear sky's luminance",
+            100.0 * ratio
+        );
+        assert!(
+            ratio < 0.01,
+            "view zenith {zenith_deg}°: {:.2} % of the clear sky",
+            100.0 * ratio
+        );
     }
 }
 

@@ -2,55 +2,108 @@
 // no terrain): the planet's ground lit by each light under the clouds (their shadow map,
 // their diffuse light and the ground–cloud interreflection: render/volumes.wgsl), the sky
 // and the lights' disks, the air's light (its single scattering over the stretches of the
-// ray outside the clouds' shadow, its multiple over the whole ray), and the clouds in front
-// composited at their mean depth, their own aerial perspective under the same shadows.
+// ray outside the clouds' shadow, its multiple over the whole ray, dimmed below the clouds),
+// and the clouds in front composited at their mean depth, their own aerial perspective under
+// the same shadows.
 
-// The air's light along `pray` up to end_m (Shadow::Lit, as the CPU's renderer gives it
-// under clouds): the multiple scattering over the whole ray (the sky still lights the air in
-// a cloud's shadow; `endp` is the ray's end piece) and the single scattering over the
-// stretches outside the shadowed ones (the complement of `list` in [0, end_m],
-// scene::lit_intervals), per channel group into acc (before the light's scale). `pray` ends
-// at end_m (or is open towards the sky).
-fn clouded_air(v: View, vl: ViewLight, pray: PointRay, list: ptr<function, ShadowList>, end_m: f32, endp: Piece, acc: ptr<function, array<vec4<f32>, MAX_CHANNEL_GROUPS>>) {
+// The air's light along `pray` (from local `q` along `dir`) up to end_m for light l
+// (Shadow::Lit, as the CPU's renderer gives it under clouds), per channel group into acc
+// (before the light's scale), and the air's transmittance to the end into t_end: the
+// multiple scattering over the whole ray, the single over the stretches outside the
+// shadowed ones of `list` (scene::lit_intervals), and below the clouds' base only w of the
+// multiple (render/shadowed_air.wgsl, over the CPU's ShadowedAir::weigh stretches: the
+// shadow's boundaries cut the air below the base). One walk over the boundaries looks up
+// the sky method's piece at each from one call site, and carries what the next stretch
+// needs of it per channel group in arrays, not the piece itself: the driver inlines every
+// call whole, and a large value carried around a loop slows LLVM's compile about twofold.
+// `pray` ends at end_m (or is open towards the sky).
+fn clouded_air(v: View, vl: ViewLight, l: u32, pray: PointRay, q: vec3<f32>, dir: vec3<f32>, list: ptr<function, ShadowList>, end_m: f32, t_end: ptr<function, array<vec4<f32>, MAX_CHANNEL_GROUPS>>, acc: ptr<function, array<vec4<f32>, MAX_CHANNEL_GROUPS>>) {
     for (var k = 0u; k < atm.groups; k++) {
         (*acc)[k] = vec4<f32>(0.0);
+        (*t_end)[k] = vec4<f32>(1.0);
     }
     if (!pray.in_atmosphere) {
         return;
     }
-    let start = piece_at(v, pray, vl, 0.0, false);
-    for (var k = 0u; k < atm.groups; k++) {
-        (*acc)[k] = whole_multiple(pray, start, endp, k);
-    }
     let offset_km = pray.s.offset_km;
-    var lit_from = 0.0;
-    for (var i = 0u; i <= (*list).n; i++) {
-        var a = lit_from;
-        var b = end_m;
-        if (i < (*list).n) {
-            b = min((*list).s[i].x, end_m);
-            lit_from = max(lit_from, (*list).s[i].y);
-        }
-        if (b <= a) {
-            if (lit_from >= end_m) {
-                break;
+    let n = (*list).n;
+    let below = air_below(l, q, dir, end_m);
+    // At the previous boundary, per channel group: single Rayleigh and Mie and the multiple
+    // scattering, each times T(0, x); the multiple at the start.
+    var prev_rayleigh: array<vec4<f32>, MAX_CHANNEL_GROUPS>;
+    var prev_mie: array<vec4<f32>, MAX_CHANNEL_GROUPS>;
+    var prev_multiple: array<vec4<f32>, MAX_CHANNEL_GROUPS>;
+    var start_multiple: array<vec4<f32>, MAX_CHANNEL_GROUPS>;
+    var i = 0u;
+    var t = 0.0;
+    var t_prev = 0.0;
+    // At most the start, two boundaries per shadowed stretch, the two of the stretch below
+    // the base and the end.
+    for (var step = 0u; step < 2u * MAX_SHADOWED + 8u; step++) {
+        let x_km = clamp(t * 1e-3 - offset_km, 0.0, pray.end_km);
+        let p = piece_at(v, pray, vl, x_km, true);
+        // The stretch [t_prev, t]: in the list's stretch i or before it.
+        let shadowed = i < n && t_prev >= (*list).s[i].x;
+        let dimmed = below.x < below.y && t_prev >= below.x && t <= below.y;
+        let b_subtracts = x_km < pray.end_km || !pray.open_end;
+        let x = q + (0.5 * (t_prev + t)) * dir;
+        let at_end = t >= end_m;
+        for (var k = 0u; k < atm.groups; k++) {
+            let c = piece_single(v, p, k);
+            let m = piece_multiple(p, k);
+            if (step == 0u) {
+                start_multiple[k] = m;
+            } else {
+                if (!shadowed) {
+                    // Bruneton4dView::lit_radiance's single scattering over the stretch.
+                    var r = prev_rayleigh[k];
+                    var mie = prev_mie[k];
+                    if (b_subtracts) {
+                        r = max(r - c.scattering, vec4<f32>(0.0));
+                        mie = max(mie - c.mie, vec4<f32>(0.0));
+                    }
+                    (*acc)[k] += r * pray.pr + mie * pray.fade * pray.pm;
+                }
+                if (dimmed) {
+                    let kept = air_weight(l, x, k);
+                    (*acc)[k] -= (1.0 - kept) * max(prev_multiple[k] - m, vec4<f32>(0.0));
+                }
             }
-            continue;
-        }
-        let a_km = max(a * 1e-3 - offset_km, 0.0);
-        let b_km = min(b * 1e-3 - offset_km, pray.end_km);
-        if (b_km > a_km) {
-            let at_end = b_km >= pray.end_km;
-            let pa = piece_at(v, pray, vl, a_km, true);
-            let pb = piece_at(v, pray, vl, b_km, true);
-            let b_subtracts = !at_end || !pray.open_end;
-            for (var k = 0u; k < atm.groups; k++) {
-                (*acc)[k] += lit_single(v, pray, pa, pb, b_subtracts, k);
+            prev_rayleigh[k] = c.scattering;
+            prev_mie[k] = c.mie;
+            prev_multiple[k] = m;
+            if (at_end) {
+                (*t_end)[k] = piece_transmittance(p, k);
             }
         }
-        if (lit_from >= end_m) {
+        if (step > 0u && i < n && t >= (*list).s[i].y) {
+            i++;
+        }
+        if (at_end) {
             break;
         }
+        // The next boundary: the list's, the stretch below the base's, or the end.
+        var next = end_m;
+        if (i < n) {
+            next = min(next, select((*list).s[i].y, (*list).s[i].x, t < (*list).s[i].x));
+        }
+        if (below.x < below.y) {
+            if (t < below.x) {
+                next = min(next, below.x);
+            } else if (t < below.y) {
+                next = min(next, below.y);
+            }
+        }
+        t_prev = t;
+        t = max(next, t);
+    }
+    // The multiple scattering over the whole ray (Bruneton4dView::shafted_radiance).
+    for (var k = 0u; k < atm.groups; k++) {
+        var whole = start_multiple[k];
+        if (!pray.open_end) {
+            whole = max(whole - prev_multiple[k], vec4<f32>(0.0));
+        }
+        (*acc)[k] = max((*acc)[k] + whole, vec4<f32>(0.0));
     }
 }
 
@@ -89,16 +142,13 @@ fn shade_clouds(dir: vec3<f32>) -> vec3<f32> {
             let span_m = select(end_m, m.depth_m, to_cloud);
             let d_km = select(select(-1.0, end_m * 1e-3, hit), m.depth_m * 1e-3, to_cloud);
             let pray = point_ray(o, vl, dir, d_km);
-            var endp: Piece;
-            if (pray.in_atmosphere) {
-                endp = piece_at(v, pray, vl, pray.end_km, false);
-            }
-            clouded_air(v, vl, pray, &list, span_m, endp, &acc);
+            var t_end: array<vec4<f32>, MAX_CHANNEL_GROUPS>;
+            clouded_air(v, vl, light, pray, q, dir, &list, span_m, &t_end, &acc);
             if (to_cloud) {
                 for (var k = 0u; k < atm.groups; k++) {
                     front += to_srgb(acc[k] * light_scale(light, k), k);
                     if (light == 0u) {
-                        seen += to_srgb(point_transmittance(pray, endp, k) * l_vol[k], k);
+                        seen += to_srgb(t_end[k] * l_vol[k], k);
                     }
                 }
                 continue;
@@ -113,7 +163,7 @@ fn shade_clouds(dir: vec3<f32>) -> vec3<f32> {
                     s.sky = e.sky * scale;
                     let t_air = sample_transmittance(g.to_light, k) * g.fraction;
                     s = dim_surface_light(light, x, up, vl.direction, k, t_air, s);
-                    let t = point_transmittance(pray, endp, k);
+                    let t = t_end[k];
                     let l = acc[k] * scale + ground_albedo(k) / PI * (s.direct + s.sky) * t;
                     rgb += to_srgb(l, k);
                 }

@@ -12,6 +12,26 @@ struct ShadowList {
     s: array<vec2<f32>, MAX_SHADOWED>,
 }
 
+// CloudShadow::entry_texel: where the ray from local `x` along `dir` enters the base sphere,
+// in texels of a map of `size` per side (fractional, centred; z < 0: x lies at or above the
+// base, or the ray does not reach it).
+fn map_entry(x: vec3<f32>, dir: vec3<f32>, size: u32) -> vec3<f32> {
+    if (cloud_point(x).alt_m >= clouds.shadow_base_m) {
+        return vec3<f32>(0.0, 0.0, -1.0);
+    }
+    let far = shell_sphere(x, dir, clouds.shadow_base_m).y;
+    if (far <= 0.0) {
+        return vec3<f32>(0.0, 0.0, -1.0);
+    }
+    let e = x + far * dir;
+    let ez = clouds.planet_radius_m + e.z;
+    if (ez <= 0.0) {
+        return vec3<f32>(0.0, 0.0, -1.0);
+    }
+    let step = 2.0 * SHADOW_HALF_EXTENT_M / f32(size);
+    return vec3<f32>((e.xy * (clouds.planet_radius_m / ez) + SHADOW_HALF_EXTENT_M) / step - 0.5, 1.0);
+}
+
 // CloudShadow::optical_depth: the layers' depth from local `x` towards light `l` (< 0: the
 // map does not cover the point, or it lies at or above the base).
 fn map_optical_depth(l: u32, x: vec3<f32>, dir: vec3<f32>) -> f32 {
@@ -19,28 +39,34 @@ fn map_optical_depth(l: u32, x: vec3<f32>, dir: vec3<f32>) -> f32 {
     if (at == NONE) {
         return -1.0;
     }
-    if (cloud_point(x).alt_m >= clouds.shadow_base_m) {
-        return -1.0;
-    }
-    let far = shell_sphere(x, dir, clouds.shadow_base_m).y;
-    if (far <= 0.0) {
-        return -1.0;
-    }
-    let e = x + far * dir;
-    let ez = clouds.planet_radius_m + e.z;
-    if (ez <= 0.0) {
-        return -1.0;
-    }
-    let step = 2.0 * SHADOW_HALF_EXTENT_M / f32(SHADOW_TEXELS);
-    let f = (e.xy * (clouds.planet_radius_m / ez) + SHADOW_HALF_EXTENT_M) / step - 0.5;
+    let e = map_entry(x, dir, SHADOW_TEXELS);
+    let f = e.xy;
     let max_f = f32(SHADOW_TEXELS - 1u);
-    if (f.x < 0.0 || f.y < 0.0 || f.x >= max_f || f.y >= max_f) {
+    if (e.z < 0.0 || f.x < 0.0 || f.y < 0.0 || f.x >= max_f || f.y >= max_f) {
         return -1.0;
     }
     let i = vec2<u32>(f);
     let t = f - vec2<f32>(i);
     let row0 = at + i.y * SHADOW_TEXELS + i.x;
     let row1 = row0 + SHADOW_TEXELS;
+    let lo = mix(cloud_data[row0], cloud_data[row0 + 1u], t.x);
+    let hi = mix(cloud_data[row1], cloud_data[row1 + 1u], t.x);
+    return mix(lo, hi, t.y);
+}
+
+// CloudShadow::mean_transmittance: the coarse map's mean transmittance towards light `l` of
+// the block local `x`'s ray enters (beyond the map, its edge; < 0: x lies at or above the
+// base).
+fn map_mean_transmittance(l: u32, x: vec3<f32>, dir: vec3<f32>) -> f32 {
+    let e = map_entry(x, dir, COARSE_TEXELS);
+    if (e.z < 0.0) {
+        return -1.0;
+    }
+    let f = clamp(e.xy, vec2<f32>(0.0), vec2<f32>(f32(COARSE_TEXELS - 1u)));
+    let i = min(vec2<u32>(f), vec2<u32>(COARSE_TEXELS - 2u));
+    let t = f - vec2<f32>(i);
+    let row0 = clouds.shadow_at[l] + SHADOW_TEXELS * SHADOW_TEXELS + i.y * COARSE_TEXELS + i.x;
+    let row1 = row0 + COARSE_TEXELS;
     let lo = mix(cloud_data[row0], cloud_data[row0 + 1u], t.x);
     let hi = mix(cloud_data[row1], cloud_data[row1 + 1u], t.x);
     return mix(lo, hi, t.y);
@@ -59,7 +85,8 @@ fn push_shadowed(list: ptr<function, ShadowList>, a: f32, b: f32) {
 }
 
 // CloudShadow::shadowed_intervals: the stretches of the ray from local `q` along `dir`
-// before `end_m` (and below the base) in light l's shadow, sampled every max(250 m, t/50).
+// before `end_m` (and below the base) in light l's shadow, sampled every max(250 m, t/50):
+// by the map's texels to SHADOW_MAX_DISTANCE_M, by the coarse map's mean beyond.
 fn shadowed_intervals(l: u32, light_dir: vec3<f32>, q: vec3<f32>, dir: vec3<f32>, end_m: f32) -> ShadowList {
     var list: ShadowList;
     list.n = 0u;
@@ -70,7 +97,7 @@ fn shadowed_intervals(l: u32, light_dir: vec3<f32>, q: vec3<f32>, dir: vec3<f32>
     if (far.x > far.y || far.y <= 0.0) {
         return list;
     }
-    let limit = min(min(far.y, end_m), SHADOW_MAX_DISTANCE_M);
+    let limit = min(far.y, end_m);
     var t = 0.0;
     var start = -1.0;
     loop {
@@ -79,8 +106,15 @@ fn shadowed_intervals(l: u32, light_dir: vec3<f32>, q: vec3<f32>, dir: vec3<f32>
         }
         let dt = max(0.02 * t, 250.0);
         let mid = min(t + 0.5 * dt, limit);
-        let tau = map_optical_depth(l, q + mid * dir, light_dir);
-        let shadowed = tau >= 0.0 && exp(-tau) < SHADOW_TRANSMITTANCE;
+        let x = q + mid * dir;
+        var shadowed: bool;
+        if (mid <= SHADOW_MAX_DISTANCE_M) {
+            let tau = map_optical_depth(l, x, light_dir);
+            shadowed = tau >= 0.0 && exp(-tau) < SHADOW_TRANSMITTANCE;
+        } else {
+            let mean = map_mean_transmittance(l, x, light_dir);
+            shadowed = mean >= 0.0 && mean < SHADOW_TRANSMITTANCE;
+        }
         if (shadowed && start < 0.0) {
             start = t;
         } else if (!shadowed && start >= 0.0) {

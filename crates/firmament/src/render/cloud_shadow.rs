@@ -9,7 +9,8 @@
 //!
 //! The map covers [`HALF_EXTENT_M`] around the observer's place in the layers' planar
 //! coordinates (the gnomonic projection of the +z cube face, as the clouds' weather);
-//! beyond it, and for points at or above the base, the caller marches towards the light.
+//! beyond it, and for points at or above the base, the caller marches towards the light
+//! (the air's shadow far along a view ray takes a coarse map's mean, which extends beyond).
 
 use rayon::prelude::*;
 
@@ -28,9 +29,14 @@ pub const SHADOW_TRANSMITTANCE: f64 = 0.5;
 /// Shadowed stretches closer than this (m) are merged, so that a ray across a field of
 /// cumulus asks the sky method for a few intervals rather than many.
 pub const MERGE_GAP_M: f64 = 800.0;
-/// The farthest along a view ray the air's shadow is looked for (m): beyond, the steps
-/// would alias the cumulus' shadows into streaks, and the air is taken as lit.
+/// The farthest along a view ray the air's shadow is looked for in the map's texels (m):
+/// beyond, the steps would alias the cumulus' shadows into streaks, and the air is in
+/// shadow where the mean transmittance of the light over [`COARSE_TEXELS`]² blocks is below
+/// [`SHADOW_TRANSMITTANCE`] (under an overcast; not under a broken field), the blocks at the
+/// map's edge standing for the clouds beyond it.
 pub const MAX_SHADOW_DISTANCE_M: f64 = 30_000.0;
+/// Blocks per side of the coarse map (of `TEXELS / COARSE_TEXELS` texels each).
+pub const COARSE_TEXELS: usize = 64;
 
 /// The volumes' optical depth towards one light over their base sphere.
 pub struct CloudShadow {
@@ -42,6 +48,8 @@ pub struct CloudShadow {
     planet_radius_m: f64,
     /// τ per texel, row-major from (−HALF, −HALF).
     tau: Vec<f32>,
+    /// The mean transmittance e^{−τ} per block of the coarse map, row-major.
+    coarse: Vec<f32>,
 }
 
 impl CloudShadow {
@@ -76,11 +84,25 @@ impl CloudShadow {
                     .sum::<f64>() as f32;
             }
         });
+        let block = TEXELS / COARSE_TEXELS;
+        let coarse = (0..COARSE_TEXELS * COARSE_TEXELS)
+            .map(|b| {
+                let (bi, bj) = (b % COARSE_TEXELS, b / COARSE_TEXELS);
+                let sum: f64 = (0..block * block)
+                    .map(|t| {
+                        let (i, j) = (bi * block + t % block, bj * block + t / block);
+                        (-(tau[j * TEXELS + i] as f64)).exp()
+                    })
+                    .sum();
+                (sum / (block * block) as f64) as f32
+            })
+            .collect();
         Some(CloudShadow {
             light,
             base_radius_m: base,
             planet_radius_m: planet,
             tau,
+            coarse,
         })
     }
 
@@ -94,9 +116,14 @@ impl CloudShadow {
         &self.tau
     }
 
-    /// The volumes' optical depth from `x` towards the light, when `x` lies below the base
-    /// sphere and its ray enters the sphere inside the map.
-    pub fn optical_depth(&self, x: Vec3) -> Option<f64> {
+    /// The mean transmittance per block, [`COARSE_TEXELS`]² row-major.
+    pub fn coarse_texels(&self) -> &[f32] {
+        &self.coarse
+    }
+
+    /// Where `x`'s ray to the light enters the base sphere, in map texels of `size` per
+    /// side (fractional, centred), when `x` lies below the sphere.
+    fn entry_texel(&self, x: Vec3, size: usize) -> Option<(f64, f64)> {
         let (_, far) = ray_sphere(x, self.light, self.base_radius_m)?;
         if far <= 0.0 || x.length_squared() >= self.base_radius_m * self.base_radius_m {
             return None;
@@ -106,27 +133,57 @@ impl CloudShadow {
             return None;
         }
         let s = self.planet_radius_m / e.z;
-        let step = 2.0 * HALF_EXTENT_M / TEXELS as f64;
-        let fx = (e.x * s + HALF_EXTENT_M) / step - 0.5;
-        let fy = (e.y * s + HALF_EXTENT_M) / step - 0.5;
+        let step = 2.0 * HALF_EXTENT_M / size as f64;
+        Some((
+            (e.x * s + HALF_EXTENT_M) / step - 0.5,
+            (e.y * s + HALF_EXTENT_M) / step - 0.5,
+        ))
+    }
+
+    /// The mean transmittance towards the light of the block `x`'s ray enters (bilinear
+    /// between blocks; beyond the map, its edge), when `x` lies below the base sphere.
+    pub fn mean_transmittance(&self, x: Vec3) -> Option<f64> {
+        let (fx, fy) = self.entry_texel(x, COARSE_TEXELS)?;
+        let max = (COARSE_TEXELS - 1) as f64;
+        let (fx, fy) = (fx.clamp(0.0, max), fy.clamp(0.0, max));
+        let last = COARSE_TEXELS - 2;
+        let (i, j) = ((fx as usize).min(last), (fy as usize).min(last));
+        Some(bilinear(
+            &self.coarse,
+            COARSE_TEXELS,
+            i,
+            j,
+            fx - i as f64,
+            fy - j as f64,
+        ))
+    }
+
+    /// The volumes' optical depth from `x` towards the light, when `x` lies below the base
+    /// sphere and its ray enters the sphere inside the map.
+    pub fn optical_depth(&self, x: Vec3) -> Option<f64> {
+        let (fx, fy) = self.entry_texel(x, TEXELS)?;
         let max = (TEXELS - 1) as f64;
         if !(0.0..max).contains(&fx) || !(0.0..max).contains(&fy) {
             return None;
         }
         let (i, j) = (fx as usize, fy as usize);
-        let (tx, ty) = (fx - i as f64, fy - j as f64);
-        let at = |i: usize, j: usize| self.tau[j * TEXELS + i] as f64;
-        let lo = at(i, j) + (at(i + 1, j) - at(i, j)) * tx;
-        let hi = at(i, j + 1) + (at(i + 1, j + 1) - at(i, j + 1)) * tx;
-        Some(lo + (hi - lo) * ty)
+        Some(bilinear(
+            &self.tau,
+            TEXELS,
+            i,
+            j,
+            fx - i as f64,
+            fy - j as f64,
+        ))
     }
 
     /// Append the stretches of `ray` before `end` (and below the base) that the map puts
-    /// in shadow to `out`, sampled every max(250 m, t/50).
+    /// in shadow to `out`, sampled every max(250 m, t/50): by the texels to
+    /// [`MAX_SHADOW_DISTANCE_M`], by the blocks' mean beyond.
     pub fn shadowed_intervals(&self, ray: &Ray, end: f64, out: &mut Vec<(f64, f64)>) {
         // Where the ray is below the base sphere.
         let limit = match ray_sphere(ray.origin, ray.dir, self.base_radius_m) {
-            Some((_, far)) if far > 0.0 => far.min(end).min(MAX_SHADOW_DISTANCE_M),
+            Some((_, far)) if far > 0.0 => far.min(end),
             _ => return,
         };
         let first = out.len();
@@ -135,9 +192,13 @@ impl CloudShadow {
         while t < limit {
             let dt = (0.02 * t).max(250.0);
             let mid = (t + 0.5 * dt).min(limit);
-            let shadowed = self
-                .optical_depth(ray.origin + mid * ray.dir)
-                .is_some_and(|tau| (-tau).exp() < SHADOW_TRANSMITTANCE);
+            let x = ray.origin + mid * ray.dir;
+            let shadowed = match mid <= MAX_SHADOW_DISTANCE_M {
+                true => {
+                    (self.optical_depth(x)).is_some_and(|tau| (-tau).exp() < SHADOW_TRANSMITTANCE)
+                }
+                false => (self.mean_transmittance(x)).is_some_and(|t| t < SHADOW_TRANSMITTANCE),
+            };
             match (shadowed, start) {
                 (true, None) => start = Some(t),
                 (false, Some(s)) => {
@@ -153,6 +214,14 @@ impl CloudShadow {
         }
         merge_close(out, first, MERGE_GAP_M);
     }
+}
+
+/// Bilinear interpolation in a row-major grid of `size` per side at texel (i, j) + (tx, ty).
+fn bilinear(grid: &[f32], size: usize, i: usize, j: usize, tx: f64, ty: f64) -> f64 {
+    let at = |i: usize, j: usize| grid[j * size + i] as f64;
+    let lo = at(i, j) + (at(i + 1, j) - at(i, j)) * tx;
+    let hi = at(i, j + 1) + (at(i + 1, j + 1) - at(i, j + 1)) * tx;
+    lo + (hi - lo) * ty
 }
 
 /// Merge the intervals of `out[first..]` (increasing) whose gaps are under `gap`.

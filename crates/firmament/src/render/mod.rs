@@ -13,6 +13,7 @@ pub mod cloud_shadow;
 pub mod cube_layout;
 pub mod disk_edges;
 pub mod frame;
+pub mod shadowed_air;
 pub mod sky_dome;
 pub mod stars;
 pub mod terrain_air;
@@ -90,6 +91,9 @@ pub struct Shader<'s> {
     /// The volumes' shadow below them per light ([`cloud_shadow`]), when a volume is a
     /// shell around the planet.
     cloud_shadows: Vec<Option<cloud_shadow::CloudShadow>>,
+    /// The share of the multiple scattering the air under the clouds keeps per light
+    /// ([`shadowed_air`]), where the light has a shadow map.
+    shadowed_air: Vec<Option<shadowed_air::ShadowedAir>>,
 }
 
 /// Per-thread scratch space of [`Shader::shade`] (no allocation per pixel).
@@ -99,6 +103,8 @@ pub struct ShadeScratch {
     lit: Vec<(f64, f64)>,
     /// The clouds' shadows along the ray.
     clouded: Vec<(f64, f64)>,
+    /// The stretches under the clouds with the share of the multiple scattering they keep.
+    dimmed: shadowed_air::Dimmed,
 }
 
 impl<'s> Shader<'s> {
@@ -127,6 +133,12 @@ impl<'s> Shader<'s> {
     /// frame of the same scene samples (`firmament_gpu`).
     pub fn cloud_shadows(&self) -> &[Option<cloud_shadow::CloudShadow>] {
         &self.cloud_shadows
+    }
+
+    /// The share of the multiple scattering the air under the clouds keeps per light (None
+    /// for a light without a shadow map), what a GPU frame of the same scene samples.
+    pub fn shadowed_air(&self) -> &[Option<shadowed_air::ShadowedAir>] {
+        &self.shadowed_air
     }
 
     /// The sky domes, one per light, when the shader has them ([`Shader::with_sky_domes`]).
@@ -209,7 +221,7 @@ impl<'s> Shader<'s> {
     ) -> Result<Shader<'s>> {
         let channels = scene.sky.model().channels();
         crate::spectrum::check_channels(channels, "rendering")?;
-        let views = scene
+        let views: Vec<Box<dyn SkyView + 's>> = scene
             .lights
             .iter()
             .map(|light| match probe {
@@ -221,6 +233,18 @@ impl<'s> Shader<'s> {
             .filter(|(_, light)| light.visible_disk)
             .map(|(i, light)| (i, light.angular_radius_rad.cos()))
             .collect();
+        let cloud_shadows: Vec<_> = match probe || scene.volumes.is_empty() {
+            true => Vec::new(),
+            false => (scene.lights.iter())
+                .map(|l| cloud_shadow::CloudShadow::new(scene, l.direction))
+                .collect(),
+        };
+        let shadowed_air = (cloud_shadows.iter().zip(views.iter()))
+            .map(|(map, view)| {
+                let map: &cloud_shadow::CloudShadow = map.as_ref()?;
+                Some(shadowed_air::ShadowedAir::new(scene, view.as_ref(), map))
+            })
+            .collect();
         Ok(Shader {
             scene,
             views,
@@ -229,12 +253,8 @@ impl<'s> Shader<'s> {
             air: None,
             domes: None,
             aerial: Vec::new(),
-            cloud_shadows: match probe || scene.volumes.is_empty() {
-                true => Vec::new(),
-                false => (scene.lights.iter())
-                    .map(|l| cloud_shadow::CloudShadow::new(scene, l.direction))
-                    .collect(),
-            },
+            cloud_shadows,
+            shadowed_air,
         })
     }
 
@@ -263,9 +283,9 @@ impl<'s> Shader<'s> {
                 };
                 let up = hit.position.normalize();
                 for (j, view) in self.views.iter().enumerate() {
-                    let (shadow, lit_at_end) = self.shadow(ray, j, end, scratch);
+                    let (shadow, lit_at_end, dimmed) = self.shadow(ray, j, end, scratch);
                     if keep {
-                        shadows.push(shadow_owned(shadow));
+                        shadows.push(volumes::OwnedShadow::new(shadow, dimmed));
                     }
                     view.sun_and_sky_irradiance(hit.position, hit.normal, direct, sky);
                     if !lit_at_end {
@@ -302,6 +322,7 @@ impl<'s> Shader<'s> {
                     if !from_volume {
                         view.sky_radiance_to_point(hit.position, shadow, l, t);
                     }
+                    shadowed_air::dim_multiple(view.as_ref(), ray, dimmed, end, l);
                     // A specular lobe (the sea's glint) on the direct beam.
                     let to_light = view.light().direction;
                     let glint = scene.surfaces[i].specular(&hit, -ray.dir, to_light);
@@ -317,9 +338,9 @@ impl<'s> Shader<'s> {
                     .any(|&(i, cos)| ray.dir.dot(scene.lights[i].direction) > cos);
                 let background = scene.background.as_ref();
                 for (j, view) in self.views.iter().enumerate() {
-                    let (shadow, _) = self.shadow(ray, j, end, scratch);
+                    let (shadow, _, dimmed) = self.shadow(ray, j, end, scratch);
                     if keep {
-                        shadows.push(shadow_owned(shadow));
+                        shadows.push(volumes::OwnedShadow::new(shadow, dimmed));
                     }
                     // The transmittance along the ray (the same for every light) only for a
                     // disk in view or a background.
@@ -329,6 +350,7 @@ impl<'s> Shader<'s> {
                         &mut [][..]
                     };
                     view.sky_radiance(ray.dir, shadow, l, t);
+                    shadowed_air::dim_multiple(view.as_ref(), ray, dimmed, end, &mut l[..n]);
                     for k in 0..n {
                         out[k] += l[k];
                     }
@@ -358,10 +380,11 @@ impl<'s> Shader<'s> {
 
     /// The parts of `ray` up to `end` that light `j` reaches (past the surfaces and under
     /// the volumes' shadow map), and whether it reaches `end` past the surfaces (the
-    /// volumes' shadow on a surface is [`volumes::dim_surface_light`]'s). In a cloud's
-    /// shadow, as in a mountain's, the air loses its single scattering and keeps its
-    /// multiple: the sky beside the cloud still lights it (broken cloud), and under an
-    /// overcast the cloud's base lights it instead, of the order of the clear sky's light
+    /// volumes' shadow on a surface is [`volumes::dim_surface_light`]'s), and the stretches
+    /// below the clouds whose multiple scattering is dimmed ([`shadowed_air`]). In a cloud's
+    /// shadow, as in a mountain's, the air loses its single scattering; its multiple
+    /// scattering, lit by the sky and the ground around, is the neighbourhood's: under broken
+    /// cloud nearly the clear sky's, under an overcast the dim light of its base
     /// (docs/accuracy.md, "Clouds").
     fn shadow<'b>(
         &self,
@@ -369,9 +392,10 @@ impl<'s> Shader<'s> {
         j: usize,
         end: f64,
         scratch: &'b mut ShadeScratch,
-    ) -> (Shadow<'b>, bool) {
+    ) -> (Shadow<'b>, bool, &'b shadowed_air::Dimmed) {
         scratch.shadowed.clear();
         scratch.clouded.clear();
+        scratch.dimmed.clear();
         let light = &self.scene.lights[j];
         self.scene
             .shadowed_intervals(ray, light.direction, end, &mut scratch.shadowed);
@@ -379,21 +403,17 @@ impl<'s> Shader<'s> {
         if let Some(Some(map)) = self.cloud_shadows.get(j) {
             map.shadowed_intervals(ray, end, &mut scratch.clouded);
         }
+        if let Some(Some(air)) = self.shadowed_air.get(j) {
+            air.weigh(ray, end, &scratch.clouded, &mut scratch.dimmed);
+        }
         if scratch.shadowed.is_empty() && scratch.clouded.is_empty() {
-            return (Shadow::None, true);
+            return (Shadow::None, true, &scratch.dimmed);
         }
         scratch.lit.clear();
         scratch.shadowed.extend_from_slice(&scratch.clouded);
         lit_intervals(&mut scratch.shadowed, end, &mut scratch.lit);
-        (Shadow::Lit(&scratch.lit), lit_at_end)
-    }
-}
-
-/// A shadow's intervals copied out of the scratch that holds them.
-fn shadow_owned(shadow: Shadow) -> volumes::OwnedShadow {
-    match &shadow {
-        Shadow::None | Shadow::Length(_) => volumes::OwnedShadow::None,
-        Shadow::Lit(l) => volumes::OwnedShadow::Lit(l.to_vec()),
+        let scratch: &'b ShadeScratch = scratch;
+        (Shadow::Lit(&scratch.lit), lit_at_end, &scratch.dimmed)
     }
 }
 

@@ -30,6 +30,7 @@
 use std::f64::consts::PI;
 
 use super::cloud_shadow::CloudShadow;
+use super::shadowed_air::{dim_multiple, Dimmed};
 use crate::math::hash::{lowbias32, unit};
 use crate::math::Vec3;
 use crate::scene::{DiffuseLight, Octaves, Ray, Scene};
@@ -86,19 +87,29 @@ pub const CACHED_LIGHTS: usize = 4;
 /// transmittance to the light and irradiances, which vary over kilometres) it reuses.
 pub const AIR_LIGHT_REUSE_M: f64 = 250.0;
 
-/// A [`Shadow`] that owns its intervals.
-pub(super) enum OwnedShadow {
-    /// All lit.
-    None,
-    /// [`Shadow::Lit`].
-    Lit(Vec<(f64, f64)>),
+/// A [`Shadow`] that owns its intervals, with the stretches under the clouds whose multiple
+/// scattering is dimmed ([`super::shadowed_air`]).
+pub(super) struct OwnedShadow {
+    /// [`Shadow::Lit`]'s intervals; None: all lit.
+    lit: Option<Vec<(f64, f64)>>,
+    dimmed: Dimmed,
 }
 
 impl OwnedShadow {
+    pub(super) fn new(shadow: Shadow, dimmed: &Dimmed) -> OwnedShadow {
+        OwnedShadow {
+            lit: match shadow {
+                Shadow::None | Shadow::Length(_) => None,
+                Shadow::Lit(l) => Some(l.to_vec()),
+            },
+            dimmed: dimmed.clone(),
+        }
+    }
+
     fn as_shadow(&self) -> Shadow<'_> {
-        match self {
-            OwnedShadow::None => Shadow::None,
-            OwnedShadow::Lit(l) => Shadow::Lit(l),
+        match &self.lit {
+            None => Shadow::None,
+            Some(l) => Shadow::Lit(l),
         }
     }
 }
@@ -249,6 +260,9 @@ pub(super) fn composite(
     for (j, view) in views.iter().enumerate() {
         let shadow = shadows.get(j).map_or(Shadow::None, |s| s.as_shadow());
         view.sky_radiance_to_point(point, shadow, &mut l[..n], &mut [0.0; MAX_CHANNELS][..n]);
+        if let Some(s) = shadows.get(j) {
+            dim_multiple(view.as_ref(), ray, &s.dimmed, d_mean, &mut l[..n]);
+        }
         for k in 0..n {
             front[k] += l[k];
         }
