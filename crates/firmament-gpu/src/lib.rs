@@ -51,6 +51,7 @@ pub mod passes;
 pub mod render;
 pub mod shader;
 pub mod terrain;
+mod wgsl_prelude;
 
 pub use bruneton4d::{GpuSky, GpuTables, Precomputer};
 pub use clouds::GpuClouds;
