@@ -2,6 +2,7 @@
 //! shipped as embedded presets, validated field by field, and resolved for a wavelength
 //! grid into a [`Model`] that the tables, the renderer and the reference path tracer share.
 
+pub mod density_table;
 pub mod groups;
 mod lift;
 pub mod limits;

@@ -68,7 +68,7 @@ pub(crate) fn compute(
                             nu,
                             length: distance_to_top_atmosphere_boundary(r, d.z, top),
                         };
-                        marcher.march_profile(&ray, profile, &phases, &Lighting::ALL, l, |_, _| {});
+                        marcher.march_profile(&ray, profile, &phases, &Lighting::ALL, l);
                         for k in 0..n {
                             e[k] += l[k] * d.z * weight;
                         }

@@ -9,6 +9,7 @@
 //! Everything is per unit irradiance of the light at the top of the atmosphere, per channel
 //! of the model's wavelength grid: radiance W·m⁻²·sr⁻¹·nm⁻¹ per W·m⁻²·nm⁻¹.
 
+use crate::atmosphere::density_table::{DensityTable, DENSITY_SAMPLES};
 use crate::atmosphere::groups::ScatteringGroups;
 use crate::atmosphere::Model;
 use crate::medium::PhaseFunction;
@@ -16,6 +17,7 @@ use crate::sky::bruneton4d::Lookup;
 use crate::spectrum::with_channel_buffers;
 
 use super::harmonics;
+use super::lanes::{Lane, LightLanes, StepLanes, LANES};
 use super::multiple_scattering::MultipleScattering;
 use super::params::altitude_mu_s_uv;
 
@@ -25,6 +27,8 @@ pub(crate) struct Medium<'a> {
     pub model: &'a Model,
     /// Whether each constituent scatters (absorbers do not).
     scatters: Vec<bool>,
+    /// The constituents' densities by altitude (within 1.3e-5 of the profiles).
+    densities: DensityTable,
 }
 
 impl<'a> Medium<'a> {
@@ -34,7 +38,16 @@ impl<'a> Medium<'a> {
             .iter()
             .map(|c| ScatteringGroups::group_of(c).is_some())
             .collect();
-        Medium { model, scatters }
+        Medium {
+            model,
+            scatters,
+            densities: DensityTable::new(model, DENSITY_SAMPLES),
+        }
+    }
+
+    /// The constituents' densities tabulated by altitude.
+    pub fn density_table(&self) -> &DensityTable {
+        &self.densities
     }
 
     /// At `altitude_m`: the extinction σ_t (m⁻¹) into `sigma_t`, the scattering σ_s (m⁻¹)
@@ -50,9 +63,9 @@ impl<'a> Medium<'a> {
         sigma_t.iter_mut().for_each(|v| *v = 0.0);
         sigma_s.iter_mut().for_each(|v| *v = 0.0);
         let n = sigma_t.len();
+        self.densities.densities(altitude_m, densities);
         for (i, c) in self.model.constituents.iter().enumerate() {
-            let rho = c.density.density(altitude_m);
-            densities[i] = rho;
+            let rho = densities[i];
             if rho <= 0.0 {
                 continue;
             }
@@ -175,11 +188,37 @@ impl Lighting<'_> {
 }
 
 /// The tables a march reads: transmittance (through `lookup`) and the multiple-scattering
-/// field (None: no multiple-scattering term, the multiple-scattering pass itself).
+/// field (None: no multiple-scattering term, the multiple-scattering pass itself), and the
+/// same in f32 lanes for the fully lit marches ([`LightLanes`]; None for a harmonic field).
 pub(crate) struct Marcher<'a> {
     pub medium: Medium<'a>,
     pub lookup: Lookup<'a>,
     pub multiple: Option<&'a MultipleScattering>,
+    pub(super) lanes: Option<LightLanes>,
+}
+
+impl<'a> Marcher<'a> {
+    /// The march over `lookup`'s transmittance and `multiple`'s field.
+    pub fn new(
+        medium: Medium<'a>,
+        lookup: Lookup<'a>,
+        multiple: Option<&'a MultipleScattering>,
+    ) -> Marcher<'a> {
+        let lanes = LightLanes::new(&medium, &lookup, multiple);
+        Marcher {
+            medium,
+            lookup,
+            multiple,
+            lanes,
+        }
+    }
+
+    /// This march without its lanes: every march on the general path (for comparing them).
+    #[cfg(test)]
+    pub fn without_lanes(mut self) -> Marcher<'a> {
+        self.lanes = None;
+        self
+    }
 }
 
 /// The distance (m) from the start to the far end of step `i` of `steps` over `length`:
@@ -202,22 +241,35 @@ pub(crate) fn step_end(i: usize, steps: usize, length: f64) -> f64 {
 pub(crate) struct RayProfile {
     /// Per step: its start and end (m from the ray's start), its middle and the radius
     /// there (m).
-    steps: Vec<[f64; 4]>,
+    pub(super) steps: Vec<[f64; 4]>,
     /// Per step, each constituent's density at its middle.
-    densities: Vec<f64>,
+    pub(super) densities: Vec<f64>,
     /// Per step and channel: the throughput before the step.
-    throughput: Vec<f64>,
+    pub(super) throughput: Vec<f64>,
     /// Per step and channel: the step's analytic length (m).
-    lengths: Vec<f64>,
+    pub(super) lengths: Vec<f64>,
     /// The ray's throughput per channel.
     pub transmittance: Vec<f64>,
     /// ∫ T·σ_s dt along the ray per channel (Hillaire's eq. 8 integrand before its phase
     /// function: what f_ms sums).
     pub scattered: Vec<f64>,
+    /// The steps for the lanes' march, when the marcher has lanes ([`LightLanes`]).
+    pub(super) lanes: StepLanes,
+}
+
+impl RayProfile {
+    /// The ray's transmittance into `transmittance`, and ∫T·σ_s into `scattered` unless it
+    /// is empty.
+    fn copy_totals(&self, transmittance: &mut [f64], scattered: &mut [f64]) {
+        transmittance.copy_from_slice(&self.transmittance);
+        if !scattered.is_empty() {
+            scattered.copy_from_slice(&self.scattered);
+        }
+    }
 }
 
 thread_local! {
-    /// The profile [`Marcher::march_over`] reuses on each thread.
+    /// The profile [`Marcher::march`] and [`Marcher::march_over`] reuse on each thread.
     static SCRATCH: std::cell::RefCell<RayProfile> = std::cell::RefCell::default();
 }
 
@@ -242,6 +294,9 @@ impl Marcher<'_> {
         p.scattered.clear();
         p.scattered.resize(n, 0.0);
         if ray.length <= 0.0 {
+            if let Some(lanes) = &self.lanes {
+                lanes.fill_steps(p, self.lookup.sun_angular_radius);
+            }
             return;
         }
         let bottom = model.bottom_radius_m;
@@ -281,6 +336,9 @@ impl Marcher<'_> {
                 t0 = t1;
             }
         });
+        if let Some(lanes) = &self.lanes {
+            lanes.fill_steps(p, self.lookup.sun_angular_radius);
+        }
     }
 
     /// [`Marcher::profile_into`] of the `steps` quadratic steps of [`step_end`].
@@ -305,16 +363,12 @@ impl Marcher<'_> {
         transmittance: &mut [f64],
         scattered: &mut [f64],
     ) {
-        self.march_over(
-            ray,
-            (1..=steps).map(|i| step_end(i, steps, ray.length)),
-            phases,
-            lighting,
-            radiance,
-            transmittance,
-            scattered,
-            |_, _| {},
-        );
+        SCRATCH.with(|cell| {
+            let mut profile = cell.borrow_mut();
+            self.profile_steps_into(ray, steps, &mut profile);
+            self.march_profile(ray, &profile, phases, lighting, radiance);
+            profile.copy_totals(transmittance, scattered);
+        });
     }
 
     /// [`Marcher::march`] over the steps ending at `ends` (m from the ray's start,
@@ -336,11 +390,8 @@ impl Marcher<'_> {
         SCRATCH.with(|cell| {
             let mut profile = cell.borrow_mut();
             self.profile_into(ray, ends, &mut profile);
-            self.march_profile(ray, &profile, phases, lighting, radiance, at_end);
-            transmittance.copy_from_slice(&profile.transmittance);
-            if !scattered.is_empty() {
-                scattered.copy_from_slice(&profile.scattered);
-            }
+            self.march_profile_each(ray, &profile, phases, lighting, radiance, at_end);
+            profile.copy_totals(transmittance, scattered);
         });
     }
 
@@ -350,6 +401,77 @@ impl Marcher<'_> {
     /// at ν, none for no single scattering) and the multiple scattering, into `radiance`
     /// (overwritten), calling `at_end(i, radiance)` after step i.
     pub fn march_profile(
+        &self,
+        ray: &MarchRay,
+        profile: &RayProfile,
+        phases: &[f64],
+        lighting: &Lighting,
+        radiance: &mut [f64],
+    ) {
+        self.march_profile_with::<false>(ray, profile, phases, lighting, radiance, |_, _| {});
+    }
+
+    /// [`Marcher::march_profile`], calling `at_end(i, radiance)` after step i with the
+    /// radiance so far.
+    pub fn march_profile_each(
+        &self,
+        ray: &MarchRay,
+        profile: &RayProfile,
+        phases: &[f64],
+        lighting: &Lighting,
+        radiance: &mut [f64],
+        at_end: impl FnMut(usize, &[f64]),
+    ) {
+        self.march_profile_with::<true>(ray, profile, phases, lighting, radiance, at_end);
+    }
+
+    /// The march, `at_end` called after each step when `EACH`.
+    fn march_profile_with<const EACH: bool>(
+        &self,
+        ray: &MarchRay,
+        profile: &RayProfile,
+        phases: &[f64],
+        lighting: &Lighting,
+        radiance: &mut [f64],
+        mut at_end: impl FnMut(usize, &[f64]),
+    ) {
+        if let (Some(lanes), Lit::All, Lit::All) = (&self.lanes, lighting.single, lighting.multiple)
+        {
+            // Fully lit: the lanes' march (the same sums; lanes.rs).
+            let mut p = [0.0f32; 16];
+            let p = if phases.len() <= p.len() {
+                for (q, v) in p.iter_mut().zip(phases) {
+                    *q = *v as f32;
+                }
+                &p[..phases.len()]
+            } else {
+                return self
+                    .march_profile_general(ray, profile, phases, lighting, radiance, at_end);
+            };
+            let mut acc = [[0.0f32; LANES]; crate::spectrum::MAX_CHANNELS / LANES];
+            let acc = &mut acc[..lanes.groups()];
+            let mut step_radiance = |i: usize, acc: &[Lane]| {
+                if EACH {
+                    lanes.unpack(acc, radiance);
+                    at_end(i, radiance);
+                }
+            };
+            lanes.march(
+                &profile.lanes,
+                ray.r * ray.mu_s,
+                ray.nu,
+                p,
+                acc,
+                |i, acc| step_radiance(i, acc),
+            );
+            lanes.unpack(acc, radiance);
+            return;
+        }
+        self.march_profile_general(ray, profile, phases, lighting, radiance, at_end);
+    }
+
+    /// [`Marcher::march_profile`] step by step in f64, for any field and lighting.
+    fn march_profile_general(
         &self,
         ray: &MarchRay,
         profile: &RayProfile,

@@ -19,6 +19,7 @@
 
 pub mod harmonics;
 pub mod irradiance;
+pub(crate) mod lanes;
 pub(crate) mod march;
 pub mod multiple_scattering;
 pub mod params;
@@ -28,7 +29,7 @@ pub mod view;
 pub use multiple_scattering::{MultipleScattering, MultipleScatteringModel, F_MS_LIMIT};
 pub use view::Hillaire2020View;
 
-use super::bruneton4d::precompute::compute_optical_depth_in;
+use super::bruneton4d::precompute::compute_optical_depth_with;
 use super::bruneton4d::{Lookup, Table2, TableSizes};
 use super::{SkyMethod, SkyView};
 use crate::atmosphere::Model;
@@ -207,14 +208,15 @@ impl Hillaire2020 {
         crate::spectrum::check_channels(model.channels(), "Hillaire 2020")?;
         let sizes = config.table_sizes();
         stage("transmittance");
-        let optical_depth = compute_optical_depth_in(&model, &sizes, config.transmittance_segments);
+        // The densities tabulated (the columns within 2e-5 of the exact ones: density_table.rs).
+        let medium = Medium::new(&model);
+        let densities = medium.density_table();
+        let optical_depth = compute_optical_depth_with(&model, &sizes, &|r, mu, d, columns| {
+            densities.columns_along_ray(r, mu, d, config.transmittance_segments, columns)
+        });
         stage("multiple scattering");
         let ms = {
-            let marcher = Marcher {
-                medium: Medium::new(&model),
-                lookup: Lookup::new(&model, sizes, &optical_depth),
-                multiple: None,
-            };
+            let marcher = Marcher::new(medium, Lookup::new(&model, sizes, &optical_depth), None);
             let (w, h) = config.multiple_scattering;
             multiple_scattering::compute(
                 &marcher,
@@ -264,11 +266,11 @@ impl Hillaire2020 {
 
     /// The march over this method's tables.
     pub(crate) fn marcher(&self) -> Marcher<'_> {
-        Marcher {
-            medium: Medium::new(&self.model),
-            lookup: Lookup::new(&self.model, self.config.table_sizes(), &self.optical_depth),
-            multiple: Some(&self.multiple_scattering),
-        }
+        Marcher::new(
+            Medium::new(&self.model),
+            Lookup::new(&self.model, self.config.table_sizes(), &self.optical_depth),
+            Some(&self.multiple_scattering),
+        )
     }
 
     /// The sky's irradiance (per unit light irradiance) on a horizontal surface at radius

@@ -365,18 +365,29 @@ pub(crate) fn compute(
     };
     // Order 1: the light scattered once towards the point, and the Lambertian ground lit by
     // the light (eq. 6), with f_ms (eq. 8).
+    let isotropic = {
+        let mut p = Vec::new();
+        marcher.medium.isotropic_phases(&mut p);
+        p
+    };
     let first = grid.gather(marcher, steps, true, &|ray, profile, ground, l| {
-        let mut phases = Vec::new();
         match model_kind {
-            MultipleScatteringModel::Isotropic => marcher.medium.isotropic_phases(&mut phases),
-            MultipleScatteringModel::Harmonics(_) => marcher.medium.phases(ray.nu, &mut phases),
+            MultipleScatteringModel::Isotropic => {
+                marcher.march_profile(ray, profile, &isotropic, &Lighting::ALL, l)
+            }
+            MultipleScatteringModel::Harmonics(_) => {
+                let mut phases = Vec::new();
+                marcher.medium.phases(ray.nu, &mut phases);
+                marcher.march_profile(ray, profile, &phases, &Lighting::ALL, l)
+            }
         }
-        marcher.march_profile(ray, profile, &phases, &Lighting::ALL, l, |_, _| {});
         let t = &profile.transmittance;
         if ground {
             let (r_g, mu_s_g) = ray.at(ray.length);
-            let mut t_sun = vec![0.0; n];
-            marcher.lookup.transmittance_to_sun(r_g, mu_s_g, &mut t_sun);
+            let mut t_sun = [0.0; MAX_CHANNELS];
+            marcher
+                .lookup
+                .transmittance_to_sun(r_g, mu_s_g, &mut t_sun[..n]);
             let cos = mu_s_g.max(0.0);
             for k in 0..n {
                 l[k] += t[k] * t_sun[k] * cos * model.ground_albedo[k] / std::f64::consts::PI;
@@ -408,17 +419,13 @@ pub(crate) fn compute(
             max_at: (0.0, 0.0, 0),
         };
         let ground_irradiance = grid.ground_table(&last.up_irradiance[..nmu_s * n]);
-        let through = Marcher {
-            medium: Medium::new(model),
-            lookup: marcher.lookup,
-            multiple: Some(&previous),
-        };
+        let through = Marcher::new(Medium::new(model), marcher.lookup, Some(&previous));
         let unlit = Lighting {
             single: Lit::Intervals(&[]),
             multiple: Lit::All,
         };
         let next = next_grid.gather(marcher, steps, false, &|ray, profile, ground, l| {
-            through.march_profile(ray, profile, &[], &unlit, l, |_, _| {});
+            through.march_profile(ray, profile, &[], &unlit, l);
             let t = &profile.transmittance;
             if ground {
                 let (r_g, mu_s_g) = ray.at(ray.length);

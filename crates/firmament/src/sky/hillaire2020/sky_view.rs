@@ -55,7 +55,7 @@ pub(crate) fn compute(
                 let view_nu = mu * mu_s + safe_sqrt(1.0 - mu * mu) * sin_s * cos_phi;
                 marcher.medium.phases(view_nu, &mut phases);
                 ray.nu = view_nu.clamp(-1.0, 1.0);
-                marcher.march_profile(&ray, &profile, &phases, &Lighting::ALL, &mut l, |_, _| {});
+                marcher.march_profile(&ray, &profile, &phases, &Lighting::ALL, &mut l);
                 for k in 0..n {
                     row[x * n + k] = l[k] as f32;
                 }

@@ -207,7 +207,15 @@ impl PrecomputeJob {
             Pass::Transmittance => {
                 let row = s.transmittance_mu * n;
                 let out = &mut w.optical_depth.data[z.start * row..z.end * row];
-                optical_depth_rows(model, &s, TRANSMITTANCE_SEGMENTS, z, out);
+                optical_depth_rows(
+                    model,
+                    &s,
+                    &|r, mu, d, columns| {
+                        model.columns_along_ray(r, mu, d, TRANSMITTANCE_SEGMENTS, columns)
+                    },
+                    z,
+                    out,
+                );
             }
             Pass::DirectIrradiance => {
                 let lookup = Lookup::new(model, s, &w.optical_depth);

@@ -40,7 +40,9 @@ pub(crate) use grid::{MuSPositions, ScatteringGrid};
 pub use job::PrecomputeJob;
 pub use order_tail::{order_tail_factors, ORDER_RATIO_CAP};
 pub use plan::{frame_schedule, Pass, Unit};
-pub use transmittance::{compute_optical_depth, compute_optical_depth_in};
+pub use transmittance::{
+    compute_optical_depth, compute_optical_depth_in, compute_optical_depth_with, Columns,
+};
 
 use crate::spectrum::MAX_CHANNELS;
 

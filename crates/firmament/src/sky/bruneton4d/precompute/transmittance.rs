@@ -18,17 +18,29 @@ pub fn compute_optical_depth(model: &Model, s: &TableSizes) -> Table2 {
 
 /// [`compute_optical_depth`] with `segments` Gauss–Legendre segments per ray.
 pub fn compute_optical_depth_in(model: &Model, s: &TableSizes, segments: usize) -> Table2 {
+    compute_optical_depth_with(model, s, &|r, mu, d, columns| {
+        model.columns_along_ray(r, mu, d, segments, columns)
+    })
+}
+
+/// [`compute_optical_depth`] with the constituents' columns along a ray from `columns(r,
+/// μ, length, out)` (e.g. [`crate::atmosphere::density_table::DensityTable`]'s).
+pub fn compute_optical_depth_with(model: &Model, s: &TableSizes, columns: &Columns) -> Table2 {
     let mut t = Table2::new(s.transmittance_mu, s.transmittance_r, model.channels());
-    optical_depth_rows(model, s, segments, 0..s.transmittance_r, &mut t.data);
+    optical_depth_rows(model, s, columns, 0..s.transmittance_r, &mut t.data);
     t
 }
+
+/// The constituents' columns (m) along the ray from radius r (m) in direction μ over a
+/// length (m), into the last argument.
+pub type Columns<'a> = dyn Fn(f64, f64, f64, &mut [f64]) + Sync + 'a;
 
 /// The rows `rows` (r texels) of [`compute_optical_depth_in`] into `out`, their part of the
 /// table's data: a unit of the resumable precomputation ([`super::PrecomputeJob`]).
 pub(super) fn optical_depth_rows(
     model: &Model,
     s: &TableSizes,
-    segments: usize,
+    columns_along_ray: &Columns,
     rows: Range<usize>,
     out: &mut [f32],
 ) {
@@ -52,7 +64,7 @@ pub(super) fn optical_depth_rows(
                 let (r, mu) =
                     params::transmittance_r_mu(&radii, u, v, s.transmittance_mu, s.transmittance_r);
                 let d = crate::math::sphere::distance_to_top_atmosphere_boundary(r, mu, radii.top);
-                model.columns_along_ray(r, mu, d, segments, &mut columns);
+                columns_along_ray(r, mu, d, &mut columns);
                 model.optical_depth_from_columns(&columns, &mut tau);
                 for k in 0..n {
                     row[x * n + k] = tau[k].min(MAX_OPTICAL_DEPTH as f64) as f32;
