@@ -229,19 +229,24 @@ impl LightLanes {
         lanes.single.clear();
         lanes.multiple.clear();
         let t = &self.optical_depth;
+        // The sun's band around the horizon is sin(horizon angle)·radius = bottom/r·radius:
+        // its 1/(2e) is r times this.
+        let inv_band_per_r = if sun_radius > 0.0 {
+            0.5 / (self.bottom * sun_radius)
+        } else {
+            0.0
+        };
         for (i, &[_, _, t_mid, r]) in profile.steps.iter().enumerate() {
             // Bruneton's transmittance mapping (bruneton4d::params::transmittance_uv) with
             // what depends on r alone taken out.
             let rho = safe_sqrt(r * r - self.bottom * self.bottom);
             let (d_min, d_max) = (self.top - r, rho + self.h);
-            let sin_h = self.bottom / r;
-            let x_r = ((r - self.bottom) / (self.top - self.bottom))
-                .clamp(0.0, 1.0)
-                .sqrt();
+            let inv_r = 1.0 / r.max(1.0);
+            let sin_h = self.bottom * inv_r;
             lanes.geometry.push(StepGeometry {
                 t_mid,
                 r,
-                inv_r: 1.0 / r.max(1.0),
+                inv_r,
                 top_minus_r2: self.top * self.top - r * r,
                 d_min,
                 inv_span: if d_max > d_min {
@@ -251,23 +256,21 @@ impl LightLanes {
                 },
                 transmittance_row: weights(rho / self.h, t.height),
                 half_band: sin_h * sun_radius,
-                inv_band: if sin_h * sun_radius > 0.0 {
-                    0.5 / (sin_h * sun_radius)
-                } else {
-                    0.0
-                },
-                cos_horizon: -safe_sqrt(1.0 - sin_h * sin_h),
-                field_row: self
-                    .multiple
-                    .as_ref()
-                    .map_or((0, 0, 0.0), |m| weights(x_r, m.height)),
+                inv_band: r * inv_band_per_r,
+                // −cos of the horizon's zenith angle = √(r² − bottom²)/r.
+                cos_horizon: -rho * inv_r,
+                field_row: self.multiple.as_ref().map_or((0, 0, 0.0), |m| {
+                    let x_r = ((r - self.bottom) / (self.top - self.bottom)).clamp(0.0, 1.0);
+                    weights(x_r.sqrt(), m.height)
+                }),
             });
             let densities = &profile.densities[i * constituents..(i + 1) * constituents];
             let (through, lengths) = (
                 &profile.throughput[i * n..(i + 1) * n],
                 &profile.lengths[i * n..(i + 1) * n],
             );
-            let mut multiple = vec![[0.0f32; LANES]; g_count];
+            let mut multiple = [[0.0f32; LANES]; crate::spectrum::MAX_CHANNELS / LANES];
+            let multiple = &mut multiple[..g_count];
             for (ci, &rho_c) in densities.iter().enumerate() {
                 let beta = &self.scattering[ci * g_count..(ci + 1) * g_count];
                 for (g, m) in multiple.iter_mut().enumerate() {
@@ -282,7 +285,7 @@ impl LightLanes {
                     lanes.single.push(w);
                 }
             }
-            lanes.multiple.extend(multiple);
+            lanes.multiple.extend_from_slice(multiple);
         }
     }
 
