@@ -10,9 +10,8 @@
 //! H = 1.2 km that is 1.3e-5, measured on the optical depths in
 //! `tests::the_tabulated_columns_are_the_exact_ones`.
 
+use super::model::gauss_radii_along_ray;
 use super::Model;
-use crate::math::quadrature::GL4;
-use crate::math::sphere;
 
 /// Grid points from the ground to the top of the atmosphere.
 pub const DENSITY_SAMPLES: usize = 8192;
@@ -88,21 +87,9 @@ impl DensityTable {
         out: &mut [f64],
     ) {
         out.iter_mut().for_each(|o| *o = 0.0);
-        if length_m <= 0.0 {
-            return;
-        }
-        // GL4.composite's nodes and weights, without its iterator's overhead.
-        let h = length_m / segments.max(1) as f64;
-        let (r2, two_r_mu) = (r * r, 2.0 * r * mu);
-        for i in 0..segments.max(1) {
-            let c = (i as f64 + 0.5) * h;
-            for (&x, &w) in GL4.nodes.iter().zip(GL4.weights) {
-                let (dx, w) = (0.5 * h * x, 0.5 * h * w);
-                for d in [c - dx, c + dx] {
-                    self.add_densities(sphere::safe_sqrt(d * d + two_r_mu * d + r2), w, out);
-                }
-            }
-        }
+        gauss_radii_along_ray(r, mu, length_m, segments, |radius, w| {
+            self.add_densities(radius, w, out)
+        });
     }
 }
 
@@ -110,6 +97,7 @@ impl DensityTable {
 mod tests {
     use super::*;
     use crate::atmosphere::Atmosphere;
+    use crate::math::sphere;
     use crate::spectrum::Wavelengths;
 
     #[test]

@@ -194,16 +194,12 @@ impl Model {
         out: &mut [f64],
     ) {
         out.iter_mut().for_each(|o| *o = 0.0);
-        if length_m <= 0.0 {
-            return;
-        }
-        for (d, w) in GL4.composite(0.0, length_m, segments) {
-            let radius = sphere::safe_sqrt(d * d + 2.0 * r * mu * d + r * r);
+        gauss_radii_along_ray(r, mu, length_m, segments, |radius, w| {
             let alt = (radius - self.bottom_radius_m).max(0.0);
             for (o, con) in out.iter_mut().zip(&self.constituents) {
                 *o += w * con.density.density(alt);
             }
-        }
+        });
     }
 
     /// Optical depth per wavelength from constituent columns (m), into `out`.
@@ -263,4 +259,22 @@ pub fn fnv1a(bytes: &[u8]) -> u64 {
         h = h.wrapping_mul(0x0000_0100_0000_01b3);
     }
     h
+}
+
+/// `f(radius, weight)` at the nodes of the composite 4-point Gauss–Legendre rule with
+/// `segments` sub-intervals over `length_m` metres of the ray from radius `r` (m) in
+/// direction `mu` (nothing when the length is not positive): the columns along a ray, from
+/// the exact profiles ([`Model::columns_along_ray`]) or a table of them
+/// (`DensityTable::columns_along_ray`).
+#[inline]
+pub fn gauss_radii_along_ray(
+    r: f64,
+    mu: f64,
+    length_m: f64,
+    segments: usize,
+    mut f: impl FnMut(f64, f64),
+) {
+    GL4.for_each_node(0.0, length_m, segments, |d, w| {
+        f(sphere::safe_sqrt(d * d + 2.0 * r * mu * d + r * r), w)
+    });
 }

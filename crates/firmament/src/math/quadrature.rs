@@ -53,6 +53,22 @@ impl GaussLegendre {
         })
     }
 
+    /// `f(x, w)` at each node and weight of [`GaussLegendre::composite`], in its order,
+    /// without an iterator's overhead (the inner loops of the transmittance passes).
+    #[inline]
+    pub fn for_each_node(&self, a: f64, b: f64, panels: usize, mut f: impl FnMut(f64, f64)) {
+        let panels = if b > a { panels } else { 0 };
+        let h = (b - a) / panels.max(1) as f64;
+        for i in 0..panels {
+            let c = a + (i as f64 + 0.5) * h;
+            for (&x, &w) in self.nodes.iter().zip(self.weights) {
+                let (dx, w) = (0.5 * h * x, 0.5 * h * w);
+                f(c - dx, w);
+                f(c + dx, w);
+            }
+        }
+    }
+
     /// ∫_a^b f by the composite rule with `panels` panels (0 when b ≤ a).
     pub fn integrate(&self, a: f64, b: f64, panels: usize, f: impl Fn(f64) -> f64) -> f64 {
         self.composite(a, b, panels).map(|(x, w)| w * f(x)).sum()

@@ -399,7 +399,7 @@ impl Marcher<'_> {
     /// `mu_s` and `nu` give the light) of the throughput so far times the step's analytic
     /// integral of the light scattered once (`phases`: each constituent's phase function
     /// at ν, none for no single scattering) and the multiple scattering, into `radiance`
-    /// (overwritten), calling `at_end(i, radiance)` after step i.
+    /// (overwritten).
     pub fn march_profile(
         &self,
         ray: &MarchRay,
@@ -462,7 +462,7 @@ impl Marcher<'_> {
                 ray.nu,
                 p,
                 acc,
-                |i, acc| step_radiance(i, acc),
+                &mut step_radiance,
             );
             lanes.unpack(acc, radiance);
             return;
