@@ -44,6 +44,7 @@
 pub mod bruneton4d;
 pub mod clouds;
 mod device;
+pub mod display;
 pub mod elek3d;
 mod error;
 pub mod hillaire2020;
