@@ -14,7 +14,9 @@ use std::process::ExitCode;
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 
-use commands::{astro, atmosphere, bake, bench, gallery, query, render, render_args, validate};
+use commands::{
+    astro, atmosphere, bake, bench, gallery, query, render, render_args, validate, view,
+};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -48,6 +50,8 @@ enum Command {
     Bench(bench::BenchArgs),
     /// Measure the table method against the Monte Carlo reference (errors per configuration; see docs/accuracy.md).
     Validate(validate::ValidateArgs),
+    /// A window drawing the scene live on the GPU: fly the camera, move the sun or the clock, switch the method, change the air and the exposure, capture PNG/EXR and save the scene.
+    View(Box<view::ViewArgs>),
 }
 
 fn run(cli: Cli) -> Result<()> {
@@ -66,6 +70,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Render(args) => render::run(&args)?,
         Command::Gallery(args) => gallery::run(&args)?,
         Command::Validate(args) => validate::run(&args)?,
+        Command::View(args) => view::run(&args)?,
     }
     Ok(())
 }

@@ -8,7 +8,10 @@
 //! - `tonemap.wgsl`: the gamut mapping, `tonemap::exposure_from_ev100`, the tone curve and
 //!   the sRGB transfer function into any colour target, resampled to the target's size.
 //!
-//! Texture readbacks ([`read_hdr_frame`], [`read_rgba8`]) serve captures and tests.
+//! The frame comes in the render pass's own frame buffer ([`crate::RenderTarget::Buffer`],
+//! [`crate::GpuRenderer::frame_buffer`]: f32, as a sun's disk at ~10⁹ cd/m² overflows half
+//! floats), so the viewer draws with the very pipeline `firmament render --backend gpu`
+//! reads back. Readbacks ([`read_hdr_frame`], [`read_rgba8`]) serve captures and tests.
 
 use firmament::render::tonemap::{ToneCurve, DISPLAY_MID_GREY, METER_K};
 use firmament::render::Frame;
@@ -17,10 +20,6 @@ use wgpu::util::DeviceExt;
 use crate::device::{read_back, scoped, staging_buffer};
 use crate::render::frame_from_pixels;
 use crate::{GpuContext, GpuError};
-
-/// The HDR frame's format the display reads: linear sRGB with Y in cd/m² and the mask in
-/// alpha (a sun's disk, ~10⁹ cd/m², overflows half floats).
-pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 /// How a frame is exposed.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -97,16 +96,7 @@ fn storage_entry(
 }
 
 fn hdr_entry(visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding: 0,
-        visibility,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: false },
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    }
+    storage_entry(0, visibility, true)
 }
 
 /// Whether a format's writes are sRGB-encoded by the hardware.
@@ -235,15 +225,15 @@ impl Display {
         pipeline
     }
 
-    /// Record the exposure pass over `hdr` (a `width`×`height` [`HDR_FORMAT`] texture
-    /// holding a frame) and the display of it into `target` (any colour format; a UNORM
+    /// Record the exposure pass over `hdr` (a `width`×`height` frame buffer, 16 bytes per
+    /// pixel as [`crate::RenderTarget::Buffer`] holds it) and the display of it into `target` (any colour format; a UNORM
     /// one receives sRGB codes, an sRGB one linear values it encodes itself).
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        hdr: &wgpu::TextureView,
+        hdr: &wgpu::Buffer,
         hdr_size: (u32, u32),
         target: &wgpu::TextureView,
         target_format: wgpu::TextureFormat,
@@ -276,7 +266,7 @@ impl Display {
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
-                    resource: wgpu::BindingResource::TextureView(hdr),
+                    resource: hdr.as_entire_binding(),
                 },
                 wgpu::BindGroupEntry {
                     binding: 1,
@@ -318,7 +308,7 @@ impl Display {
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
-                    resource: wgpu::BindingResource::TextureView(hdr),
+                    resource: hdr.as_entire_binding(),
                 },
                 wgpu::BindGroupEntry {
                     binding: 1,
@@ -374,26 +364,16 @@ impl Display {
     }
 }
 
-/// A texture for frames the display reads: [`HDR_FORMAT`], usable as a render target of
-/// the sky methods (storage binding), read by the display, copied out for captures and in
-/// from a frame the CPU drew.
-pub fn hdr_texture(ctx: &GpuContext, width: u32, height: u32) -> wgpu::Texture {
-    ctx.device().create_texture(&wgpu::TextureDescriptor {
+/// A frame buffer the display reads (`width`×`height`, 16 bytes per pixel; usage STORAGE,
+/// COPY_SRC for captures and COPY_DST for a frame the CPU drew).
+pub fn hdr_buffer(ctx: &GpuContext, width: u32, height: u32) -> wgpu::Buffer {
+    ctx.device().create_buffer(&wgpu::BufferDescriptor {
         label: Some("hdr frame"),
-        size: wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: HDR_FORMAT,
-        usage: wgpu::TextureUsages::STORAGE_BINDING
-            | wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::COPY_SRC
-            | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
+        size: width as u64 * height as u64 * crate::PIXEL_BYTES,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
     })
 }
 
@@ -441,15 +421,27 @@ fn read_texture(
     Ok(out)
 }
 
-/// An [`HDR_FORMAT`] texture's frame as the CPU's [`Frame`] (waits for the device).
-pub fn read_hdr_frame(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Frame, GpuError> {
-    let raw = read_texture(ctx, texture, 16, "reading the frame back")?;
-    let values: Vec<f32> = bytemuck::pod_collect_to_vec(&raw);
-    Ok(frame_from_pixels(
-        &values,
-        texture.width() as usize,
-        texture.height() as usize,
-    ))
+/// A frame buffer's frame as the CPU's [`Frame`] (waits for the device).
+pub fn read_hdr_frame(
+    ctx: &GpuContext,
+    buffer: &wgpu::Buffer,
+    width: u32,
+    height: u32,
+) -> Result<Frame, GpuError> {
+    let bytes = width as u64 * height as u64 * crate::PIXEL_BYTES;
+    let during = "reading the frame back";
+    let staging = scoped(ctx, during, || {
+        let staging = staging_buffer(ctx.device(), during, bytes);
+        let mut encoder = ctx
+            .device()
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
+        ctx.queue().submit([encoder.finish()]);
+        Ok(staging)
+    })?;
+    let raw = read_back(ctx, &[&staging], during)?;
+    let values: Vec<f32> = bytemuck::pod_collect_to_vec(&raw[0]);
+    Ok(frame_from_pixels(&values, width as usize, height as usize))
 }
 
 /// An 8-bit RGBA texture's codes, rows from the top (waits for the device); a BGRA one is

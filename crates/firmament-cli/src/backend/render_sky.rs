@@ -19,7 +19,9 @@ use firmament::sky::bruneton4d::{Bruneton4d, TableConfig};
 use firmament::sky::SkyMethod;
 use firmament_gpu::elek3d::{GpuElek3d, GpuElek3dRenderer};
 use firmament_gpu::hillaire2020::{GpuHillaire, GpuHillaireRenderer, HillairePrecomputer};
-use firmament_gpu::{GpuClouds, GpuError, GpuRenderer, GpuSky, GpuTerrain, RenderInputs};
+use firmament_gpu::{
+    GpuClouds, GpuError, GpuRenderer, GpuSky, GpuTerrain, RenderInputs, RenderTarget,
+};
 
 use super::{gpu_failure, on_gpu, Backend, Gpu};
 use crate::common::{cancel_flag, progress_bar, spinner, AtmosphereArgs};
@@ -70,6 +72,19 @@ impl<'a> RenderSky<'a> {
         atmosphere: &AtmosphereArgs,
         method: Method,
         quiet: bool,
+    ) -> Result<Self> {
+        Self::with_tables_from(backend, atmosphere, method, quiet, false)
+    }
+
+    /// [`RenderSky::new`], the GPU's 4D tables computed on the CPU (through the table
+    /// cache) and uploaded when `cpu_tables`: a software rasteriser takes half a minute
+    /// for what the CPU does in seconds, or reads from its cache at once.
+    pub fn with_tables_from(
+        backend: &'a Backend,
+        atmosphere: &AtmosphereArgs,
+        method: Method,
+        quiet: bool,
+        cpu_tables: bool,
     ) -> Result<Self> {
         let gpu = match (backend, method) {
             (Backend::Cpu, _) => {
@@ -133,20 +148,17 @@ impl<'a> RenderSky<'a> {
             }
         };
         let cpu_sky = Box::new(OnceLock::new());
-        let (sky, sky_model, config) = match &atmosphere.tables {
-            Some(_) => {
-                let cpu = atmosphere.sky(quiet)?;
-                let sky = GpuSky::from_sky(&gpu.ctx, &cpu)
-                    .map_err(|e| gpu_failure("uploading the tables", e))?;
-                let (model, config) = (cpu.model.clone(), cpu.tables.config);
-                let _ = cpu_sky.set(cpu);
-                (sky, model, config)
-            }
-            None => {
-                let model = atmosphere.model()?;
-                let config = atmosphere.table_config()?;
-                (gpu.sky(&model, &config, quiet)?, model, config)
-            }
+        let (sky, sky_model, config) = if atmosphere.tables.is_some() || cpu_tables {
+            let cpu = atmosphere.sky(quiet)?;
+            let sky = GpuSky::from_sky(&gpu.ctx, &cpu)
+                .map_err(|e| gpu_failure("uploading the tables", e))?;
+            let (model, config) = (cpu.model.clone(), cpu.tables.config);
+            let _ = cpu_sky.set(cpu);
+            (sky, model, config)
+        } else {
+            let model = atmosphere.model()?;
+            let config = atmosphere.table_config()?;
+            (gpu.sky(&model, &config, quiet)?, model, config)
         };
         let renderer = GpuRenderer::new(&gpu.ctx)
             .map_err(|e| gpu_failure("compiling the render shader", e))?;
@@ -292,6 +304,36 @@ impl<'a> RenderSky<'a> {
                 })
             }
         }
+    }
+
+    /// Record a frame of the clear sky lit by `sources` into `target` on the GPU (nothing
+    /// submitted; no terrain, clouds or stars: those need the CPU's parts of
+    /// [`RenderSky::render`]). The viewer's frame path.
+    pub fn encode_frame(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        settings: &RenderSettings,
+        sources: &SkySources,
+        target: RenderTarget,
+    ) -> Result<()> {
+        let inputs = RenderInputs {
+            background: sources.background.as_ref(),
+            ..RenderInputs::default()
+        };
+        let lights = &sources.lights;
+        let recorded = match self {
+            RenderSky::Cpu(..) => anyhow::bail!("encode_frame draws on the GPU only"),
+            RenderSky::Gpu {
+                gpu, sky, renderer, ..
+            } => renderer.encode(&gpu.ctx, encoder, sky, lights, settings, target, inputs),
+            RenderSky::GpuHillaire {
+                gpu, sky, renderer, ..
+            } => renderer.encode(&gpu.ctx, encoder, sky, lights, settings, target, inputs),
+            RenderSky::GpuElek3d {
+                gpu, sky, renderer, ..
+            } => renderer.encode(&gpu.ctx, encoder, sky, lights, settings, target, inputs),
+        };
+        recorded.map_err(|e| gpu_failure("recording the frame", e))
     }
 
     /// The CPU twin of the GPU's 4D tables (read back from the device once), with the

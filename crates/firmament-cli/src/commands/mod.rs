@@ -16,3 +16,4 @@ pub mod render_args;
 pub mod render_reference;
 pub mod timelapse;
 pub mod validate;
+pub mod view;

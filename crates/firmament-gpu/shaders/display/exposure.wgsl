@@ -20,7 +20,8 @@ struct ExposureParams {
     reset: u32,
 }
 
-@group(0) @binding(0) var frame_hdr: texture_2d<f32>;
+// The frame as the render pass writes it (`RenderTarget::Buffer`): rows from the top.
+@group(0) @binding(0) var<storage, read> frame_pixels: array<vec4<f32>>;
 @group(0) @binding(1) var<uniform> params: ExposureParams;
 // [EV100 in use, metered log-average luminance (cd/m²), pixels metered, brightest luminance]
 @group(0) @binding(2) var<storage, read_write> exposure_state: array<f32, 4>;
@@ -62,11 +63,10 @@ fn auto_ev100(mean_luminance: f32) -> f32 {
 
 @compute @workgroup_size(256)
 fn log_average_luminance(@builtin(local_invocation_index) i: u32) {
-    let w = params.size.x;
     let n = params.size.x * params.size.y;
     var brightest = 0.0;
     for (var p = i; p < n; p = p + EXPOSURE_THREADS) {
-        let y = frame_luminance(textureLoad(frame_hdr, vec2<u32>(p % w, p / w), 0).rgb);
+        let y = frame_luminance(frame_pixels[p].rgb);
         // NaN and negative values never win.
         if (y > brightest) {
             brightest = y;
@@ -80,7 +80,7 @@ fn log_average_luminance(@builtin(local_invocation_index) i: u32) {
     var sum = 0.0;
     var count = 0.0;
     for (var p = i; p < n; p = p + EXPOSURE_THREADS) {
-        let px = textureLoad(frame_hdr, vec2<u32>(p % w, p / w), 0);
+        let px = frame_pixels[p];
         let y = frame_luminance(px.rgb);
         if (px.a > 0.5 && y > floor_y) {
             sum = sum + log(y);

@@ -18,7 +18,8 @@ struct DisplayParams {
     meter_k: f32,
 }
 
-@group(0) @binding(0) var frame_hdr: texture_2d<f32>;
+// The frame as the render pass writes it (`RenderTarget::Buffer`): rows from the top.
+@group(0) @binding(0) var<storage, read> frame_pixels: array<vec4<f32>>;
 @group(0) @binding(1) var<uniform> display: DisplayParams;
 @group(0) @binding(2) var<storage, read> exposure_state: array<f32, 4>;
 
@@ -75,7 +76,7 @@ fn linear_to_srgb(c: f32) -> f32 {
 // One source pixel shown: gamut, exposure, curve (display-linear).
 fn shown(p: vec2<i32>, exposure: f32) -> vec3<f32> {
     let q = clamp(p, vec2<i32>(0), vec2<i32>(display.source_size) - vec2<i32>(1));
-    var c = textureLoad(frame_hdr, q, 0).rgb;
+    var c = frame_pixels[u32(q.y) * display.source_size.x + u32(q.x)].rgb;
     // A NaN shows as black, as `encode_srgb` on the CPU.
     c = select(c, vec3<f32>(0.0), c != c);
     c = map_into_gamut(c) * exposure;

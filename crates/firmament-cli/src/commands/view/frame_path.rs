@@ -1,0 +1,255 @@
+//! The viewer's frame: the scene's sky drawn by the GPU backend into an HDR frame buffer
+//! (`RenderSky::encode_frame`, the same pipeline and dispatch `firmament render --backend
+//! gpu` reads back), then exposed and tone-mapped on the GPU into the window or an offscreen target
+//! (`firmament_gpu::display`). No readback in the frame loop; captures read the textures.
+//! The same path draws in the window and offscreen (tests, `--screenshot` without one).
+
+use anyhow::{Context, Result};
+use firmament::render::{Frame, RenderSettings};
+use firmament::scene::sky_lights::SkySources;
+use firmament_gpu::display::{
+    hdr_buffer, read_hdr_frame, read_rgba8, Display, DisplaySettings, Exposure,
+};
+use firmament_gpu::RenderTarget;
+
+use super::state::ViewState;
+use crate::backend::{gpu_failure, Backend, RenderSky};
+use crate::commands::render::{atmosphere_args, sources_of_scene};
+use crate::method::Method;
+
+/// What the sky's tables depend on: rebuilt when it changes.
+#[derive(Clone, Debug, PartialEq)]
+struct SkyKey {
+    method: Method,
+    preset: String,
+    file: Option<std::path::PathBuf>,
+    wavelengths: Option<String>,
+}
+
+impl SkyKey {
+    fn of(state: &ViewState) -> SkyKey {
+        let a = &state.scene.atmosphere;
+        SkyKey {
+            method: state.method,
+            preset: a.preset.clone(),
+            file: a.file.clone(),
+            wavelengths: a.wavelengths.clone(),
+        }
+    }
+}
+
+/// The viewer's GPU frame path.
+pub struct FramePath {
+    backend: &'static Backend,
+    /// Baked 4D tables for the first atmosphere (`--tables`), and the table sizes of fresh
+    /// ones.
+    tables: Option<(SkyKey, std::path::PathBuf)>,
+    table_size: String,
+    sky: Option<(SkyKey, RenderSky<'static>)>,
+    display: Display,
+    /// The HDR frame buffer and its size.
+    hdr: Option<(wgpu::Buffer, (u32, u32))>,
+    /// Seconds the last sky build took (for the panel).
+    pub last_build_s: f64,
+}
+
+/// The size the sky is drawn at for a target of `size` pixels.
+pub fn render_size(state: &ViewState, size: (u32, u32)) -> (u32, u32) {
+    let s = state.render_scale.clamp(0.1, 1.0);
+    (
+        ((size.0 as f64 * s).round() as u32).max(1),
+        ((size.1 as f64 * s).round() as u32).max(1),
+    )
+}
+
+impl FramePath {
+    /// A frame path on the backend's GPU (`backend` must be a GPU one); `tables` (baked
+    /// by `firmament bake`) serve the 4D method while the atmosphere is `state`'s, and
+    /// fresh tables have `table_size` (`default` or `small`).
+    pub fn new(
+        backend: &'static Backend,
+        state: &ViewState,
+        tables: Option<std::path::PathBuf>,
+        table_size: &str,
+    ) -> Result<FramePath> {
+        let Backend::Gpu(gpu) = backend else {
+            anyhow::bail!("the viewer draws on the GPU");
+        };
+        let display = Display::new(&gpu.ctx).map_err(|e| gpu_failure("the display pass", e))?;
+        Ok(FramePath {
+            backend,
+            tables: tables.map(|t| (SkyKey::of(state), t)),
+            table_size: table_size.to_string(),
+            sky: None,
+            display,
+            hdr: None,
+            last_build_s: 0.0,
+        })
+    }
+
+    fn ctx(&self) -> &firmament_gpu::GpuContext {
+        match self.backend {
+            Backend::Gpu(gpu) => &gpu.ctx,
+            Backend::Cpu => unreachable!("FramePath::new refuses the CPU"),
+        }
+    }
+
+    /// Build the sky when the method or the atmosphere changed; returns whether it did. On
+    /// a software rasteriser the 4D tables come from the CPU (and its cache).
+    pub fn ensure_sky(&mut self, state: &ViewState) -> Result<bool> {
+        let key = SkyKey::of(state);
+        if self.sky.as_ref().is_some_and(|(k, _)| *k == key) {
+            return Ok(false);
+        }
+        let started = std::time::Instant::now();
+        // The baked tables while the atmosphere is theirs (any method reads them as 4D).
+        let tables = self.tables.as_ref().and_then(|(k, path)| {
+            let same =
+                k.preset == key.preset && k.file == key.file && k.wavelengths == key.wavelengths;
+            (same && key.method == Method::Bruneton4d).then(|| path.clone())
+        });
+        let mut atmosphere = atmosphere_args(&state.scene, tables, &self.table_size, false);
+        if atmosphere.tables.is_some() {
+            // The file's wavelengths.
+            atmosphere.wavelengths = None;
+        }
+        let software = self.ctx().is_software();
+        let sky =
+            RenderSky::with_tables_from(self.backend, &atmosphere, key.method, true, software)
+                .with_context(|| format!("building the {} sky", key.method.name()))?;
+        self.last_build_s = started.elapsed().as_secs_f64();
+        self.sky = Some((key, sky));
+        Ok(true)
+    }
+
+    /// The sky in use (after [`FramePath::ensure_sky`]).
+    pub fn sky(&self) -> Option<&RenderSky<'static>> {
+        self.sky.as_ref().map(|(_, s)| s)
+    }
+
+    /// The lights, glow and stars of the scene (from its date and place, or its sun).
+    pub fn sources(&self, state: &ViewState) -> Result<SkySources> {
+        let sky = self.sky().context("no sky yet")?;
+        sources_of_scene(sky.model(), &state.scene)
+    }
+
+    /// Record a frame of `state` for a target of `target_size`: the sky into the HDR
+    /// frame buffer at the render scale, then the display into `target`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        state: &ViewState,
+        sources: &SkySources,
+        target: &wgpu::TextureView,
+        target_format: wgpu::TextureFormat,
+        target_size: (u32, u32),
+        display: DisplaySettings,
+    ) -> Result<()> {
+        let size = render_size(state, target_size);
+        if self.hdr.as_ref().is_none_or(|(_, s)| *s != size) {
+            self.hdr = Some((hdr_buffer(self.ctx(), size.0, size.1), size));
+        }
+        let (hdr, _) = self.hdr.as_ref().expect("just made");
+        let settings = RenderSettings {
+            camera: &state.scene.camera,
+            width: size.0 as usize,
+            height: size.1 as usize,
+            white_balance: state.scene.output.white_balance,
+        };
+        let sky = self.sky().context("no sky yet")?;
+        sky.encode_frame(encoder, &settings, sources, RenderTarget::Buffer(hdr))?;
+        self.display.encode(
+            self.ctx(),
+            encoder,
+            hdr,
+            size,
+            target,
+            target_format,
+            target_size,
+            &display,
+        );
+        Ok(())
+    }
+
+    /// The last frame's HDR pixels (linear sRGB, Y in cd/m²), for EXR captures and tests.
+    pub fn hdr_frame(&self) -> Result<Frame> {
+        let (hdr, (w, h)) = self.hdr.as_ref().context("no frame drawn yet")?;
+        read_hdr_frame(self.ctx(), hdr, *w, *h)
+            .map_err(|e| gpu_failure("reading the frame back", e))
+    }
+
+    /// The EV100 the last frame was shown at.
+    pub fn shown_ev100(&self) -> Result<f64> {
+        Ok(self
+            .display
+            .read_exposure(self.ctx())
+            .map_err(|e| gpu_failure("reading the exposure back", e))?
+            .ev100)
+    }
+
+    /// Draw one frame of `state` offscreen at `size` (the same path as the window's) and
+    /// return the HDR frame and the displayed 8-bit RGBA pixels.
+    pub fn draw_offscreen(
+        &mut self,
+        state: &ViewState,
+        size: (u32, u32),
+        display: DisplaySettings,
+    ) -> Result<(Frame, Vec<[u8; 4]>)> {
+        self.ensure_sky(state)?;
+        let sources = self.sources(state)?;
+        let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+        let target = self
+            .ctx()
+            .device()
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some("offscreen display"),
+                size: wgpu::Extent3d {
+                    width: size.0,
+                    height: size.1,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            });
+        let mut encoder =
+            self.ctx()
+                .device()
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("viewer frame"),
+                });
+        self.encode(
+            &mut encoder,
+            state,
+            &sources,
+            &target.create_view(&Default::default()),
+            format,
+            size,
+            display,
+        )?;
+        self.ctx().queue().submit([encoder.finish()]);
+        let pixels = read_rgba8(self.ctx(), &target)
+            .map_err(|e| gpu_failure("reading the display back", e))?;
+        Ok((self.hdr_frame()?, pixels))
+    }
+}
+
+/// The display settings of the state's exposure: the scene's EV100 when it has one, else
+/// automatic with the state's adaptation.
+pub fn display_settings(state: &ViewState, dt_s: f64, reset: bool) -> DisplaySettings {
+    DisplaySettings {
+        exposure: match state.scene.output.ev100 {
+            Some(ev100) => Exposure::Manual { ev100 },
+            None => Exposure::Automatic {
+                tau_s: state.adapt_tau_s,
+            },
+        },
+        curve: state.scene.output.tonemap,
+        dt_s,
+        reset,
+    }
+}

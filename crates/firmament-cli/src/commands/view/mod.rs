@@ -1,0 +1,222 @@
+//! `firmament view`: the scene drawn live by the GPU backend in a window, with a panel to
+//! move the sun or the clock, fly the camera, switch the sky method, change the atmosphere
+//! and the exposure, and capture the view (PNG as shown, EXR in cd/m², the scene as TOML for
+//! `firmament render`). `--offscreen` draws the same frame path without a window.
+//!
+//! - `state.rs`: what is shown (a scene file, the method, the viewer's settings);
+//! - `controls.rs`, `presets.rs`: the camera under the keys and the mouse, named views;
+//! - `frame_path.rs`: the sky into an HDR texture, the display pass into the target;
+//! - `panel.rs`: the egui panel; `window.rs`: winit, the surface, egui; `capture.rs`: files.
+
+pub mod capture;
+pub mod controls;
+pub mod frame_path;
+pub mod panel;
+pub mod presets;
+pub mod state;
+pub mod window;
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use firmament::scene::SceneFile;
+
+use crate::backend::{Backend, Gpu};
+use crate::method::Method;
+use capture::CaptureKind;
+use frame_path::{display_settings, FramePath};
+use state::ViewState;
+
+/// Arguments of `firmament view`.
+#[derive(Args, Debug, Clone)]
+pub struct ViewArgs {
+    /// Scene file (TOML, as `firmament render --scene` reads it). Without one: the default
+    /// scene's golden hour, without its terrain.
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
+    /// The sky method drawing the view: bruneton4d (`lut`), hillaire2020, elek3d.
+    #[arg(long, value_enum, default_value_t = Method::Bruneton4d)]
+    pub method: Method,
+    /// Window width (pixels).
+    #[arg(long, default_value_t = 1280)]
+    pub width: u32,
+    /// Window height (pixels).
+    #[arg(long, default_value_t = 720)]
+    pub height: u32,
+    /// The fraction of the window's size the sky is drawn at, 0.1–1 (default: 1 on a GPU,
+    /// 0.5 on a software rasteriser).
+    #[arg(long, value_name = "0.1-1")]
+    pub render_scale: Option<f64>,
+    /// Draw this many frames, write `--screenshot`, and exit.
+    #[arg(long, value_name = "N")]
+    pub frames: Option<u32>,
+    /// With --frames: write the last frame to this file, `.png` (what the window shows) or
+    /// `.exr` (linear, Y in cd/m²); may be given twice.
+    #[arg(long, value_name = "OUT.png|OUT.exr")]
+    pub screenshot: Vec<PathBuf>,
+    /// Draw without a window (the same frame path; no panel): needs --frames.
+    #[arg(long)]
+    pub offscreen: bool,
+    /// With --frames: also write the view's scene (TOML) here, as Ctrl+S does:
+    /// `firmament render --scene FILE` draws it offline.
+    #[arg(long, value_name = "FILE.toml")]
+    pub save_scene: Option<PathBuf>,
+    /// Precomputed 4D tables from `firmament bake` for the scene's atmosphere (must match
+    /// it); without them the tables are computed (on the CPU through the table cache on a
+    /// software rasteriser, on the GPU otherwise).
+    #[arg(long, value_name = "FILE")]
+    pub tables: Option<PathBuf>,
+    /// Table sizes when no --tables are given: `default` or `small` (fast, coarse).
+    #[arg(long, default_value = "default", value_name = "default|small")]
+    pub table_size: String,
+    /// Where F12's captures and Ctrl+S's scenes are written.
+    #[arg(long, default_value = ".", value_name = "DIR")]
+    pub capture_dir: PathBuf,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// The scene the viewer starts from, and what of it the viewer does not draw yet.
+pub fn load_scene(path: Option<&PathBuf>) -> Result<(SceneFile, Vec<String>)> {
+    let mut scene = match path {
+        Some(p) => SceneFile::from_file(p)?,
+        None => state::default_scene(),
+    };
+    let mut not_drawn = Vec::new();
+    if scene.terrain.take().is_some() {
+        not_drawn
+            .push("the scene's terrain: `firmament render` draws it, the viewer not yet".into());
+    }
+    if !scene.clouds.is_empty() {
+        scene.clouds.clear();
+        not_drawn
+            .push("the scene's clouds: `firmament render` draws them, the viewer not yet".into());
+    }
+    if scene.surface.take().is_some() {
+        not_drawn.push(
+            "the planet's surface map: `firmament render` draws it, the viewer not yet".into(),
+        );
+    }
+    not_drawn
+        .push("stars: splatted on the CPU by `firmament render`, not in the viewer yet".into());
+    Ok((scene, not_drawn))
+}
+
+fn check(args: &ViewArgs) -> Result<()> {
+    if args.method == Method::Reference {
+        anyhow::bail!("invalid value for `--method`: reference (accepted in the viewer: bruneton4d, hillaire2020, elek3d; the reference's progressive path tracing is not in the viewer yet)");
+    }
+    if let Some(s) = args.render_scale {
+        if !(0.1..=1.0).contains(&s) {
+            anyhow::bail!("invalid value for `--render-scale`: {s} (accepted: 0.1 to 1)");
+        }
+    }
+    for (name, v) in [("--width", args.width), ("--height", args.height)] {
+        if !(16..=8192).contains(&v) {
+            anyhow::bail!("invalid value for `{name}`: {v} (accepted: 16 to 8192)");
+        }
+    }
+    if args.frames == Some(0) {
+        anyhow::bail!("invalid value for `--frames`: 0 (accepted: 1 or more)");
+    }
+    if !args.screenshot.is_empty() && args.frames.is_none() {
+        anyhow::bail!("`--screenshot` is written after `--frames N`: give both");
+    }
+    if args.save_scene.is_some() && args.frames.is_none() {
+        anyhow::bail!(
+            "`--save-scene` is written after `--frames N`: give both (in the window, Ctrl+S saves)"
+        );
+    }
+    if !matches!(args.table_size.as_str(), "default" | "small") {
+        anyhow::bail!(
+            "invalid value for `--table-size`: {} (accepted: default, small)",
+            args.table_size
+        );
+    }
+    if args.offscreen && args.frames.is_none() {
+        anyhow::bail!("`--offscreen` draws `--frames N` and exits: give --frames");
+    }
+    for p in &args.screenshot {
+        CaptureKind::of(p)?;
+        crate::common::check_output_dir(p, "--screenshot")?;
+    }
+    if let Some(p) = &args.save_scene {
+        crate::common::check_output_dir(p, "--save-scene")?;
+    }
+    Ok(())
+}
+
+/// Run `firmament view`.
+pub fn run(args: &ViewArgs) -> Result<()> {
+    check(args)?;
+    let (scene, not_drawn) = load_scene(args.scene.as_ref())?;
+    if !args.quiet {
+        for line in &not_drawn {
+            eprintln!("note: {line}");
+        }
+    }
+    let mut state = ViewState::new(scene, args.method, false);
+    if let Some(s) = args.render_scale {
+        state.render_scale = s;
+    }
+    if args.offscreen {
+        return run_offscreen(args, state);
+    }
+    window::run(args.clone(), state, not_drawn)
+}
+
+/// `--offscreen`: the window's frame path without a window.
+fn run_offscreen(args: &ViewArgs, mut state: ViewState) -> Result<()> {
+    let gpu = Gpu::open().context("`firmament view`")?;
+    if !args.quiet {
+        eprintln!("backend: gpu ({}), offscreen", gpu.describe());
+    }
+    if args.render_scale.is_none() && gpu.ctx.is_software() {
+        state.render_scale = 0.5;
+    }
+    let backend: &'static Backend = Box::leak(Box::new(Backend::Gpu(Box::new(gpu))));
+    let mut path = FramePath::new(backend, &state, args.tables.clone(), &args.table_size)?;
+    let frames = args.frames.unwrap_or(1);
+    let size = (args.width, args.height);
+    let mut last = None;
+    let started = std::time::Instant::now();
+    for i in 0..frames {
+        let display = display_settings(&state, 1.0 / 60.0, i == 0);
+        last = Some(path.draw_offscreen(&state, size, display)?);
+    }
+    if !args.quiet {
+        eprintln!(
+            "view: {frames} frame(s) of {}×{} ({} drawn at {}×{}) in {:.2} s",
+            size.0,
+            size.1,
+            state.method.name(),
+            frame_path::render_size(&state, size).0,
+            frame_path::render_size(&state, size).1,
+            started.elapsed().as_secs_f64()
+        );
+    }
+    let (hdr, shown) = last.expect("at least one frame");
+    let ev100 = path.shown_ev100()?;
+    for p in &args.screenshot {
+        match CaptureKind::of(p)? {
+            CaptureKind::Png => capture::write_png(p, size, &shown)?,
+            CaptureKind::Exr => capture::write_exr(p, &hdr, &state, ev100)?,
+        }
+        if !args.quiet {
+            eprintln!("wrote {}", p.display());
+        }
+    }
+    if let Some(p) = &args.save_scene {
+        capture::write_scene(p, &state, size)?;
+        if !args.quiet {
+            eprintln!(
+                "wrote {}: {}",
+                p.display(),
+                state.render_command(&p.display().to_string())
+            );
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,336 @@
+//! The viewer's panel (egui): the method, the sun or the date, the camera and its presets,
+//! the atmosphere, the exposure, the capture buttons and the timings. It edits a
+//! [`ViewState`] and reports what was asked; it draws nothing itself, so it is tested
+//! headlessly (`egui_kittest`, below).
+
+use firmament::render::tonemap::ToneCurve;
+
+use super::presets::PRESETS as VIEW_PRESETS;
+use super::state::{ViewState, MAX_ALTITUDE_M, PRESETS, VIEW_METHODS};
+
+/// What the panel asked for this frame, besides editing the state.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PanelActions {
+    pub screenshot: bool,
+    pub save_scene: bool,
+}
+
+/// What the panel shows besides the state.
+#[derive(Clone, Debug, Default)]
+pub struct PanelInfo {
+    /// The adapter in words.
+    pub adapter: String,
+    /// The last frame's time on the CPU clock, submission to submission (ms).
+    pub frame_ms: f64,
+    /// The GPU's time for the sky's dispatch and the display (ms), when measured.
+    pub gpu_ms: Option<(f64, f64)>,
+    /// The size the sky is drawn at.
+    pub render_size: (u32, u32),
+    /// The EV100 the frame was shown at.
+    pub shown_ev100: Option<f64>,
+    /// Seconds the sky's tables took to build last.
+    pub build_s: f64,
+    /// A line about the last capture or save, or an error.
+    pub message: String,
+    /// What the scene has that the viewer does not draw yet.
+    pub not_drawn: Vec<String>,
+}
+
+/// Draw the panel into `ui`, editing `state`.
+pub fn panel(ui: &mut egui::Ui, state: &mut ViewState, info: &PanelInfo) -> PanelActions {
+    let mut actions = PanelActions::default();
+    ui.heading("firmament");
+    ui.label(format!(
+        "drawing: {} on {}",
+        state.method.name(),
+        if info.adapter.is_empty() {
+            "the GPU"
+        } else {
+            &info.adapter
+        }
+    ));
+    ui.horizontal(|ui| {
+        for m in VIEW_METHODS {
+            ui.radio_value(&mut state.method, m, m.name());
+        }
+    });
+    ui.separator();
+    sun_section(ui, state);
+    ui.separator();
+    camera_section(ui, state);
+    ui.separator();
+    ui.label("Atmosphere");
+    ui.horizontal_wrapped(|ui| {
+        for p in PRESETS {
+            let on = state.scene.atmosphere.file.is_none() && state.scene.atmosphere.preset == p;
+            if ui.selectable_label(on, p).clicked() {
+                state.scene.atmosphere.preset = p.to_string();
+                state.scene.atmosphere.file = None;
+            }
+        }
+    });
+    ui.horizontal(|ui| {
+        ui.label("wavelengths");
+        let w = &mut state.scene.atmosphere.wavelengths;
+        for (label, value) in [("spectral (16)", "spectral"), ("rgb (3)", "rgb")] {
+            let on = w.as_deref().unwrap_or("spectral") == value;
+            if ui.selectable_label(on, label).clicked() {
+                *w = Some(value.to_string());
+            }
+        }
+    });
+    ui.separator();
+    exposure_section(ui, state, info);
+    ui.separator();
+    ui.horizontal(|ui| {
+        if ui.button("Screenshot (F12)").clicked() {
+            actions.screenshot = true;
+        }
+        if ui.button("Save scene (Ctrl+S)").clicked() {
+            actions.save_scene = true;
+        }
+    });
+    if !info.message.is_empty() {
+        ui.label(&info.message);
+    }
+    ui.separator();
+    ui.label(format!(
+        "frame {:.1} ms · sky {}×{}{}",
+        info.frame_ms,
+        info.render_size.0,
+        info.render_size.1,
+        match info.gpu_ms {
+            Some((sky, display)) => format!(" · GPU: sky {sky:.2} ms, display {display:.2} ms"),
+            None => String::new(),
+        }
+    ));
+    ui.label(format!("tables built in {:.2} s", info.build_s));
+    for line in &info.not_drawn {
+        ui.small(line);
+    }
+    actions
+}
+
+fn sun_section(ui: &mut egui::Ui, state: &mut ViewState) {
+    if state.dated() {
+        let at = state
+            .scene
+            .time
+            .as_ref()
+            .map(|t| t.at.clone())
+            .unwrap_or_default();
+        ui.label(format!("Time: {at}"));
+        ui.horizontal(|ui| {
+            for (label, hours) in [
+                ("−1 h", -1.0),
+                ("−10 min", -1.0 / 6.0),
+                ("+10 min", 1.0 / 6.0),
+                ("+1 h", 1.0),
+            ] {
+                if ui.button(label).clicked() {
+                    // A date the ephemerides refuse stays where it was.
+                    let _ = state.shift_time(hours);
+                }
+            }
+        });
+    } else {
+        ui.label("Sun (drag with the right mouse button)");
+        let mut elevation = state.sun_elevation_deg();
+        let mut azimuth = state.scene.sun.azimuth_deg;
+        let e = ui.add(egui::Slider::new(&mut elevation, -18.0..=90.0).text("elevation °"));
+        let a = ui.add(egui::Slider::new(&mut azimuth, 0.0..=360.0).text("azimuth °"));
+        if e.changed() || a.changed() {
+            state.set_sun(elevation, azimuth);
+        }
+    }
+    ui.horizontal(|ui| {
+        let label = if state.playing { "Pause" } else { "Play" };
+        if ui.button(label).clicked() {
+            state.playing = !state.playing;
+        }
+        ui.add(
+            egui::Slider::new(&mut state.hours_per_second, 0.01..=2.0)
+                .logarithmic(true)
+                .text("h/s"),
+        );
+    });
+    ui.checkbox(&mut state.scene.sun.disk, "sun disk");
+}
+
+fn camera_section(ui: &mut egui::Ui, state: &mut ViewState) {
+    ui.label("Camera (drag: look · W/S E/Q: fly · Shift: faster · wheel: zoom)");
+    let c = &mut state.scene.camera;
+    let mut altitude = c.altitude_m;
+    if ui
+        .add(
+            egui::Slider::new(&mut altitude, 2.0..=MAX_ALTITUDE_M)
+                .logarithmic(true)
+                .text("altitude m"),
+        )
+        .changed()
+    {
+        state.set_altitude(altitude);
+    }
+    let c = &mut state.scene.camera;
+    ui.add(egui::Slider::new(&mut c.heading_deg, 0.0..=360.0).text("heading °"));
+    ui.add(egui::Slider::new(&mut c.pitch_deg, -89.0..=89.0).text("pitch °"));
+    ui.add(egui::Slider::new(&mut c.fov_deg, 5.0..=120.0).text("field of view °"));
+    ui.horizontal_wrapped(|ui| {
+        for p in VIEW_PRESETS {
+            if ui.button(p.name).clicked() {
+                p.apply(state);
+            }
+        }
+    });
+}
+
+fn exposure_section(ui: &mut egui::Ui, state: &mut ViewState, info: &PanelInfo) {
+    let mut automatic = state.scene.output.ev100.is_none();
+    if ui.checkbox(&mut automatic, "automatic exposure").changed() {
+        state.scene.output.ev100 = if automatic {
+            None
+        } else {
+            Some(info.shown_ev100.unwrap_or(12.0))
+        };
+    }
+    match &mut state.scene.output.ev100 {
+        Some(ev) => {
+            ui.add(egui::Slider::new(ev, -8.0..=20.0).text("EV100"));
+        }
+        None => {
+            ui.add(egui::Slider::new(&mut state.adapt_tau_s, 0.0..=5.0).text("adaptation s"));
+            if let Some(ev) = info.shown_ev100 {
+                ui.label(format!("EV100 {ev:.2}"));
+            }
+        }
+    }
+    ui.horizontal(|ui| {
+        ui.label("tone curve");
+        for (label, curve) in [
+            ("ACES", ToneCurve::Aces),
+            ("filmic", ToneCurve::Filmic),
+            ("clamp", ToneCurve::Clamp),
+        ] {
+            if ui
+                .selectable_label(state.scene.output.tonemap == curve, label)
+                .clicked()
+            {
+                state.set_curve(curve);
+            }
+        }
+    });
+    ui.add(egui::Slider::new(&mut state.render_scale, 0.1..=1.0).text("render scale"));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::method::Method;
+    use egui_kittest::kittest::Queryable;
+    use egui_kittest::Harness;
+
+    fn state() -> ViewState {
+        ViewState::new(
+            super::super::state::default_scene(),
+            Method::Bruneton4d,
+            true,
+        )
+    }
+
+    fn harness(state: ViewState) -> Harness<'static, ViewState> {
+        Harness::new_ui_state(
+            |ui, s: &mut ViewState| {
+                egui::ScrollArea::vertical().show(ui, |ui| {
+                    panel(ui, s, &PanelInfo::default());
+                });
+            },
+            state,
+        )
+    }
+
+    #[test]
+    fn the_method_the_atmosphere_and_the_curve_follow_the_clicks() {
+        let mut h = harness(state());
+        h.get_by_label("hillaire2020").click();
+        h.run();
+        assert_eq!(h.state().method, Method::Hillaire2020);
+        h.get_by_label("hazy").click();
+        h.get_by_label("rgb (3)").click();
+        h.run();
+        assert_eq!(h.state().scene.atmosphere.preset, "hazy");
+        assert_eq!(
+            h.state().scene.atmosphere.wavelengths.as_deref(),
+            Some("rgb")
+        );
+        h.get_by_label("filmic").click();
+        h.run();
+        assert_eq!(h.state().scene.output.tonemap, ToneCurve::Filmic);
+    }
+
+    #[test]
+    fn play_presets_and_exposure_change_the_scene() {
+        let mut h = harness(state());
+        h.get_by_label("Play").click();
+        h.run();
+        assert!(h.state().playing);
+        h.get_by_label("orbit").click();
+        h.run();
+        assert!(h.state().scene.camera.altitude_m > 1.0e6);
+        assert!(h.state().scene.camera.pitch_deg < -80.0);
+        // Manual exposure starts where the automatic one was shown (12 without a frame).
+        h.get_by_label("automatic exposure").click();
+        h.run();
+        assert_eq!(h.state().scene.output.ev100, Some(12.0));
+        h.get_by_label("automatic exposure").click();
+        h.run();
+        assert_eq!(h.state().scene.output.ev100, None);
+    }
+
+    #[test]
+    fn the_buttons_report_captures_and_dates_move_by_the_hour() {
+        let mut s = state();
+        s.scene.location = Some(firmament::scene::file::SceneLocation {
+            lat_deg: 48.0,
+            lon_deg: 2.0,
+            elevation_m: 0.0,
+            pressure_hpa: 1013.25,
+            temperature_c: 10.0,
+        });
+        s.scene.time = Some(firmament::scene::file::SceneTime {
+            at: "2026-03-20T18:00:00Z".into(),
+            moon_disk: true,
+        });
+        let asked = std::rc::Rc::new(std::cell::Cell::new(PanelActions::default()));
+        let seen = asked.clone();
+        let mut h = Harness::new_ui_state(
+            move |ui, s: &mut ViewState| {
+                let a = panel(ui, s, &PanelInfo::default());
+                let mut all = seen.get();
+                all.screenshot |= a.screenshot;
+                all.save_scene |= a.save_scene;
+                seen.set(all);
+            },
+            s,
+        );
+        h.get_by_label("+1 h").click();
+        h.run();
+        assert!(h
+            .state()
+            .scene
+            .time
+            .as_ref()
+            .unwrap()
+            .at
+            .starts_with("2026-03-20T19:00:00"));
+        h.get_by_label("Screenshot (F12)").click();
+        h.get_by_label("Save scene (Ctrl+S)").click();
+        h.run();
+        assert_eq!(
+            asked.get(),
+            PanelActions {
+                screenshot: true,
+                save_scene: true
+            }
+        );
+    }
+}

@@ -1,0 +1,233 @@
+//! `firmament view` end to end: the viewer's frame path offscreen against `firmament
+//! render` of the scene it saved (same tables, same method), the real window under Xvfb
+//! against the offscreen frame, and its refusals.
+//!
+//! GPU tests open an adapter first (`firmament_gpu::test_context()`): without one they skip,
+//! saying so, unless `CI` is set, where they fail. The window test needs `xvfb-run` (Debian's
+//! `xvfb`): without it, it skips outside CI and fails in CI.
+
+mod common;
+
+use std::path::Path;
+use std::process::Command;
+use std::sync::{Mutex, MutexGuard, OnceLock};
+
+use common::{fails_with, run, succeeds, tables_arg, tmp_subdir};
+
+fn gpu() -> Option<MutexGuard<'static, ()>> {
+    static AVAILABLE: OnceLock<bool> = OnceLock::new();
+    static LOCK: Mutex<()> = Mutex::new(());
+    let available = *AVAILABLE.get_or_init(|| firmament_gpu::test_context().is_some());
+    available.then(|| LOCK.lock().unwrap_or_else(|e| e.into_inner()))
+}
+
+fn luminance(p: &[f32; 3]) -> f64 {
+    0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64
+}
+
+/// Mean absolute difference of two 8-bit images over columns `from_x..`.
+fn mean_code_diff(a: &Path, b: &Path, from_x: usize) -> f64 {
+    let (wa, ha, pa) = firmament::io::read_png_srgb8(a).unwrap();
+    let (wb, hb, pb) = firmament::io::read_png_srgb8(b).unwrap();
+    assert_eq!((wa, ha), (wb, hb));
+    let mut sum = 0.0;
+    let mut n = 0usize;
+    for y in 0..ha {
+        for x in from_x..wa {
+            let (p, q) = (pa[y * wa + x], pb[y * wa + x]);
+            for k in 0..3 {
+                sum += (p[k] as f64 - q[k] as f64).abs();
+                n += 1;
+            }
+        }
+    }
+    sum / n as f64
+}
+
+/// The offscreen viewer's 192×108 frame, its scene saved.
+fn offscreen(dir: &Path, size: (u32, u32), method: &str) -> std::process::Output {
+    run(&[
+        "view",
+        "--offscreen",
+        "--frames",
+        "2",
+        "--width",
+        &size.0.to_string(),
+        "--height",
+        &size.1.to_string(),
+        "--render-scale",
+        "1",
+        "--method",
+        method,
+        "--tables",
+        tables_arg(),
+        "--screenshot",
+        dir.join("view.exr").to_str().unwrap(),
+        "--screenshot",
+        dir.join("view.png").to_str().unwrap(),
+        "--save-scene",
+        dir.join("scene.toml").to_str().unwrap(),
+    ])
+}
+
+#[test]
+fn the_viewers_frame_is_what_render_draws_of_its_saved_scene() {
+    let Some(_gpu) = gpu() else { return };
+    let dir = tmp_subdir("view-vs-render");
+    let o = offscreen(&dir, (192, 108), "bruneton4d");
+    succeeds(&o);
+    let r = run(&[
+        "render",
+        "--scene",
+        dir.join("scene.toml").to_str().unwrap(),
+        "--tables",
+        tables_arg(),
+        "--backend",
+        "gpu",
+        "--method",
+        "bruneton4d",
+        "--out",
+        dir.join("render.exr").to_str().unwrap(),
+        "--out",
+        dir.join("render.png").to_str().unwrap(),
+    ]);
+    succeeds(&r);
+    let v = firmament::io::read_exr(dir.join("view.exr")).unwrap();
+    let c = firmament::io::read_exr(dir.join("render.exr")).unwrap();
+    assert_eq!((v.width, v.height), (192, 108));
+    assert_eq!((c.width, c.height), (192, 108));
+    // The sun's disk is about one pixel here: `render` splats a disk under four pixels as a
+    // point on the CPU, the viewer draws it on the GPU (no CPU pass in its frame loop), so
+    // the disk's few pixels (above 10⁶ cd/m², where no sky is) are compared apart.
+    let disk = 1.0e6;
+    let (mut sv, mut sc, mut rel, mut n, mut dv, mut dc) = (0.0, 0.0, 0.0, 0usize, 0.0, 0.0);
+    for (p, q) in v.data.iter().zip(&c.data) {
+        let (a, b) = (luminance(p), luminance(q));
+        if a > disk || b > disk {
+            dv += a;
+            dc += b;
+            continue;
+        }
+        sv += a;
+        sc += b;
+        if b > 0.0 {
+            rel += (a - b).abs() / b;
+            n += 1;
+        }
+    }
+    let mean_ratio = sv / sc - 1.0;
+    let mean_rel = rel / n as f64;
+    eprintln!(
+        "view vs render: mean luminance {mean_ratio:+.2e}, mean |ΔL|/L {mean_rel:.2e}; the disk's pixels' sum {:+.3}",
+        dv / dc - 1.0
+    );
+    assert!(mean_ratio.abs() <= 0.01, "mean luminance {mean_ratio:+.4}");
+    assert!(
+        mean_rel <= 0.01,
+        "mean relative luminance difference {mean_rel:.4}"
+    );
+    // Both exposed automatically from the same frame: the displays agree to a code or two
+    // (the GPU's curve in f32 against the CPU's dithered one).
+    let d = mean_code_diff(&dir.join("view.png"), &dir.join("render.png"), 0);
+    eprintln!("view vs render PNG: mean |Δcode| {d:.3}");
+    assert!(d <= 1.5, "mean code difference {d}");
+    // The saved scene is a scene file render reads, with the viewer's size.
+    let text = std::fs::read_to_string(dir.join("scene.toml")).unwrap();
+    assert!(text.contains("width = 192"), "{text}");
+}
+
+#[test]
+fn the_window_draws_and_captures_what_the_offscreen_path_draws() {
+    let Some(_gpu) = gpu() else { return };
+    let have_xvfb = Command::new("xvfb-run").arg("--help").output().is_ok();
+    if !have_xvfb {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI is set but xvfb-run is missing (apt-get install xvfb)"
+        );
+        eprintln!("skipping the window test: no xvfb-run");
+        return;
+    }
+    let dir = tmp_subdir("view-window");
+    let (w, h) = (640u32, 240u32);
+    let shot = dir.join("window.png");
+    let o = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24"])
+        .arg(env!("CARGO_BIN_EXE_firmament"))
+        .env("FIRMAMENT_CACHE_DIR", common::cache_dir())
+        .args([
+            "view",
+            "--frames",
+            "3",
+            "--width",
+            &w.to_string(),
+            "--height",
+            &h.to_string(),
+            "--render-scale",
+            "1",
+            "--tables",
+            tables_arg(),
+            "--screenshot",
+            shot.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    succeeds(&o);
+    let off = offscreen(&dir, (w, h), "bruneton4d");
+    succeeds(&off);
+    // Not blank: the sky's rows differ from the ground's, and the panel is there.
+    let (_, _, px) = firmament::io::read_png_srgb8(&shot).unwrap();
+    let lum = |p: [u8; 3]| p.iter().map(|&c| c as f64).sum::<f64>();
+    let (lo, hi) = px.iter().fold((f64::MAX, 0f64), |(lo, hi), &p| {
+        (lo.min(lum(p)), hi.max(lum(p)))
+    });
+    assert!(hi - lo > 200.0, "a blank capture: codes {lo}..{hi}");
+    // Right of the panel (330 points wide at scale 1) the window shows the offscreen frame.
+    let d = mean_code_diff(&shot, &dir.join("view.png"), 400);
+    eprintln!("window vs offscreen: mean |Δcode| {d:.3} right of the panel");
+    assert!(
+        d <= 1.0,
+        "the window's view differs from the offscreen frame: {d}"
+    );
+}
+
+#[test]
+fn the_viewer_refuses_what_it_cannot_do() {
+    let dir = tmp_subdir("view-refusals");
+    fails_with(
+        &run(&[
+            "view",
+            "--method",
+            "reference",
+            "--offscreen",
+            "--frames",
+            "1",
+        ]),
+        &["--method", "reference", "bruneton4d, hillaire2020, elek3d"],
+    );
+    let jpg = dir.join("shot.jpg");
+    fails_with(
+        &run(&[
+            "view",
+            "--offscreen",
+            "--frames",
+            "1",
+            "--screenshot",
+            jpg.to_str().unwrap(),
+        ]),
+        &["--screenshot", ".png or .exr"],
+    );
+    fails_with(&run(&["view", "--offscreen"]), &["--frames"]);
+    fails_with(
+        &run(&[
+            "view",
+            "--offscreen",
+            "--frames",
+            "1",
+            "--render-scale",
+            "3",
+        ]),
+        &["--render-scale", "0.1 to 1"],
+    );
+    assert!(!jpg.exists());
+}
