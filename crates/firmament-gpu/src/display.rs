@@ -226,8 +226,11 @@ impl Display {
     }
 
     /// Record the exposure pass over `hdr` (a `width`×`height` frame buffer, 16 bytes per
-    /// pixel as [`crate::RenderTarget::Buffer`] holds it) and the display of it into `target` (any colour format; a UNORM
-    /// one receives sRGB codes, an sRGB one linear values it encodes itself).
+    /// pixel as [`crate::RenderTarget::Buffer`] holds it) and the display of it into
+    /// `target` (any colour format; a UNORM one receives sRGB codes, an sRGB one linear
+    /// values it encodes itself). With
+    /// `timestamps` (a set of [`crate::pass_timer::PASS_QUERIES`]) the exposure pass
+    /// writes slots 4–5 and the tone mapping 6–7.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -239,6 +242,7 @@ impl Display {
         target_format: wgpu::TextureFormat,
         target_size: (u32, u32),
         settings: &DisplaySettings,
+        timestamps: Option<&wgpu::QuerySet>,
     ) {
         let device = ctx.device();
         let (manual, ev100, tau_s) = match settings.exposure {
@@ -281,7 +285,11 @@ impl Display {
         {
             let mut cpass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("exposure"),
-                timestamp_writes: None,
+                timestamp_writes: timestamps.map(|set| wgpu::ComputePassTimestampWrites {
+                    query_set: set,
+                    beginning_of_pass_write_index: Some(4),
+                    end_of_pass_write_index: Some(5),
+                }),
             });
             cpass.set_pipeline(&self.exposure_pipeline);
             cpass.set_bind_group(0, &exposure_group, &[]);
@@ -333,7 +341,11 @@ impl Display {
                 },
             })],
             depth_stencil_attachment: None,
-            timestamp_writes: None,
+            timestamp_writes: timestamps.map(|set| wgpu::RenderPassTimestampWrites {
+                query_set: set,
+                beginning_of_pass_write_index: Some(6),
+                end_of_pass_write_index: Some(7),
+            }),
             occlusion_query_set: None,
             multiview_mask: None,
         });

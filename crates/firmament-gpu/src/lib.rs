@@ -48,6 +48,7 @@ pub mod display;
 pub mod elek3d;
 mod error;
 pub mod hillaire2020;
+pub mod pass_timer;
 pub mod passes;
 pub mod render;
 pub mod shader;

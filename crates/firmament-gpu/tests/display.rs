@@ -95,6 +95,7 @@ fn show(
         out.format(),
         (out.width(), out.height()),
         &settings,
+        None,
     );
     ctx.queue().submit([encoder.finish()]);
     read_rgba8(ctx, out).unwrap()
@@ -180,4 +181,52 @@ fn the_exposure_adapts_and_holds_a_manual_value() {
     // Upscaled ×2: the display is not blank and keeps the gradient's order left to right.
     let row: Vec<u8> = (0..64).map(|x| codes[16 * 64 + x][1]).collect();
     assert!(row[63] > row[8] && row[8] <= row[32], "{row:?}");
+}
+
+#[test]
+fn the_pass_timer_reads_the_display_passes_back_without_a_stall() {
+    let Some(ctx) = test_context() else { return };
+    let Some(mut timer) = firmament_gpu::pass_timer::PassTimer::new(&ctx) else {
+        eprintln!("no timestamp queries on {}: nothing to time", ctx.adapter_name());
+        return;
+    };
+    let frame = synthetic_frame(64, 32);
+    let hdr = upload(&ctx, &frame);
+    let display = Display::new(&ctx).unwrap();
+    let out = target(&ctx, 64, 32, wgpu::TextureFormat::Rgba8Unorm);
+    let settings = DisplaySettings {
+        exposure: Exposure::Automatic { tau_s: 0.0 },
+        curve: ToneCurve::Aces,
+        dt_s: 0.0,
+        reset: true,
+    };
+    // Nothing read back before a frame.
+    assert_eq!(timer.times(&ctx), None);
+    let mut encoder = ctx
+        .device()
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+    display.encode(
+        &ctx,
+        &mut encoder,
+        &hdr.0,
+        hdr.1,
+        &out.create_view(&Default::default()),
+        out.format(),
+        (64, 32),
+        &settings,
+        Some(timer.query_set()),
+    );
+    assert!(timer.resolve(&mut encoder, false));
+    ctx.queue().submit([encoder.finish()]);
+    timer.after_submit();
+    // While the copy is mapped, a second frame records no copy.
+    let mut second = ctx
+        .device()
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+    assert!(!timer.resolve(&mut second, false));
+    ctx.device()
+        .poll(wgpu::PollType::wait_indefinitely())
+        .unwrap();
+    let t = timer.times(&ctx).expect("times after the device is idle");
+    assert!(t.display_ms > 0.0 && t.display_ms < 60_000.0, "{t:?}");
 }

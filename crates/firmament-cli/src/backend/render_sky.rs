@@ -308,16 +308,19 @@ impl<'a> RenderSky<'a> {
 
     /// Record a frame of the clear sky lit by `sources` into `target` on the GPU (nothing
     /// submitted; no terrain, clouds or stars: those need the CPU's parts of
-    /// [`RenderSky::render`]). The viewer's frame path.
+    /// [`RenderSky::render`]); `timestamps` as `RenderInputs::timestamps`. The viewer's
+    /// frame path.
     pub fn encode_frame(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         settings: &RenderSettings,
         sources: &SkySources,
         target: RenderTarget,
+        timestamps: Option<&wgpu::QuerySet>,
     ) -> Result<()> {
         let inputs = RenderInputs {
             background: sources.background.as_ref(),
+            timestamps,
             ..RenderInputs::default()
         };
         let lights = &sources.lights;

@@ -196,7 +196,7 @@ impl GpuElek3dRenderer {
     ) -> Result<(), GpuError> {
         let job = self.prepare(ctx, sky, lights, settings, target, inputs)?;
         scoped(ctx, "recording the frame", || {
-            record(encoder, &job, None);
+            record(encoder, &job, inputs.timestamps);
             Ok(())
         })
     }

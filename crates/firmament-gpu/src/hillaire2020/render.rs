@@ -215,7 +215,7 @@ impl GpuHillaireRenderer {
     ) -> Result<(), GpuError> {
         let job = self.prepare(ctx, sky, lights, settings, target, inputs)?;
         scoped(ctx, "recording the frame", || {
-            self.record(encoder, &job, None);
+            self.record(encoder, &job, inputs.timestamps);
             Ok(())
         })
     }

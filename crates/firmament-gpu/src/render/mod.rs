@@ -103,6 +103,11 @@ pub struct RenderInputs<'a> {
     /// under their shadows and light, the air's shafts through their gaps, the clouds
     /// composited at their mean depth), and ignores `shadow_lengths`. Not with a terrain.
     pub clouds: Option<&'a GpuClouds>,
+    /// Timestamps written around the frame's compute passes when given (a query set of
+    /// at least 4 on a device with `TIMESTAMP_QUERY`): 0 and 1 around the pass of the 4D
+    /// and 3D tables' frames; Hillaire 2020's sky-view pass at 0 and 1, its pixels at 2
+    /// and 3. A viewer's per-pass times ([`crate::pass_timer::PassTimer`]).
+    pub timestamps: Option<&'a wgpu::QuerySet>,
 }
 
 /// A render pipeline (for one output), its `camera_slice` entry point, and its
@@ -294,7 +299,7 @@ impl GpuRenderer {
     ) -> Result<(), GpuError> {
         let job = self.prepare(ctx, sky, lights, settings, target, inputs)?;
         scoped(ctx, "recording the frame", || {
-            self.record(encoder, &job, None);
+            self.record(encoder, &job, inputs.timestamps);
             Ok(())
         })
     }

@@ -10,6 +10,7 @@ use firmament::scene::sky_lights::SkySources;
 use firmament_gpu::display::{
     hdr_buffer, read_hdr_frame, read_rgba8, Display, DisplaySettings, Exposure,
 };
+use firmament_gpu::pass_timer::{PassTimer, PassTimes};
 use firmament_gpu::RenderTarget;
 
 use super::state::ViewState;
@@ -51,6 +52,8 @@ pub struct FramePath {
     hdr: Option<(wgpu::Buffer, (u32, u32))>,
     /// Seconds the last sky build took (for the panel).
     pub last_build_s: f64,
+    /// Per-pass GPU times (None without timestamp queries).
+    timer: Option<PassTimer>,
 }
 
 /// The size the sky is drawn at for a target of `size` pixels.
@@ -84,6 +87,7 @@ impl FramePath {
             display,
             hdr: None,
             last_build_s: 0.0,
+            timer: PassTimer::new(&gpu.ctx),
         })
     }
 
@@ -158,7 +162,8 @@ impl FramePath {
             white_balance: state.scene.output.white_balance,
         };
         let sky = self.sky().context("no sky yet")?;
-        sky.encode_frame(encoder, &settings, sources, RenderTarget::Buffer(hdr))?;
+        let set = self.timer.as_ref().map(|t| t.query_set());
+        sky.encode_frame(encoder, &settings, sources, RenderTarget::Buffer(hdr), set)?;
         self.display.encode(
             self.ctx(),
             encoder,
@@ -168,8 +173,29 @@ impl FramePath {
             target_format,
             target_size,
             &display,
+            set,
         );
+        let hillaire = state.method == Method::Hillaire2020;
+        if let Some(t) = self.timer.as_mut() {
+            t.resolve(encoder, hillaire);
+        }
         Ok(())
+    }
+
+    /// Call after submitting a frame [`FramePath::encode`] recorded: starts reading its
+    /// timestamps back.
+    pub fn submitted(&mut self) {
+        if let Some(t) = self.timer.as_mut() {
+            t.after_submit();
+        }
+    }
+
+    /// The latest per-pass GPU times read back (None without timestamp queries).
+    pub fn pass_times(&mut self) -> Option<PassTimes> {
+        let Backend::Gpu(gpu) = self.backend else {
+            return None;
+        };
+        self.timer.as_mut().and_then(|t| t.times(&gpu.ctx))
     }
 
     /// The last frame's HDR pixels (linear sRGB, Y in cd/m²), for EXR captures and tests.
@@ -232,6 +258,7 @@ impl FramePath {
             display,
         )?;
         self.ctx().queue().submit([encoder.finish()]);
+        self.submitted();
         let pixels = read_rgba8(self.ctx(), &target)
             .map_err(|e| gpu_failure("reading the display back", e))?;
         Ok((self.hdr_frame()?, pixels))

@@ -197,6 +197,14 @@ fn run_offscreen(args: &ViewArgs, mut state: ViewState) -> Result<()> {
             started.elapsed().as_secs_f64()
         );
     }
+    if let Some(t) = path.pass_times() {
+        if !args.quiet {
+            eprintln!(
+                "view: GPU times of a frame (timestamp queries): sky {:.3} ms, display {:.3} ms",
+                t.sky_ms, t.display_ms
+            );
+        }
+    }
     let (hdr, shown) = last.expect("at least one frame");
     let ev100 = path.shown_ev100()?;
     for p in &args.screenshot {

@@ -101,7 +101,7 @@ pub fn panel(ui: &mut egui::Ui, state: &mut ViewState, info: &PanelInfo) -> Pane
         info.render_size.1,
         match info.gpu_ms {
             Some((sky, display)) => format!(" · GPU: sky {sky:.2} ms, display {display:.2} ms"),
-            None => String::new(),
+            None => " · no GPU timestamps on this adapter".into(),
         }
     ));
     ui.label(format!("tables built in {:.2} s", info.build_s));

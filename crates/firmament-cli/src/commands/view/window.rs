@@ -381,6 +381,8 @@ impl App {
         let copy = capture_now.then(|| copy_out(ctx.device(), &mut encoder, &frame.texture));
         ctx.queue()
             .submit(extra.into_iter().chain([encoder.finish()]));
+        g.path.submitted();
+        self.info.gpu_ms = g.path.pass_times().map(|t| (t.sky_ms, t.display_ms));
         if let Some(staging) = &copy {
             let shown = read_copy(ctx, staging, &frame.texture)?;
             let ev100 = g.path.shown_ev100()?;
