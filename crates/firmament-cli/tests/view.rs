@@ -44,10 +44,23 @@ fn mean_code_diff(a: &Path, b: &Path, from_x: usize) -> f64 {
     sum / n as f64
 }
 
-/// The offscreen viewer's 192×108 frame, its scene saved.
-fn offscreen(dir: &Path, size: (u32, u32), method: &str) -> std::process::Output {
+/// The default scene without its terrain (the clear sky), written to `dir`.
+fn clear_scene(dir: &Path) -> std::path::PathBuf {
+    let scene = firmament::scene::SceneFile {
+        terrain: None,
+        ..Default::default()
+    };
+    let path = dir.join("clear.toml");
+    std::fs::write(&path, toml::to_string(&scene).unwrap()).unwrap();
+    path
+}
+
+/// The offscreen viewer's frame of `scene`, its scene saved.
+fn offscreen(dir: &Path, scene: &Path, size: (u32, u32), method: &str) -> std::process::Output {
     run(&[
         "view",
+        "--scene",
+        scene.to_str().unwrap(),
         "--offscreen",
         "--frames",
         "2",
@@ -70,13 +83,10 @@ fn offscreen(dir: &Path, size: (u32, u32), method: &str) -> std::process::Output
     ])
 }
 
-#[test]
-fn the_viewers_frame_is_what_render_draws_of_its_saved_scene() {
-    let Some(_gpu) = gpu() else { return };
-    let dir = tmp_subdir("view-vs-render");
-    let o = offscreen(&dir, (192, 108), "bruneton4d");
-    succeeds(&o);
-    let r = run(&[
+/// `firmament render` of the scene the viewer saved in `dir`, on the GPU from the same
+/// tables: `render.exr` and `render.png`.
+fn render_saved_scene(dir: &Path) {
+    succeeds(&run(&[
         "render",
         "--scene",
         dir.join("scene.toml").to_str().unwrap(),
@@ -90,36 +100,20 @@ fn the_viewers_frame_is_what_render_draws_of_its_saved_scene() {
         dir.join("render.exr").to_str().unwrap(),
         "--out",
         dir.join("render.png").to_str().unwrap(),
-    ]);
-    succeeds(&r);
-    let v = firmament::io::read_exr(dir.join("view.exr")).unwrap();
-    let c = firmament::io::read_exr(dir.join("render.exr")).unwrap();
-    assert_eq!((v.width, v.height), (192, 108));
-    assert_eq!((c.width, c.height), (192, 108));
-    // The sun's disk is about one pixel here: `render` splats a disk under four pixels as a
-    // point on the CPU, the viewer draws it on the GPU (no CPU pass in its frame loop), so
-    // the disk's few pixels (above 10⁶ cd/m², where no sky is) are compared apart.
-    let disk = 1.0e6;
-    let (mut sv, mut sc, mut rel, mut n, mut dv, mut dc) = (0.0, 0.0, 0.0, 0usize, 0.0, 0.0);
-    for (p, q) in v.data.iter().zip(&c.data) {
-        let (a, b) = (luminance(p), luminance(q));
-        if a > disk || b > disk {
-            dv += a;
-            dc += b;
-            continue;
-        }
-        sv += a;
-        sc += b;
-        if b > 0.0 {
-            rel += (a - b).abs() / b;
-            n += 1;
-        }
-    }
-    let mean_ratio = sv / sc - 1.0;
-    let mean_rel = rel / n as f64;
+    ]));
+}
+
+#[test]
+fn the_viewers_frame_is_what_render_draws_of_its_saved_scene() {
+    let Some(_gpu) = gpu() else { return };
+    let dir = tmp_subdir("view-vs-render");
+    let o = offscreen(&dir, &clear_scene(&dir), (192, 108), "bruneton4d");
+    succeeds(&o);
+    render_saved_scene(&dir);
+    let (mean_rel, mean_ratio, disks) =
+        exr_difference(&dir.join("view.exr"), &dir.join("render.exr"));
     eprintln!(
-        "view vs render: mean luminance {mean_ratio:+.2e}, mean |ΔL|/L {mean_rel:.2e}; the disk's pixels' sum {:+.3}",
-        dv / dc - 1.0
+        "view vs render: mean luminance {mean_ratio:+.2e}, mean |ΔL|/L {mean_rel:.2e}; the disk's pixels' sum {disks:+.3}"
     );
     assert!(mean_ratio.abs() <= 0.01, "mean luminance {mean_ratio:+.4}");
     assert!(
@@ -157,6 +151,8 @@ fn the_window_draws_and_captures_what_the_offscreen_path_draws() {
         .env("FIRMAMENT_CACHE_DIR", common::cache_dir())
         .args([
             "view",
+            "--scene",
+            clear_scene(&dir).to_str().unwrap(),
             "--frames",
             "3",
             "--width",
@@ -173,7 +169,7 @@ fn the_window_draws_and_captures_what_the_offscreen_path_draws() {
         .output()
         .unwrap();
     succeeds(&o);
-    let off = offscreen(&dir, (w, h), "bruneton4d");
+    let off = offscreen(&dir, &clear_scene(&dir), (w, h), "bruneton4d");
     succeeds(&off);
     // Not blank: the sky's rows differ from the ground's, and the panel is there.
     let (_, _, px) = firmament::io::read_png_srgb8(&shot).unwrap();
@@ -189,6 +185,55 @@ fn the_window_draws_and_captures_what_the_offscreen_path_draws() {
         d <= 1.0,
         "the window's view differs from the offscreen frame: {d}"
     );
+}
+
+/// Two EXR frames of the same size compared by luminance: the mean |ΔL|/L, the ratio of
+/// their mean luminances − 1, and that ratio over the lights' disks' pixels alone. A disk of
+/// about a pixel is drawn by the viewer on the GPU, where `render` splats a disk under four
+/// pixels as a point on the CPU (no CPU pass in the viewer's frame loop), so the disks'
+/// pixels (above 10⁶ cd/m², where no sky is) are compared apart.
+fn exr_difference(a: &Path, b: &Path) -> (f64, f64, f64) {
+    let v = firmament::io::read_exr(a).unwrap();
+    let c = firmament::io::read_exr(b).unwrap();
+    assert_eq!((v.width, v.height), (c.width, c.height));
+    let disk = 1.0e6;
+    let (mut sv, mut sc, mut rel, mut n, mut dv, mut dc) = (0.0, 0.0, 0.0, 0usize, 0.0, 0.0);
+    for (p, q) in v.data.iter().zip(&c.data) {
+        let (a, b) = (luminance(p), luminance(q));
+        if a > disk || b > disk {
+            dv += a;
+            dc += b;
+            continue;
+        }
+        sv += a;
+        sc += b;
+        if b > 0.0 {
+            rel += (a - b).abs() / b;
+            n += 1;
+        }
+    }
+    let disks = if dc > 0.0 { dv / dc - 1.0 } else { 0.0 };
+    (rel / n as f64, sv / sc - 1.0, disks)
+}
+
+#[test]
+fn the_viewer_draws_the_terrain_as_render_does() {
+    let Some(_gpu) = gpu() else { return };
+    let dir = tmp_subdir("view-terrain");
+    // The default scene: the valley at golden hour, its shafts; the sun behind a ridge.
+    let defaults = dir.join("default.toml");
+    std::fs::write(
+        &defaults,
+        toml::to_string(&firmament::scene::SceneFile::default()).unwrap(),
+    )
+    .unwrap();
+    succeeds(&offscreen(&dir, &defaults, (96, 54), "bruneton4d"));
+    render_saved_scene(&dir);
+    let (rel, mean, disks) = exr_difference(&dir.join("view.exr"), &dir.join("render.exr"));
+    eprintln!(
+        "terrain: view vs render: mean |ΔL|/L {rel:.2e}, mean luminance {mean:+.2e}; the disks' pixels {disks:+.3}"
+    );
+    assert!(rel <= 0.01 && mean.abs() <= 0.01, "{rel} {mean}");
 }
 
 #[test]

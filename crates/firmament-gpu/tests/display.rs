@@ -187,7 +187,10 @@ fn the_exposure_adapts_and_holds_a_manual_value() {
 fn the_pass_timer_reads_the_display_passes_back_without_a_stall() {
     let Some(ctx) = test_context() else { return };
     let Some(mut timer) = firmament_gpu::pass_timer::PassTimer::new(&ctx) else {
-        eprintln!("no timestamp queries on {}: nothing to time", ctx.adapter_name());
+        eprintln!(
+            "no timestamp queries on {}: nothing to time",
+            ctx.adapter_name()
+        );
         return;
     };
     let frame = synthetic_frame(64, 32);

@@ -306,8 +306,9 @@ impl<'a> RenderSky<'a> {
         }
     }
 
-    /// Record a frame of the clear sky lit by `sources` into `target` on the GPU (nothing
-    /// submitted; no terrain, clouds or stars: those need the CPU's parts of
+    /// Record a frame lit by `sources` into `target` on the GPU (nothing submitted), over
+    /// `terrain` when given (uploaded by [`RenderSky::gpu_terrain`] for these lights and
+    /// this camera; the 4D tables only); no clouds or stars (those need the CPU's parts of
     /// [`RenderSky::render`]); `timestamps` as `RenderInputs::timestamps`. The viewer's
     /// frame path.
     pub fn encode_frame(
@@ -317,10 +318,15 @@ impl<'a> RenderSky<'a> {
         sources: &SkySources,
         target: RenderTarget,
         timestamps: Option<&wgpu::QuerySet>,
+        terrain: Option<&GpuTerrain>,
     ) -> Result<()> {
+        if terrain.is_some() && !matches!(self, RenderSky::Gpu { .. }) {
+            anyhow::bail!("a terrain is drawn on the GPU by the 4D tables only so far");
+        }
         let inputs = RenderInputs {
             background: sources.background.as_ref(),
             timestamps,
+            terrain,
             ..RenderInputs::default()
         };
         let lights = &sources.lights;
@@ -388,7 +394,7 @@ impl<'a> RenderSky<'a> {
     /// `terrain` on the device for a GPU frame: its shadow fields for the frame's lights,
     /// the sky's radiance under its horizons and, when it changes the air's light, the
     /// observer's air volume, all computed on the CPU.
-    fn gpu_terrain(
+    pub fn gpu_terrain(
         &self,
         terrain: &Heightfield,
         settings: &RenderSettings,

@@ -7,15 +7,16 @@
 use anyhow::{Context, Result};
 use firmament::render::{Frame, RenderSettings};
 use firmament::scene::sky_lights::SkySources;
+use firmament::scene::terrain::Heightfield;
 use firmament_gpu::display::{
     hdr_buffer, read_hdr_frame, read_rgba8, Display, DisplaySettings, Exposure,
 };
 use firmament_gpu::pass_timer::{PassTimer, PassTimes};
-use firmament_gpu::RenderTarget;
+use firmament_gpu::{GpuTerrain, RenderTarget};
 
 use super::state::ViewState;
 use crate::backend::{gpu_failure, Backend, RenderSky};
-use crate::commands::render::{atmosphere_args, sources_of_scene};
+use crate::commands::render::{sources_of_scene, terrain_and_atmosphere};
 use crate::method::Method;
 
 /// What the sky's tables depend on: rebuilt when it changes.
@@ -25,6 +26,8 @@ struct SkyKey {
     preset: String,
     file: Option<std::path::PathBuf>,
     wavelengths: Option<String>,
+    /// The terrain's configuration (its tables take its albedo and floor), as TOML.
+    terrain: Option<String>,
 }
 
 impl SkyKey {
@@ -35,8 +38,20 @@ impl SkyKey {
             preset: a.preset.clone(),
             file: a.file.clone(),
             wavelengths: a.wavelengths.clone(),
+            terrain: state
+                .scene
+                .terrain
+                .as_ref()
+                .map(|t| toml::to_string(t).unwrap_or_default()),
         }
     }
+}
+
+/// What the terrain's uploads depend on besides the sky: the lights and the observer.
+#[derive(Clone, Debug, PartialEq)]
+struct TerrainKey {
+    lights: Vec<[f64; 3]>,
+    altitude_m: f64,
 }
 
 /// The viewer's GPU frame path.
@@ -54,6 +69,13 @@ pub struct FramePath {
     pub last_build_s: f64,
     /// Per-pass GPU times (None without timestamp queries).
     timer: Option<PassTimer>,
+    /// The scene's terrain on the sky's planet (built with the sky).
+    terrain: Option<Heightfield>,
+    /// Its shadow fields, sky domes and air volume on the device for the current lights and
+    /// observer (the 4D tables only).
+    gpu_terrain: Option<(TerrainKey, GpuTerrain)>,
+    /// Seconds the last terrain upload took (its CPU parts).
+    pub last_terrain_s: f64,
 }
 
 /// The size the sky is drawn at for a target of `size` pixels.
@@ -88,6 +110,9 @@ impl FramePath {
             hdr: None,
             last_build_s: 0.0,
             timer: PassTimer::new(&gpu.ctx),
+            terrain: None,
+            gpu_terrain: None,
+            last_terrain_s: 0.0,
         })
     }
 
@@ -112,7 +137,9 @@ impl FramePath {
                 k.preset == key.preset && k.file == key.file && k.wavelengths == key.wavelengths;
             (same && key.method == Method::Bruneton4d).then(|| path.clone())
         });
-        let mut atmosphere = atmosphere_args(&state.scene, tables, &self.table_size, false);
+        // With a terrain the tables take its mean albedo and its floor, as `render`'s do.
+        let (terrain, mut atmosphere) =
+            terrain_and_atmosphere(&state.scene, tables, &self.table_size, false, true)?;
         if atmosphere.tables.is_some() {
             // The file's wavelengths.
             atmosphere.wavelengths = None;
@@ -123,6 +150,8 @@ impl FramePath {
                 .with_context(|| format!("building the {} sky", key.method.name()))?;
         self.last_build_s = started.elapsed().as_secs_f64();
         self.sky = Some((key, sky));
+        self.terrain = terrain;
+        self.gpu_terrain = None;
         Ok(true)
     }
 
@@ -155,15 +184,47 @@ impl FramePath {
             self.hdr = Some((hdr_buffer(self.ctx(), size.0, size.1), size));
         }
         let (hdr, _) = self.hdr.as_ref().expect("just made");
+        let sky = self.sky.as_ref().map(|(_, s)| s).context("no sky yet")?;
+        // The camera's altitude is above the terrain under it, as in `render`.
+        let camera = state
+            .scene
+            .camera_over(self.terrain.as_ref(), sky.model().bottom_radius_m);
         let settings = RenderSettings {
-            camera: &state.scene.camera,
+            camera: &camera,
             width: size.0 as usize,
             height: size.1 as usize,
             white_balance: state.scene.output.white_balance,
         };
-        let sky = self.sky().context("no sky yet")?;
+        // The terrain's uploads follow the lights and the observer (the 4D tables only).
+        let terrain = match (&self.terrain, state.method) {
+            (Some(t), Method::Bruneton4d) => {
+                let key = TerrainKey {
+                    lights: sources
+                        .lights
+                        .iter()
+                        .map(|l| [l.direction.x, l.direction.y, l.direction.z])
+                        .collect(),
+                    altitude_m: camera.altitude_m,
+                };
+                if self.gpu_terrain.as_ref().is_none_or(|(k, _)| *k != key) {
+                    let started = std::time::Instant::now();
+                    let uploaded = sky.gpu_terrain(t, &settings, sources, true)?;
+                    self.last_terrain_s = started.elapsed().as_secs_f64();
+                    self.gpu_terrain = Some((key, uploaded));
+                }
+                self.gpu_terrain.as_ref().map(|(_, g)| g)
+            }
+            _ => None,
+        };
         let set = self.timer.as_ref().map(|t| t.query_set());
-        sky.encode_frame(encoder, &settings, sources, RenderTarget::Buffer(hdr), set)?;
+        sky.encode_frame(
+            encoder,
+            &settings,
+            sources,
+            RenderTarget::Buffer(hdr),
+            set,
+            terrain,
+        )?;
         self.display.encode(
             self.ctx(),
             encoder,

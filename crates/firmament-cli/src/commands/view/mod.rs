@@ -32,7 +32,7 @@ use state::ViewState;
 #[derive(Args, Debug, Clone)]
 pub struct ViewArgs {
     /// Scene file (TOML, as `firmament render --scene` reads it). Without one: the default
-    /// scene's golden hour, without its terrain.
+    /// scene (golden hour in the valley).
     #[arg(long, value_name = "FILE")]
     pub scene: Option<PathBuf>,
     /// The sky method drawing the view: bruneton4d (`lut`), hillaire2020, elek3d.
@@ -82,12 +82,14 @@ pub struct ViewArgs {
 pub fn load_scene(path: Option<&PathBuf>) -> Result<(SceneFile, Vec<String>)> {
     let mut scene = match path {
         Some(p) => SceneFile::from_file(p)?,
-        None => state::default_scene(),
+        None => SceneFile::default(),
     };
     let mut not_drawn = Vec::new();
-    if scene.terrain.take().is_some() {
-        not_drawn
-            .push("the scene's terrain: `firmament render` draws it, the viewer not yet".into());
+    if scene.terrain.is_some() {
+        not_drawn.push(
+            "the terrain: drawn with bruneton4d only (hillaire2020 and elek3d draw it in `firmament render` on the CPU)"
+                .into(),
+        );
     }
     if !scene.clouds.is_empty() {
         scene.clouds.clear();

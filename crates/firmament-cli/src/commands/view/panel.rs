@@ -230,11 +230,7 @@ mod tests {
     use egui_kittest::Harness;
 
     fn state() -> ViewState {
-        ViewState::new(
-            super::super::state::default_scene(),
-            Method::Bruneton4d,
-            true,
-        )
+        ViewState::new(super::super::state::clear_scene(), Method::Bruneton4d, true)
     }
 
     fn harness(state: ViewState) -> Harness<'static, ViewState> {

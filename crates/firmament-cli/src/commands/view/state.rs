@@ -137,9 +137,9 @@ impl ViewState {
     }
 }
 
-/// The viewer's default scene: the default scene's golden hour without its terrain (the
-/// viewer draws the clear sky so far).
-pub fn default_scene() -> SceneFile {
+/// The default scene's golden hour without its terrain: the clear sky, for tests.
+#[cfg(test)]
+pub fn clear_scene() -> SceneFile {
     SceneFile {
         terrain: None,
         ..SceneFile::default()
@@ -161,7 +161,7 @@ mod tests {
     use super::*;
 
     fn state() -> ViewState {
-        ViewState::new(default_scene(), Method::Bruneton4d, true)
+        ViewState::new(clear_scene(), Method::Bruneton4d, true)
     }
 
     #[test]
