@@ -251,6 +251,11 @@ impl FramePath {
         }
     }
 
+    /// Whether the adapter has timestamp queries (per-pass times).
+    pub fn has_timer(&self) -> bool {
+        self.timer.is_some()
+    }
+
     /// The latest per-pass GPU times read back (None without timestamp queries).
     pub fn pass_times(&mut self) -> Option<PassTimes> {
         let Backend::Gpu(gpu) = self.backend else {

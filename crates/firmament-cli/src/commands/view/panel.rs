@@ -24,6 +24,8 @@ pub struct PanelInfo {
     pub frame_ms: f64,
     /// The GPU's time for the sky's dispatch and the display (ms), when measured.
     pub gpu_ms: Option<(f64, f64)>,
+    /// Whether the adapter has timestamp queries (the times may not be read back yet).
+    pub timestamps: bool,
     /// The size the sky is drawn at.
     pub render_size: (u32, u32),
     /// The EV100 the frame was shown at.
@@ -101,10 +103,13 @@ pub fn panel(ui: &mut egui::Ui, state: &mut ViewState, info: &PanelInfo) -> Pane
         info.render_size.1,
         match info.gpu_ms {
             Some((sky, display)) => format!(" · GPU: sky {sky:.2} ms, display {display:.2} ms"),
+            None if info.timestamps => " · GPU times: reading back".into(),
             None => " · no GPU timestamps on this adapter".into(),
         }
     ));
-    ui.label(format!("tables built in {:.2} s", info.build_s));
+    if info.build_s > 0.0 {
+        ui.label(format!("tables built in {:.2} s", info.build_s));
+    }
     for line in &info.not_drawn {
         ui.small(line);
     }

@@ -281,6 +281,8 @@ impl App {
         let Some(g) = self.gfx.as_mut() else {
             return Ok(());
         };
+        self.info.timestamps = g.path.has_timer();
+        self.info.render_size = render_size(&self.state, (g.config.width, g.config.height));
         // The panel first: what it changes is drawn in this frame.
         let raw = g.egui_state.take_egui_input(&g.window);
         let mut actions = Default::default();
