@@ -130,8 +130,9 @@ fn the_sky_irradiance_matches_the_reference() {
             colour.to_xyz(&truth.irradiance)[1],
         );
         // The irradiance table integrates the method's own sky (its isotropic multiple
-        // scattering included): measured −5.6 % at 60°, −6.8 % at 15° (the multiple
-        // scattering's deficit, see docs/accuracy.md); the reference's noise is about 1 %.
+        // scattering included): measured −4.6 % at 60°, −6.2 % at 15° (the multiple
+        // scattering's deficit, see docs/accuracy.md; −5.6 / −6.8 % with the coarser (8, 8)
+        // gather rule); the reference's noise is about 1 %.
         let error = e / e_ref - 1.0;
         eprintln!("sun {sun_elevation}°: sky irradiance {error:+.4} against the reference");
         assert!(error.abs() < 0.09, "sun {sun_elevation}°: {error:+.4}");
@@ -331,6 +332,39 @@ fn the_column_march_is_as_accurate_as_one_march_per_point() {
         100.0 * per_point.1
     );
     assert!(count > 250.0);
-    assert!(column.0 / count < 0.002 && column.1 < 0.01, "{column:?}");
-    assert!(column.0 <= per_point.0 * 1.5, "{column:?} {per_point:?}");
+    // One step per slice: measured mean 0.014 %, worst 0.15 % (30 steps per point: 0.009 %,
+    // 0.23 %). The column's worst may not pass the per-point march's, nor its mean 0.03 %.
+    assert!(column.0 / count < 3e-4 && column.1 < 0.01, "{column:?}");
+    assert!(column.1 <= per_point.1, "{column:?} {per_point:?}");
+}
+
+#[test]
+fn the_default_gather_rule_is_close_to_a_fine_one() {
+    // Ψ_ms's gather over the sphere: the default rule (16 Gauss nodes in μ split at the
+    // horizon, 2 azimuths over [0, π] mirrored: 64 directions, Hillaire's count) against a
+    // (32, 32) rule, texels above 10⁻³ of the table's peak. The integrand is sharp in μ
+    // (near the horizon the paths are long) and smooth in φ: (8, 8), the same count of
+    // marches twice over, read a median of 3.6 % and p95 14 % here.
+    let model = earth();
+    let fine = HillaireConfig {
+        multiple_scattering_directions: (32, 32),
+        ..HillaireConfig::default()
+    };
+    let coarse = Hillaire2020::compute(model.clone(), &HillaireConfig::default()).unwrap();
+    let fine = Hillaire2020::compute(model, &fine).unwrap();
+    let (a, b) = (
+        &coarse.multiple_scattering.table.data,
+        &fine.multiple_scattering.table.data,
+    );
+    let peak = b.iter().cloned().fold(0.0f32, f32::max);
+    let mut errors: Vec<f64> = a
+        .iter()
+        .zip(b)
+        .filter(|(_, &y)| y > 1e-3 * peak)
+        .map(|(&x, &y)| ((x - y) / y).abs() as f64)
+        .collect();
+    errors.sort_by(f64::total_cmp);
+    let (median, p95) = (errors[errors.len() / 2], errors[errors.len() * 95 / 100]);
+    eprintln!("Ψ_ms against a (32, 32) gather: median {median:.2e}, p95 {p95:.2e}");
+    assert!(median < 5e-3 && p95 < 0.05, "median {median}, p95 {p95}");
 }

@@ -105,6 +105,44 @@ impl<'a> Lookup<'a> {
         });
     }
 
+    /// [`Lookup::transmittance`] to each of `distances` (m) along one ray, into `out`
+    /// (channels per distance): the ray's own end of the optical depth looked up once.
+    pub fn transmittances_along(
+        &self,
+        r: f64,
+        mu: f64,
+        distances: &[f64],
+        ground: bool,
+        out: &mut [f64],
+    ) {
+        let n = out.len() / distances.len().max(1);
+        with_channel_buffers(n, |[start, end]| {
+            // From the ground the ray is reversed: τ(r_d, −μ_d) − τ(r, −μ).
+            if ground {
+                self.optical_depth_to_top(r, -mu, start);
+            } else {
+                self.optical_depth_to_top(r, mu, start);
+            }
+            for (&d, o) in distances.iter().zip(out.chunks_mut(n)) {
+                let (r_d, mu_d) = advance(r, mu, d, self.radii.bottom, self.radii.top);
+                let (a, b) = if ground {
+                    self.optical_depth_to_top(r_d, -mu_d, end);
+                    (&*end, &*start)
+                } else {
+                    self.optical_depth_to_top(r_d, mu_d, end);
+                    (&*start, &*end)
+                };
+                for ((o, &a), &b) in o.iter_mut().zip(a).zip(b) {
+                    *o = if a < MAX_OPTICAL_DEPTH as f64 && b < MAX_OPTICAL_DEPTH as f64 {
+                        (-(a - b).max(0.0)).exp()
+                    } else {
+                        0.0
+                    };
+                }
+            }
+        });
+    }
+
     /// Transmittance to the sun times the visible fraction of the solar disk above the
     /// planet's horizon (Bruneton 2017 `GetTransmittanceToSun`, smoothstep approximation).
     #[inline]

@@ -24,7 +24,7 @@ use crate::sky::bruneton4d::{Lookup, Table2};
 
 use super::harmonics;
 use super::march::Medium;
-use super::params::MU_S_HORIZON_STRETCH;
+use super::step_lanes::{BlockCoordinates, StepGeometry, StepLanes, BLOCK};
 
 /// Channels per lane group.
 pub(crate) const LANES: usize = 4;
@@ -56,13 +56,14 @@ pub(crate) fn exp_neg(x: Lane) -> Lane {
     let shifted: Lane = from_fn(|i| y[i] + ROUND);
     let n: Lane = from_fn(|i| shifted[i] - ROUND);
     let f: Lane = from_fn(|i| (-x[i] - n[i] * LN2_HI) - n[i] * LN2_LO);
+    // Estrin's scheme: the same polynomial in three dependent levels instead of Horner's
+    // seven (a step's exponential was the march's longest chain of latencies).
+    let [c6, c5, c4, c3, c2] = EXP_TAYLOR;
     let p: Lane = from_fn(|i| {
         let f = f[i];
-        let mut p = EXP_TAYLOR[0];
-        for c in &EXP_TAYLOR[1..] {
-            p = p * f + c;
-        }
-        (p * f + 1.0) * f + 1.0
+        let f2 = f * f;
+        let f4 = f2 * f2;
+        (1.0 + f) + f2 * (c2 + c3 * f) + f4 * ((c4 + c5 * f) + f2 * c6)
     });
     // 2ⁿ: n from the shifted float's low bits, moved into the exponent field.
     let exponent: [u32; LANES] = from_fn(|i| {
@@ -73,24 +74,6 @@ pub(crate) fn exp_neg(x: Lane) -> Lane {
             << 23
     });
     from_fn(|i| p[i] * f32::from_bits(exponent[i]) * ((y[i] > -126.0) as u32 as f32))
-}
-
-/// ln x for x ≥ 1 (f32): x = m·2^e with m ∈ [√½, √2), ln m = 2·atanh(s), s = (m − 1)/(m + 1),
-/// |s| ≤ 0.172, by its series to s⁹ (remainder ≤ 2·s¹¹/11 = 7e-10).
-#[inline(always)]
-fn ln_f32(x: f32) -> f32 {
-    let bits = x.to_bits();
-    let mut e = ((bits >> 23) & 0xff) as i32 - 127;
-    let mut m = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
-    if m > std::f32::consts::SQRT_2 {
-        m *= 0.5;
-        e += 1;
-    }
-    let s = (m - 1.0) / (m + 1.0);
-    let s2 = s * s;
-    let series =
-        2.0 * s * (1.0 + s2 * (1.0 / 3.0 + s2 * (1.0 / 5.0 + s2 * (1.0 / 7.0 + s2 / 9.0))));
-    e as f32 * std::f32::consts::LN_2 + series
 }
 
 /// A table's texels as lane groups: `groups` lanes per texel, channels past the model's 0.
@@ -225,9 +208,7 @@ impl LightLanes {
         let constituents = self.field_weight.len();
         let (n, g_count) = (self.channels, self.groups);
         let lanes = &mut profile.lanes;
-        lanes.geometry.clear();
-        lanes.single.clear();
-        lanes.multiple.clear();
+        lanes.clear(sun_radius);
         let t = &self.optical_depth;
         // The sun's band around the horizon is sin(horizon angle)·radius = bottom/r·radius:
         // its 1/(2e) is r times this.
@@ -243,10 +224,9 @@ impl LightLanes {
             let (d_min, d_max) = (self.top - r, rho + self.h);
             let inv_r = 1.0 / r.max(1.0);
             let sin_h = self.bottom * inv_r;
-            lanes.geometry.push(StepGeometry {
+            lanes.push(StepGeometry {
                 t_mid,
                 r,
-                inv_r,
                 top_minus_r2: self.top * self.top - r * r,
                 d_min,
                 inv_span: if d_max > d_min {
@@ -287,6 +267,7 @@ impl LightLanes {
             }
             lanes.multiple.extend_from_slice(multiple);
         }
+        lanes.pad();
     }
 
     /// The light's part of a march over `lanes` (from a profile filled by
@@ -310,41 +291,21 @@ impl LightLanes {
         acc.iter_mut().for_each(|a| *a = [0.0; LANES]);
         let tau = &self.optical_depth;
         let single = !phases.is_empty();
-        // Steps in blocks, each in two passes: first every step's lookup coordinates (short,
-        // independent computations whose square roots and divisions overlap), then the
-        // lookups and sums. In one pass each step's chain of latencies ran alone.
-        const BLOCK: usize = 32;
-        let mut fraction = [0.0f32; BLOCK];
-        let mut t_col = [(0usize, 0usize, 0.0f32); BLOCK];
-        let mut f_col = [(0usize, 0usize, 0.0f32); BLOCK];
-        for (b, block) in lanes.geometry.chunks(BLOCK).enumerate() {
-            for (j, s) in block.iter().enumerate() {
-                let mu_s = ((r_mu_s + s.t_mid * nu) * s.inv_r).clamp(-1.0, 1.0);
-                let above = mu_s - s.cos_horizon;
-                fraction[j] = if above >= s.half_band {
-                    1.0
-                } else if above <= -s.half_band {
-                    0.0
-                } else {
-                    let t = ((above + s.half_band) * s.inv_band) as f32;
-                    t * t * (3.0 - 2.0 * t)
-                };
-                if single {
-                    let r_mu = s.r * mu_s;
-                    let d = (-r_mu + safe_sqrt(r_mu * r_mu + s.top_minus_r2)).max(0.0);
-                    t_col[j] = weights((d - s.d_min) * s.inv_span, tau.width);
-                }
-                if let Some(field) = &self.multiple {
-                    f_col[j] = weights(mu_s_unit_half(mu_s), field.width);
-                }
-            }
-            for (j, s) in block.iter().enumerate() {
+        // Steps in blocks, each in two passes: first every step's lookup coordinates, over
+        // whole arrays (step_lanes.rs: SIMD), then the lookups and sums.
+        let field_width = self.multiple.as_ref().map_or(0, |f| f.width);
+        let mut at = BlockCoordinates::default();
+        for b in 0..lanes.len().div_ceil(BLOCK) {
+            lanes.coordinates(b, r_mu_s, nu, single, tau.width, field_width, &mut at);
+            for j in 0..BLOCK.min(lanes.len() - b * BLOCK) {
                 let i = b * BLOCK + j;
-                if single && fraction[j] > 0.0 {
+                let fraction = at.fraction[j];
+                if single && fraction > 0.0 {
                     let weights =
                         &lanes.single[i * constituents * groups..(i + 1) * constituents * groups];
+                    let (column, row) = (at.transmittance.at(j), lanes.transmittance_row[i]);
                     for (g, a) in acc.iter_mut().enumerate() {
-                        let t_sun = exp_neg(tau.sample(t_col[j], s.transmittance_row, g));
+                        let t_sun = exp_neg(tau.sample(column, row, g));
                         let mut phased = [0.0f32; LANES];
                         for (c, p) in phases.iter().enumerate() {
                             let w = &weights[c * groups + g];
@@ -353,14 +314,15 @@ impl LightLanes {
                             }
                         }
                         for l in 0..LANES {
-                            a[l] += fraction[j] * phased[l] * t_sun[l];
+                            a[l] += fraction * phased[l] * t_sun[l];
                         }
                     }
                 }
                 if let Some(field) = &self.multiple {
                     let m = &lanes.multiple[i * groups..(i + 1) * groups];
+                    let (column, row) = (at.field.at(j), lanes.field_row[i]);
                     for (g, a) in acc.iter_mut().enumerate() {
-                        let psi = field.sample(f_col[j], s.field_row, g);
+                        let psi = field.sample(column, row, g);
                         for l in 0..LANES {
                             a[l] += m[g][l] * psi[l];
                         }
@@ -378,50 +340,6 @@ impl LightLanes {
             *o = acc[k / LANES][k % LANES] as f64;
         }
     }
-}
-
-/// The Ψ_ms table's column coordinate of μ_s (as params::altitude_mu_s_uv): x =
-/// asinh(μ_s·sinh k)/k mapped to [0, 1], the logarithm in f32 (its absolute error, ~1e-7
-/// of a column, is far below the table's f32 values' own rounding).
-#[inline(always)]
-fn mu_s_unit_half(mu_s: f64) -> f64 {
-    let k = MU_S_HORIZON_STRETCH;
-    let y = (mu_s * k.sinh()) as f32;
-    let a = y.abs();
-    let asinh = ln_f32(a + (a * a + 1.0).sqrt());
-    ((y.signum() * asinh * (0.5 / k) as f32) as f64 + 0.5).clamp(0.0, 1.0)
-}
-
-/// What a step's lookups need from its radius.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct StepGeometry {
-    /// The step's middle (m from the ray's start) and its radius (m).
-    t_mid: f64,
-    r: f64,
-    inv_r: f64,
-    /// top² − r² (m²).
-    top_minus_r2: f64,
-    /// The transmittance mapping's shortest and 1/(longest − shortest) distance to the top.
-    d_min: f64,
-    inv_span: f64,
-    transmittance_row: (usize, usize, f32),
-    /// The sun's visible fraction there (Lookup::sun_visible_fraction): a smoothstep over
-    /// μ_s − cos(the horizon's zenith angle) ∈ [−e, e], e = sin(that angle)·the sun's
-    /// angular radius; e and 1/(2e) (0 for a point light).
-    half_band: f64,
-    inv_band: f64,
-    cos_horizon: f64,
-    field_row: (usize, usize, f32),
-}
-
-/// A profile's steps for [`LightLanes::march`].
-#[derive(Default)]
-pub(crate) struct StepLanes {
-    geometry: Vec<StepGeometry>,
-    /// Per step, constituent and lane group: T·ℓ·ρ_c·β_c.
-    single: Vec<Lane>,
-    /// Per step and lane group: T·ℓ·Σ_c ρ_c·β_c·k₀·Y₀₀.
-    multiple: Vec<Lane>,
 }
 
 #[cfg(test)]
@@ -470,6 +388,7 @@ mod tests {
                 let a = sky_view::compute(&lanes, r, mu_s, 48, 27, 30);
                 let b = sky_view::compute(&general, r, mu_s, 48, 27, 30);
                 let worst = worst_difference(&a, &b);
+                eprintln!("sky view at {altitude} m, μ_s {mu_s}: {worst:.2e}");
                 assert!(
                     worst < 5e-6,
                     "sky view at {altitude} m, μ_s {mu_s}: {worst:e}"
@@ -490,6 +409,7 @@ mod tests {
             };
             let first = || Marcher::new(Medium::new(&sky.model), lanes.lookup, None);
             let worst = worst_difference(&gather(&first()), &gather(&first().without_lanes()));
+            eprintln!("Ψ_ms: {worst:.2e}");
             assert!(worst < 5e-6, "Ψ_ms: {worst:e}");
         }
     }
@@ -508,26 +428,5 @@ mod tests {
         }
         assert!(worst < 3e-7, "worst relative error {worst:e}");
         assert_eq!(exp_neg([90.0, 104.0, 200.0, 87.0])[..3], [0.0; 3]);
-    }
-
-    #[test]
-    fn ln_is_the_logarithm() {
-        for i in 0..20000 {
-            let x = 1.0 + i as f32 * 0.013;
-            let want = (x as f64).ln();
-            assert!(
-                (ln_f32(x) as f64 - want).abs() < 2e-7 * want.max(1.0),
-                "ln {x}"
-            );
-        }
-    }
-
-    #[test]
-    fn the_column_mapping_is_the_tables() {
-        for i in -1000..=1000 {
-            let mu_s = i as f64 / 1000.0;
-            let want = super::super::params::mu_s_unit(mu_s) * 0.5 + 0.5;
-            assert!((mu_s_unit_half(mu_s) - want).abs() < 2e-7, "μ_s {mu_s}");
-        }
     }
 }

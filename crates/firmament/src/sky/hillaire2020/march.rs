@@ -17,9 +17,10 @@ use crate::sky::bruneton4d::Lookup;
 use crate::spectrum::with_channel_buffers;
 
 use super::harmonics;
-use super::lanes::{Lane, LightLanes, StepLanes, LANES};
+use super::lanes::{Lane, LightLanes, LANES};
 use super::multiple_scattering::MultipleScattering;
 use super::params::altitude_mu_s_uv;
+use super::step_lanes::StepLanes;
 
 /// The extinction and scattering of the air at an altitude, per constituent: what the
 /// march reads at each sample.

@@ -144,11 +144,18 @@ impl<'a> Hillaire2020View<'a> {
 
 /// Steps per interval between consecutive points of [`SkyView::sky_radiance_along`]'s
 /// column march (uniform within each; the aerial-perspective volume's quadratic slices
-/// make the steps denser near the camera, as the per-point march's are). With two, 64
-/// steps for a 32-slice column are closer to a 600-step march than 30 steps per point are
-/// (mean 0.006 % against 0.015 %, worst 0.09 % against 0.42 %: `tests/hillaire2020.rs`),
-/// for a 16th of the steps.
-pub const COLUMN_STEPS_PER_POINT: usize = 2;
+/// make the steps denser near the camera, as the per-point march's are). With one, the 32
+/// steps of a 32-slice column are within a mean 0.014 %, worst 0.15 % of a 600-step march
+/// to each point, where 30 steps per point are within 0.009 % / 0.23 %
+/// (`tests/hillaire2020.rs`), for a 30th of the steps. Two steps per slice (0.006 % /
+/// 0.09 %) cost the volume 40 % more time (5.9 against 4.2 ms, BENCHMARKS.md) for an error
+/// far below the volume's own (0.4 % mean against per-pixel aerial perspective).
+pub const COLUMN_STEPS_PER_POINT: usize = 1;
+
+/// The longest step (m) of that column march: an interval longer than this takes more
+/// steps (the volume's 32 slices over 32 km are at most 2 km wide and take one each; a
+/// column's few points far apart are marched as finely as its slices).
+pub const COLUMN_STEP_MAX_M: f64 = 2_000.0;
 
 /// The lit intervals of `shadow` shifted by `offset` (m: from the observer to the ray's
 /// start), into `buffer`.
@@ -310,38 +317,45 @@ impl SkyView for Hillaire2020View<'_> {
         }
         let mu = start.mu();
         let ground = ray_intersects_ground(start.r, mu, model.bottom_radius_m);
-        for (i, &d) in distances.iter().enumerate() {
-            self.marcher.lookup.transmittance(
-                start.r,
-                mu,
-                d,
-                ground,
-                &mut transmittance[i * n..(i + 1) * n],
-            );
-        }
+        self.marcher.lookup.transmittances_along(
+            start.r,
+            mu,
+            &distances,
+            ground,
+            &mut transmittance[..distances.len() * n],
+        );
         let ray = self.march_ray(&start, dir, previous);
-        let k = COLUMN_STEPS_PER_POINT;
-        let ends = distances.iter().enumerate().flat_map(|(i, &d)| {
-            let from = if i == 0 { 0.0 } else { distances[i - 1] };
-            (1..=k).map(move |j| from + (d - from) * j as f64 / k as f64)
-        });
+        // Each interval's steps: COLUMN_STEPS_PER_POINT, more where it is longer than
+        // COLUMN_STEP_MAX_M; `last_step[i]` is the step that ends at point i.
+        let mut ends = Vec::with_capacity(distances.len() * COLUMN_STEPS_PER_POINT);
+        let mut last_step = Vec::with_capacity(distances.len());
+        let mut from = 0.0;
+        for &d in &distances {
+            let k = COLUMN_STEPS_PER_POINT.max(((d - from) / COLUMN_STEP_MAX_M).ceil() as usize);
+            ends.extend((1..=k).map(|j| from + (d - from) * j as f64 / k as f64));
+            last_step.push(ends.len() - 1);
+            from = d;
+        }
+        let mut next = 0;
         let irradiance = &self.light.irradiance;
         self.with_phases(ray.nu, |phases| {
             with_channel_buffers(n, |[l, t]| {
                 self.marcher.march_over(
                     &ray,
-                    ends,
+                    ends.into_iter(),
                     phases,
                     &Lighting::ALL,
                     l,
                     t,
                     &mut [],
                     |step, so_far| {
-                        if (step + 1) % k == 0 {
-                            let i = (step + 1) / k - 1;
+                        // Points at one distance share their step.
+                        while next < last_step.len() && last_step[next] == step {
+                            let i = next;
                             for (c, o) in radiance[i * n..(i + 1) * n].iter_mut().enumerate() {
                                 *o = so_far[c] * irradiance[c];
                             }
+                            next += 1;
                         }
                     },
                 );
