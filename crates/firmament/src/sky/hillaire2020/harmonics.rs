@@ -33,6 +33,12 @@ pub const fn index(l: usize, m: usize) -> usize {
 /// Every Y_ℓm (ℓ ≤ `degree`, 0 ≤ m ≤ ℓ) at zenith cosine `mu` and azimuth cosine
 /// `cos_phi` (from the light's), into `out` (at least [`coefficient_count`] long).
 pub fn eval(degree: usize, mu: f64, cos_phi: f64, out: &mut [f64]) {
+    let norm = &*NORMALISATIONS;
+    if degree == 0 {
+        // The isotropic field's one constant (every gather direction asks for it).
+        out[0] = norm[0];
+        return;
+    }
     let mu = mu.clamp(-1.0, 1.0);
     let sin_theta = (1.0 - mu * mu).max(0.0).sqrt();
     let cos_phi = cos_phi.clamp(-1.0, 1.0);
@@ -48,7 +54,6 @@ pub fn eval(degree: usize, mu: f64, cos_phi: f64, out: &mut [f64]) {
     // Associated Legendre functions without the Condon–Shortley phase (the same on both
     // sides of the projection): P_m^m = (2m − 1)!!·sin^m θ, P_{m+1}^m = (2m + 1)μ·P_m^m,
     // (ℓ − m)P_ℓ^m = (2ℓ − 1)μ·P_{ℓ−1}^m − (ℓ + m − 1)·P_{ℓ−2}^m.
-    let norm = &*NORMALISATIONS;
     let mut p_mm = 1.0;
     for m in 0..=degree {
         if m > 0 {

@@ -109,10 +109,17 @@ impl LaneTable {
 
     /// Bilinear at columns (x0, x1, tx) of the rows (y0, y1, ty), lane group g.
     #[inline(always)]
-    fn sample(&self, x: (usize, usize, f32), y: (usize, usize, f32), g: usize) -> Lane {
+    fn sample<const G: usize>(
+        &self,
+        x: (usize, usize, f32),
+        y: (usize, usize, f32),
+        g: usize,
+    ) -> Lane {
         let (x0, x1, tx) = x;
         let (y0, y1, ty) = y;
-        let at = |yy: usize, xx: usize| &self.data[(yy * self.width + xx) * self.groups + g];
+        // G lane groups per texel (0: the table's count).
+        let groups = if G > 0 { G } else { self.groups };
+        let at = |yy: usize, xx: usize| &self.data[(yy * self.width + xx) * groups + g];
         let (a, b, c, d) = (at(y0, x0), at(y0, x1), at(y1, x0), at(y1, x1));
         let (w00, w10, w01, w11) = (
             (1.0 - tx) * (1.0 - ty),
@@ -208,7 +215,7 @@ impl LightLanes {
         let constituents = self.field_weight.len();
         let (n, g_count) = (self.channels, self.groups);
         let lanes = &mut profile.lanes;
-        lanes.clear(sun_radius);
+        lanes.clear(profile.steps.len(), constituents, g_count, sun_radius);
         let t = &self.optical_depth;
         // The sun's band around the horizon is sin(horizon angle)·radius = bottom/r·radius:
         // its 1/(2e) is r times this.
@@ -284,9 +291,30 @@ impl LightLanes {
         nu: f64,
         phases: &[f32],
         acc: &mut [Lane],
+        at_end: impl FnMut(usize, &[Lane]),
+    ) {
+        // One lane group (RGB) compiled on its own: its loops over groups unrolled.
+        if self.groups == 1 {
+            self.march_groups::<1>(lanes, r_mu_s, nu, phases, acc, at_end)
+        } else {
+            self.march_groups::<0>(lanes, r_mu_s, nu, phases, acc, at_end)
+        }
+    }
+
+    /// [`LightLanes::march`] over `G` lane groups (0: the model's count).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn march_groups<const G: usize>(
+        &self,
+        lanes: &StepLanes,
+        r_mu_s: f64,
+        nu: f64,
+        phases: &[f32],
+        acc: &mut [Lane],
         mut at_end: impl FnMut(usize, &[Lane]),
     ) {
-        let groups = self.groups;
+        let groups = if G > 0 { G } else { self.groups };
+        let acc = &mut acc[..groups];
         let constituents = self.field_weight.len();
         acc.iter_mut().for_each(|a| *a = [0.0; LANES]);
         let tau = &self.optical_depth;
@@ -305,7 +333,7 @@ impl LightLanes {
                         &lanes.single[i * constituents * groups..(i + 1) * constituents * groups];
                     let (column, row) = (at.transmittance.at(j), lanes.transmittance_row[i]);
                     for (g, a) in acc.iter_mut().enumerate() {
-                        let t_sun = exp_neg(tau.sample(column, row, g));
+                        let t_sun = exp_neg(tau.sample::<G>(column, row, g));
                         let mut phased = [0.0f32; LANES];
                         for (c, p) in phases.iter().enumerate() {
                             let w = &weights[c * groups + g];
@@ -322,7 +350,7 @@ impl LightLanes {
                     let m = &lanes.multiple[i * groups..(i + 1) * groups];
                     let (column, row) = (at.field.at(j), lanes.field_row[i]);
                     for (g, a) in acc.iter_mut().enumerate() {
-                        let psi = field.sample(column, row, g);
+                        let psi = field.sample::<G>(column, row, g);
                         for l in 0..LANES {
                             a[l] += m[g][l] * psi[l];
                         }

@@ -126,8 +126,10 @@ fn block(v: &[f32], b: usize) -> &[f32; BLOCK] {
 }
 
 impl StepLanes {
-    /// Empty, for a light of angular radius `sun_radius` (rad).
-    pub fn clear(&mut self, sun_radius: f64) {
+    /// Empty, with room for `steps` steps of `constituents` × `groups` lanes of weights,
+    /// for a light of angular radius `sun_radius` (rad).
+    pub fn clear(&mut self, steps: usize, constituents: usize, groups: usize, sun_radius: f64) {
+        let padded = steps.div_ceil(BLOCK) * BLOCK;
         for v in [
             &mut self.t_mid,
             &mut self.r,
@@ -140,11 +142,16 @@ impl StepLanes {
             &mut self.cos_horizon,
         ] {
             v.clear();
+            v.reserve(padded);
         }
         self.transmittance_row.clear();
+        self.transmittance_row.reserve(steps);
         self.field_row.clear();
+        self.field_row.reserve(steps);
         self.single.clear();
+        self.single.reserve(steps * constituents * groups);
         self.multiple.clear();
+        self.multiple.reserve(steps * groups);
         self.point_light = sun_radius <= 0.0;
     }
 
