@@ -96,11 +96,7 @@ impl<'a> Lookup<'a> {
                 self.optical_depth_to_top(r_d, mu_d, b);
             }
             for (o, &b) in out.iter_mut().zip(b.iter()) {
-                *o = if *o < MAX_OPTICAL_DEPTH as f64 && b < MAX_OPTICAL_DEPTH as f64 {
-                    (-(*o - b).max(0.0)).exp()
-                } else {
-                    0.0
-                };
+                *o = transmittance_between(*o, b);
             }
         });
     }
@@ -133,11 +129,7 @@ impl<'a> Lookup<'a> {
                     (&*start, &*end)
                 };
                 for ((o, &a), &b) in o.iter_mut().zip(a).zip(b) {
-                    *o = if a < MAX_OPTICAL_DEPTH as f64 && b < MAX_OPTICAL_DEPTH as f64 {
-                        (-(a - b).max(0.0)).exp()
-                    } else {
-                        0.0
-                    };
+                    *o = transmittance_between(a, b);
                 }
             }
         });
@@ -196,5 +188,16 @@ impl<'a> Lookup<'a> {
             self.sizes.irradiance_r,
         );
         table.sample_twilight_into(u, v, self.irradiance_twilight_cells, out);
+    }
+}
+
+/// e^{−(τ_a − τ_b)} between a ray's near end (optical depth `a` to the top) and its far end
+/// (`b`), 0 where either is the table's stand-in for T = 0 (see [`Lookup::transmittance`]).
+#[inline]
+fn transmittance_between(a: f64, b: f64) -> f64 {
+    if a < MAX_OPTICAL_DEPTH as f64 && b < MAX_OPTICAL_DEPTH as f64 {
+        (-(a - b).max(0.0)).exp()
+    } else {
+        0.0
     }
 }

@@ -234,6 +234,7 @@ impl LightLanes {
             lanes.push(StepGeometry {
                 t_mid,
                 r,
+                inv_r,
                 top_minus_r2: self.top * self.top - r * r,
                 d_min,
                 inv_span: if d_max > d_min {

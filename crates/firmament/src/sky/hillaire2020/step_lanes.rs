@@ -80,6 +80,8 @@ pub(crate) struct StepGeometry {
     /// The step's middle (m from the ray's start) and its radius (m).
     pub t_mid: f64,
     pub r: f64,
+    /// 1/r (1/m).
+    pub inv_r: f64,
     /// top² − r² (m²).
     pub top_minus_r2: f64,
     /// The transmittance mapping's shortest and 1/(longest − shortest) distance to the top.
@@ -126,11 +128,9 @@ fn block(v: &[f32], b: usize) -> &[f32; BLOCK] {
 }
 
 impl StepLanes {
-    /// Empty, with room for `steps` steps of `constituents` × `groups` lanes of weights,
-    /// for a light of angular radius `sun_radius` (rad).
-    pub fn clear(&mut self, steps: usize, constituents: usize, groups: usize, sun_radius: f64) {
-        let padded = steps.div_ceil(BLOCK) * BLOCK;
-        for v in [
+    /// The per-step geometry's arrays.
+    fn geometry_mut(&mut self) -> [&mut Vec<f32>; 9] {
+        [
             &mut self.t_mid,
             &mut self.r,
             &mut self.inv_r,
@@ -140,7 +140,14 @@ impl StepLanes {
             &mut self.half_band,
             &mut self.inv_band,
             &mut self.cos_horizon,
-        ] {
+        ]
+    }
+
+    /// Empty, with room for `steps` steps of `constituents` × `groups` lanes of weights,
+    /// for a light of angular radius `sun_radius` (rad).
+    pub fn clear(&mut self, steps: usize, constituents: usize, groups: usize, sun_radius: f64) {
+        let padded = steps.div_ceil(BLOCK) * BLOCK;
+        for v in self.geometry_mut() {
             v.clear();
             v.reserve(padded);
         }
@@ -164,7 +171,7 @@ impl StepLanes {
     pub fn push(&mut self, g: StepGeometry) {
         self.t_mid.push(g.t_mid as f32);
         self.r.push(g.r as f32);
-        self.inv_r.push((1.0 / g.r.max(1.0)) as f32);
+        self.inv_r.push(g.inv_r as f32);
         self.top_minus_r2.push(g.top_minus_r2 as f32);
         self.d_min.push(g.d_min as f32);
         self.inv_span.push(g.inv_span as f32);
@@ -179,17 +186,7 @@ impl StepLanes {
     /// coordinates are computed and not read).
     pub fn pad(&mut self) {
         let padded = self.len().div_ceil(BLOCK) * BLOCK;
-        for v in [
-            &mut self.t_mid,
-            &mut self.r,
-            &mut self.inv_r,
-            &mut self.top_minus_r2,
-            &mut self.d_min,
-            &mut self.inv_span,
-            &mut self.half_band,
-            &mut self.inv_band,
-            &mut self.cos_horizon,
-        ] {
+        for v in self.geometry_mut() {
             let last = v.last().copied().unwrap_or(1.0);
             v.resize(padded, last);
         }
