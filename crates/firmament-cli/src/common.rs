@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use clap::Args;
-use firmament::atmosphere::{Atmosphere, Model};
+use firmament::atmosphere::{Adjustments, Atmosphere, Model};
 use firmament::scene::file::DEFAULT_WAVELENGTHS;
 use firmament::sky::bruneton4d::cache::{Loaded, TableCache};
 use firmament::sky::bruneton4d::{
@@ -59,6 +59,9 @@ pub struct AtmosphereArgs {
     /// Scattering orders and their tail, when no --tables are given.
     #[command(flatten)]
     pub order_args: OrderArgs,
+    /// The atmosphere's aerosols, ozone, Rayleigh scattering, ground or radius changed.
+    #[command(flatten)]
+    pub adjust: AdjustArgs,
     /// Table sizes when no --tables are given: `default` (Bruneton 2017's sizes) or `small` (fast, coarse).
     #[arg(long, default_value = "default", value_name = "default|small")]
     pub table_size: String,
@@ -78,6 +81,52 @@ pub struct AtmosphereArgs {
     /// tables' light comes from the air that the terrain leaves.
     #[arg(skip)]
     pub ground_lift_m: Option<f64>,
+}
+
+/// Changes to the preset's or file's atmosphere (`firmament::atmosphere::Adjustments`, a
+/// scene's `[atmosphere.adjust]`); errors name the field as `adjust.NAME`.
+#[derive(Args, Debug, Clone, Default)]
+pub struct AdjustArgs {
+    /// The aerosols' vertical optical depth at 550 nm, 0–3 (earth: 0.087, hazy: 0.36):
+    /// every aerosol's extinction scaled to it, its spectral shape kept.
+    #[arg(long, value_name = "TAU")]
+    pub aerosol_optical_depth: Option<f64>,
+    /// The ozone column (Dobson units), 0–2000 (earth: 300): the absorbers scaled to it.
+    #[arg(long, value_name = "DU")]
+    pub ozone_du: Option<f64>,
+    /// Factor on the air molecules' (Rayleigh) scattering, 0–10.
+    #[arg(long, value_name = "FACTOR")]
+    pub rayleigh_scale: Option<f64>,
+    /// A grey ground albedo, 0–1, in place of the atmosphere's.
+    #[arg(long = "ground-albedo", value_name = "0-1")]
+    pub grey_ground_albedo: Option<f64>,
+    /// The planet's radius (m), 1e5–1e8; the atmosphere keeps its thickness.
+    #[arg(long, value_name = "M")]
+    pub planet_radius_m: Option<f64>,
+}
+
+impl AdjustArgs {
+    /// The flags as the library's adjustments.
+    pub fn adjustments(&self) -> Adjustments {
+        Adjustments {
+            aerosol_optical_depth: self.aerosol_optical_depth,
+            ozone_du: self.ozone_du,
+            rayleigh_scale: self.rayleigh_scale,
+            ground_albedo: self.grey_ground_albedo,
+            planet_radius_m: self.planet_radius_m,
+        }
+    }
+
+    /// The same flags from the library's adjustments (a scene's).
+    pub fn of(a: &Adjustments) -> AdjustArgs {
+        AdjustArgs {
+            aerosol_optical_depth: a.aerosol_optical_depth,
+            ozone_du: a.ozone_du,
+            rayleigh_scale: a.rayleigh_scale,
+            grey_ground_albedo: a.ground_albedo,
+            planet_radius_m: a.planet_radius_m,
+        }
+    }
 }
 
 /// The orders of scattering computed tables sum (`query`, `bake`, `render`, through
@@ -109,11 +158,12 @@ impl Default for AtmosphereArgs {
 impl AtmosphereArgs {
     /// The chosen atmosphere.
     pub fn atmosphere(&self) -> Result<Atmosphere> {
-        Ok(match (&self.atmosphere, &self.preset) {
+        let base = match (&self.atmosphere, &self.preset) {
             (Some(path), _) => Atmosphere::from_file(path)?,
             (None, Some(name)) => Atmosphere::preset(name)?,
             (None, None) => Atmosphere::preset("earth")?,
-        })
+        };
+        Ok(base.adjusted(&self.adjust.adjustments())?)
     }
 
     /// The wavelengths: --wavelengths, else those of the --tables file, else spectral.

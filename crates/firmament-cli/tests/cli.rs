@@ -63,6 +63,64 @@ fn query_prints_the_documented_json() {
 }
 
 #[test]
+fn adjusted_atmospheres_have_the_depths_asked_and_refuse_what_they_cannot() {
+    let o = run(&[
+        "query",
+        "--wavelengths",
+        "rgb",
+        "--table-size",
+        "small",
+        "--orders",
+        "3",
+        "--no-cache",
+        "--aerosol-optical-depth",
+        "0.5",
+        "--ozone-du",
+        "450",
+        "--rayleigh-scale",
+        "1.5",
+        "--altitude-m",
+        "0",
+        "--sun-zenith-deg",
+        "30",
+        "--view",
+        "0,0",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let tau = |k: &str| v["optical_depth_zenith"][k][1].as_f64().unwrap();
+    // At 550 nm: the aerosols' depth as asked; ozone σ(550)·450 DU; Rayleigh 1.5 × earth's
+    // 0.0973 (Bodhaine 1999).
+    assert!((tau("mie") - 0.5).abs() < 1e-9, "{}", tau("mie"));
+    let ozone = firmament::spectrum::ozone_cross_section_m2(550.0) * 450.0 * 2.6867e20;
+    assert!((tau("ozone") / ozone - 1.0).abs() < 1e-6, "{} {ozone}", tau("ozone"));
+    assert!((tau("rayleigh") - 1.5 * 0.0973).abs() < 0.003, "{}", tau("rayleigh"));
+    let dir = tmp().join("adjust-refused");
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("never.png");
+    for (args, words) in [
+        (
+            vec!["--preset", "mars", "--ozone-du", "300"],
+            vec!["adjust.ozone_du", "no absorber"],
+        ),
+        (
+            vec!["--aerosol-optical-depth=4"],
+            vec!["adjust.aerosol_optical_depth", "[0, 3]"],
+        ),
+        (
+            vec!["--planet-radius-m", "10"],
+            vec!["adjust.planet_radius_m", "[100000, 100000000]"],
+        ),
+    ] {
+        let mut a = vec!["render", "--no-terrain", "--width", "16", "--height", "9"];
+        a.extend(args);
+        a.extend(["--out", out.to_str().unwrap()]);
+        fails_with(&run(&a), &words);
+        assert!(!out.exists());
+    }
+}
+
+#[test]
 fn invalid_query_inputs_are_refused_clearly() {
     let t = tables().to_str().unwrap();
     let base = ["query", "--tables", t, "--sun-zenith-deg", "30"];

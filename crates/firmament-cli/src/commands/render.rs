@@ -37,6 +37,7 @@ pub fn atmosphere_args(
         },
         atmosphere: scene.atmosphere.file.clone(),
         wavelengths: scene.atmosphere.wavelengths.clone(),
+        adjust: crate::common::AdjustArgs::of(&scene.atmosphere.adjust),
         tables,
         table_size: table_size.to_string(),
         no_cache,

@@ -109,6 +109,9 @@ pub struct RenderArgs {
         firmament::scene::file::DEFAULT_WAVELENGTHS,
     ))]
     pub wavelengths: Option<String>,
+    /// Changes to the atmosphere (over the scene's `[atmosphere.adjust]`, field by field).
+    #[command(flatten)]
+    pub adjust: crate::common::AdjustArgs,
     /// Precomputed tables from `firmament bake`.
     #[arg(long, value_name = "FILE")]
     pub tables: Option<PathBuf>,
@@ -435,6 +438,20 @@ pub fn scene_from_args(args: &RenderArgs) -> Result<Scene> {
     }
     if let Some(w) = &args.wavelengths {
         scene.atmosphere.wavelengths = Some(w.clone());
+    }
+    // The flags given override the scene's adjustments one by one.
+    let flags = args.adjust.adjustments();
+    let a = &mut scene.atmosphere.adjust;
+    for (flag, field) in [
+        (flags.aerosol_optical_depth, &mut a.aerosol_optical_depth),
+        (flags.ozone_du, &mut a.ozone_du),
+        (flags.rayleigh_scale, &mut a.rayleigh_scale),
+        (flags.ground_albedo, &mut a.ground_albedo),
+        (flags.planet_radius_m, &mut a.planet_radius_m),
+    ] {
+        if flag.is_some() {
+            *field = flag;
+        }
     }
     if let Some(ev) = args.ev100 {
         scene.output.ev100 = Some(ev);

@@ -2,6 +2,7 @@
 //! shipped as embedded presets, validated field by field, and resolved for a wavelength
 //! grid into a [`Model`] that the tables, the renderer and the reference path tracer share.
 
+pub mod adjust;
 pub mod density_table;
 pub mod groups;
 mod lift;
@@ -14,6 +15,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+pub use adjust::Adjustments;
 pub use groups::ScatteringGroups;
 pub use model::{Model, OpticalDepths};
 

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use super::camera::{Camera, Projection};
 use super::terrain::TerrainConfig;
+use crate::atmosphere::Adjustments;
 use crate::render::tonemap::ToneCurve;
 use crate::{Error, Result};
 
@@ -24,6 +25,11 @@ pub struct SceneAtmosphere {
     /// program is given, else [`DEFAULT_WAVELENGTHS`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wavelengths: Option<String>,
+    /// `[atmosphere.adjust]`: the aerosols' optical depth, the ozone column, the Rayleigh
+    /// scale, the ground albedo or the planet's radius changed on the preset or file
+    /// ([`Adjustments`]).
+    #[serde(default, skip_serializing_if = "Adjustments::is_empty")]
+    pub adjust: Adjustments,
 }
 
 /// The wavelengths a picture is rendered at unless told otherwise: spectral. With the RGB
@@ -51,7 +57,9 @@ pub struct SceneImage {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneSun {
-    /// Zenith angle (degrees, 0–180).
+    /// Zenith angle (degrees, 0–180); the default scene's when absent (a dated scene's
+    /// `[sun]` says only whether the disk is drawn).
+    #[serde(default = "default_sun_zenith")]
     pub zenith_deg: f64,
     /// Azimuth (degrees clockwise from north); the default scene's when absent.
     #[serde(default = "default_sun_azimuth")]
@@ -59,6 +67,10 @@ pub struct SceneSun {
     /// Draw the solar disk.
     #[serde(default = "yes")]
     pub disk: bool,
+}
+
+fn default_sun_zenith() -> f64 {
+    SceneSun::default().zenith_deg
 }
 
 fn default_sun_azimuth() -> f64 {
@@ -187,6 +199,7 @@ impl Default for SceneFile {
                 preset: default_preset(),
                 file: None,
                 wavelengths: None,
+                adjust: Adjustments::default(),
             },
             camera: Camera {
                 projection: Projection::Perspective,
@@ -333,6 +346,10 @@ impl SceneFile {
     /// Check every value; messages name the field.
     pub fn validate(&self) -> Result<()> {
         self.camera.validate()?;
+        self.atmosphere
+            .adjust
+            .validate()
+            .map_err(|e| e.prefixed("atmosphere."))?;
         let (w, h) = (self.image.width, self.image.height);
         if !(1..=32768).contains(&w) {
             return Err(Error::invalid("image.width", w, "an integer in [1, 32768]"));
