@@ -18,6 +18,7 @@ use firmament_gpu::{GpuContext, GpuError, GpuSky};
 use crate::common::{cancel_flag, print_tables_time, spinner, AtmosphereArgs};
 
 mod render_sky;
+mod retable;
 
 pub use render_sky::RenderSky;
 

@@ -53,6 +53,8 @@ pub enum RenderSky<'a> {
         sky: Box<GpuHillaire>,
         sky_model: Box<Model>,
         renderer: Box<GpuHillaireRenderer>,
+        /// Its table passes, kept for a new atmosphere ([`RenderSky::retable`]).
+        precomputer: Box<HillairePrecomputer>,
     },
     /// The 3D tables, computed on the CPU and rendered on the GPU (the clear sky).
     GpuElek3d {
@@ -98,14 +100,15 @@ impl<'a> RenderSky<'a> {
                 let model = atmosphere.model()?;
                 let config = atmosphere.hillaire.config();
                 let started = Instant::now();
-                let sky = on_gpu("Hillaire 2020's tables on the GPU", quiet, || {
-                    let precomputer = HillairePrecomputer::new(&gpu.ctx)
-                        .map_err(|e| gpu_failure("compiling Hillaire 2020's passes", e))?;
-                    let sky = GpuHillaire::compute(&gpu.ctx, &precomputer, &model, &config)
-                        .map_err(|e| gpu_failure("Hillaire 2020's tables", e))?;
-                    gpu.wait_idle("Hillaire 2020's tables")?;
-                    Ok(sky)
-                })?;
+                let (sky, precomputer) =
+                    on_gpu("Hillaire 2020's tables on the GPU", quiet, || {
+                        let precomputer = HillairePrecomputer::new(&gpu.ctx)
+                            .map_err(|e| gpu_failure("compiling Hillaire 2020's passes", e))?;
+                        let sky = GpuHillaire::compute(&gpu.ctx, &precomputer, &model, &config)
+                            .map_err(|e| gpu_failure("Hillaire 2020's tables", e))?;
+                        gpu.wait_idle("Hillaire 2020's tables")?;
+                        Ok((sky, precomputer))
+                    })?;
                 if !quiet {
                     eprintln!(
                         "tables: {:.2} s on the GPU (hillaire2020, f_ms ≤ {:.2}; shader compilation included; kept on the device)",
@@ -120,6 +123,7 @@ impl<'a> RenderSky<'a> {
                     sky: Box::new(sky),
                     sky_model: Box::new(model),
                     renderer: Box::new(renderer),
+                    precomputer: Box::new(precomputer),
                 });
             }
             (Backend::Gpu(gpu), Method::Elek3d) => {
@@ -280,6 +284,7 @@ impl<'a> RenderSky<'a> {
                 sky,
                 sky_model,
                 renderer,
+                ..
             } => {
                 let inputs = RenderInputs {
                     background: sources.background.as_ref(),

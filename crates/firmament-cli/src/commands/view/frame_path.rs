@@ -5,9 +5,12 @@
 //! The same path draws in the window and offscreen (tests, `--screenshot` without one).
 
 use anyhow::{Context, Result};
+use firmament::atmosphere::Adjustments;
 use firmament::render::{Frame, RenderSettings};
 use firmament::scene::sky_lights::SkySources;
 use firmament::scene::terrain::Heightfield;
+use firmament::sky::bruneton4d::amortised::{AmortisedTables, UpdateProgress};
+use firmament::sky::bruneton4d::Bruneton4d;
 use firmament_gpu::display::{
     hdr_buffer, read_hdr_frame, read_rgba8, Display, DisplaySettings, Exposure,
 };
@@ -19,12 +22,10 @@ use crate::backend::{gpu_failure, Backend, RenderSky};
 use crate::commands::render::{sources_of_scene, terrain_and_atmosphere};
 use crate::method::Method;
 
-/// What the sky's tables depend on: rebuilt when it changes.
+/// What the sky's passes and buffers depend on: the sky is built afresh when it changes.
 #[derive(Clone, Debug, PartialEq)]
 struct SkyKey {
     method: Method,
-    preset: String,
-    file: Option<std::path::PathBuf>,
     wavelengths: Option<String>,
     /// The terrain's configuration (its tables take its albedo and floor), as TOML.
     terrain: Option<String>,
@@ -32,17 +33,35 @@ struct SkyKey {
 
 impl SkyKey {
     fn of(state: &ViewState) -> SkyKey {
-        let a = &state.scene.atmosphere;
         SkyKey {
             method: state.method,
-            preset: a.preset.clone(),
-            file: a.file.clone(),
-            wavelengths: a.wavelengths.clone(),
+            wavelengths: state.scene.atmosphere.wavelengths.clone(),
             terrain: state
                 .scene
                 .terrain
                 .as_ref()
                 .map(|t| toml::to_string(t).unwrap_or_default()),
+        }
+    }
+}
+
+/// What only the tables depend on: a change re-runs the tables with the sky's passes kept
+/// (`RenderSky::retable`), or, for the 4D tables on a software rasteriser, spreads their
+/// precomputation over frames (`AmortisedTables`) while the previous ones are drawn.
+#[derive(Clone, Debug, PartialEq)]
+struct AirKey {
+    preset: String,
+    file: Option<std::path::PathBuf>,
+    adjust: Adjustments,
+}
+
+impl AirKey {
+    fn of(state: &ViewState) -> AirKey {
+        let a = &state.scene.atmosphere;
+        AirKey {
+            preset: a.preset.clone(),
+            file: a.file.clone(),
+            adjust: a.adjust.clone(),
         }
     }
 }
@@ -59,9 +78,18 @@ pub struct FramePath {
     backend: &'static Backend,
     /// Baked 4D tables for the first atmosphere (`--tables`), and the table sizes of fresh
     /// ones.
-    tables: Option<(SkyKey, std::path::PathBuf)>,
+    tables: Option<(SkyKey, AirKey, std::path::PathBuf)>,
     table_size: String,
-    sky: Option<(SkyKey, RenderSky<'static>)>,
+    /// The sky, what its passes were built for, and the atmosphere asked of it last.
+    sky: Option<(SkyKey, AirKey, RenderSky<'static>)>,
+    /// The atmosphere's arguments of the last fresh build (the terrain's albedo and floor
+    /// in them): a new atmosphere changes the preset, file and adjustments only.
+    args: Option<crate::common::AtmosphereArgs>,
+    /// The 4D tables' amortised update on a software rasteriser (the CPU computes them
+    /// over frames; the device draws the previous set until the swap).
+    amortised: Option<AmortisedTables>,
+    /// Where the amortised update stood after the last frame.
+    update: Option<UpdateProgress>,
     display: Display,
     /// The HDR frame buffer and its size.
     hdr: Option<(wgpu::Buffer, (u32, u32))>,
@@ -103,9 +131,12 @@ impl FramePath {
         let display = Display::new(&gpu.ctx).map_err(|e| gpu_failure("the display pass", e))?;
         Ok(FramePath {
             backend,
-            tables: tables.map(|t| (SkyKey::of(state), t)),
+            tables: tables.map(|t| (SkyKey::of(state), AirKey::of(state), t)),
             table_size: table_size.to_string(),
             sky: None,
+            args: None,
+            amortised: None,
+            update: None,
             display,
             hdr: None,
             last_build_s: 0.0,
@@ -123,18 +154,51 @@ impl FramePath {
         }
     }
 
-    /// Build the sky when the method or the atmosphere changed; returns whether it did. On
-    /// a software rasteriser the 4D tables come from the CPU (and its cache).
+    /// Build the sky when the method, the wavelengths or the terrain changed; re-run its
+    /// tables when only the atmosphere did (amortised over frames for the 4D tables on a
+    /// software rasteriser); run this frame's share of an amortised update. Returns whether
+    /// the tables drawn changed (the exposure adapts afresh).
     pub fn ensure_sky(&mut self, state: &ViewState) -> Result<bool> {
-        let key = SkyKey::of(state);
-        if self.sky.as_ref().is_some_and(|(k, _)| *k == key) {
+        let (key, air) = (SkyKey::of(state), AirKey::of(state));
+        let retable = match &self.sky {
+            Some((k, a, _)) if *k == key => {
+                // A new planet radius moves the terrain: built afresh.
+                let moved = state.scene.terrain.is_some()
+                    && a.adjust.planet_radius_m != air.adjust.planet_radius_m;
+                (*a != air).then_some(!moved)
+            }
+            _ => Some(false),
+        };
+        match retable {
+            Some(true) => self.retable(state, air)?,
+            Some(false) => {
+                self.build(state, key, air)?;
+                return Ok(true);
+            }
+            None => {}
+        }
+        let Some(amortised) = self.amortised.as_mut() else {
+            return Ok(false);
+        };
+        let report = amortised.frame();
+        self.update = report.running;
+        if !report.swapped {
             return Ok(false);
         }
+        let front = amortised.front();
+        let tables = Bruneton4d::new(front.model.clone(), front.tables.clone())?;
+        let (_, _, sky) = self.sky.as_mut().expect("an update runs for a sky");
+        sky.set_tables(tables)?;
+        self.gpu_terrain = None;
+        Ok(true)
+    }
+
+    /// A fresh sky for `state`.
+    fn build(&mut self, state: &ViewState, key: SkyKey, air: AirKey) -> Result<()> {
         let started = std::time::Instant::now();
         // The baked tables while the atmosphere is theirs (any method reads them as 4D).
-        let tables = self.tables.as_ref().and_then(|(k, path)| {
-            let same =
-                k.preset == key.preset && k.file == key.file && k.wavelengths == key.wavelengths;
+        let tables = self.tables.as_ref().and_then(|(k, a, path)| {
+            let same = k.wavelengths == key.wavelengths && k.terrain == key.terrain && *a == air;
             (same && key.method == Method::Bruneton4d).then(|| path.clone())
         });
         // With a terrain the tables take its mean albedo and its floor, as `render`'s do.
@@ -149,20 +213,82 @@ impl FramePath {
             RenderSky::with_tables_from(self.backend, &atmosphere, key.method, true, software)
                 .with_context(|| format!("building the {} sky", key.method.name()))?;
         self.last_build_s = started.elapsed().as_secs_f64();
-        self.sky = Some((key, sky));
+        // Later atmospheres keep these wavelengths and the terrain's ground.
+        atmosphere.tables = None;
+        atmosphere.wavelengths = Some(
+            sky.model()
+                .wavelengths
+                .nm()
+                .iter()
+                .map(|w| w.to_string())
+                .collect::<Vec<_>>()
+                .join(","),
+        );
+        self.args = Some(atmosphere);
+        self.sky = Some((key, air, sky));
         self.terrain = terrain;
         self.gpu_terrain = None;
-        Ok(true)
+        self.amortised = None;
+        self.update = None;
+        Ok(())
+    }
+
+    /// The tables of a new atmosphere for the sky in use: the 4D tables on a software
+    /// rasteriser through the amortised update (requested here, run by frames), any other
+    /// at once with the sky's passes kept.
+    fn retable(&mut self, state: &ViewState, air: AirKey) -> Result<()> {
+        let mut args = self.args.clone().context("no sky yet")?;
+        let a = &state.scene.atmosphere;
+        (args.preset, args.atmosphere) = match &a.file {
+            Some(f) => (None, Some(f.clone())),
+            None => (Some(a.preset.clone()), None),
+        };
+        args.adjust = crate::common::AdjustArgs::of(&a.adjust);
+        let software = self.ctx().is_software();
+        let (key, held, sky) = self.sky.as_mut().context("no sky yet")?;
+        if key.method == Method::Bruneton4d && software {
+            let model = args.model()?;
+            if self.amortised.is_none() {
+                let RenderSky::Gpu { cpu_sky, .. } = sky else {
+                    anyhow::bail!("the 4D sky on a software rasteriser holds its CPU tables");
+                };
+                let now = cpu_sky.get().context("the 4D sky's CPU tables")?;
+                let front = Bruneton4d::new(now.model.clone(), now.tables.clone())?;
+                self.amortised = Some(AmortisedTables::new(front, state.update_frames)?);
+            }
+            let amortised = self.amortised.as_mut().expect("just made");
+            amortised.set_frames(state.update_frames)?;
+            amortised.request(model)?;
+        } else {
+            let started = std::time::Instant::now();
+            sky.retable(&args, true)
+                .with_context(|| format!("the {} tables", key.method.name()))?;
+            self.last_build_s = started.elapsed().as_secs_f64();
+            self.gpu_terrain = None;
+        }
+        *held = air;
+        Ok(())
+    }
+
+    /// A line for the panel while the 4D tables of a new atmosphere are computed over
+    /// frames (the previous ones drawn meanwhile).
+    pub fn update_line(&self) -> Option<String> {
+        let u = self.update?;
+        Some(format!(
+            "new atmosphere's 4D tables: {:.0} % ({} frames left); drawing the previous ones",
+            100.0 * u.fraction,
+            u.frames_left
+        ))
     }
 
     /// The sky in use (after [`FramePath::ensure_sky`]).
     pub fn sky(&self) -> Option<&RenderSky<'static>> {
-        self.sky.as_ref().map(|(_, s)| s)
+        self.sky.as_ref().map(|(_, _, s)| s)
     }
 
     /// The lights, glow and stars of the scene (from its date and place, or its sun).
     pub fn sources(&self, state: &ViewState) -> Result<SkySources> {
-        let sky = self.sky().context("no sky yet")?;
+        let sky = self.sky.as_ref().map(|(_, _, s)| s).context("no sky yet")?;
         sources_of_scene(sky.model(), &state.scene)
     }
 
@@ -184,7 +310,7 @@ impl FramePath {
             self.hdr = Some((hdr_buffer(self.ctx(), size.0, size.1), size));
         }
         let (hdr, _) = self.hdr.as_ref().expect("just made");
-        let sky = self.sky.as_ref().map(|(_, s)| s).context("no sky yet")?;
+        let sky = self.sky.as_ref().map(|(_, _, s)| s).context("no sky yet")?;
         // The camera's altitude is above the terrain under it, as in `render`.
         let camera = state
             .scene
@@ -346,3 +472,7 @@ pub fn display_settings(state: &ViewState, dt_s: f64, reset: bool) -> DisplaySet
         reset,
     }
 }
+
+#[cfg(test)]
+#[path = "frame_path_tests.rs"]
+mod tests;

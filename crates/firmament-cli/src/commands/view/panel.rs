@@ -32,6 +32,8 @@ pub struct PanelInfo {
     pub shown_ev100: Option<f64>,
     /// Seconds the sky's tables took to build last.
     pub build_s: f64,
+    /// The amortised update of the 4D tables in flight, in words.
+    pub update: Option<String>,
     /// A line about the last capture or save, or an error.
     pub message: String,
     /// What the scene has that the viewer does not draw yet.
@@ -56,6 +58,9 @@ pub fn panel(ui: &mut egui::Ui, state: &mut ViewState, info: &PanelInfo) -> Pane
             ui.radio_value(&mut state.method, m, m.name());
         }
     });
+    if let Some(line) = &info.update {
+        ui.small(line);
+    }
     ui.separator();
     sun_section(ui, state);
     ui.separator();
@@ -81,6 +86,7 @@ pub fn panel(ui: &mut egui::Ui, state: &mut ViewState, info: &PanelInfo) -> Pane
             }
         }
     });
+    air_section(ui, state);
     ui.separator();
     exposure_section(ui, state, info);
     ui.separator();
@@ -117,27 +123,14 @@ pub fn panel(ui: &mut egui::Ui, state: &mut ViewState, info: &PanelInfo) -> Pane
 }
 
 fn sun_section(ui: &mut egui::Ui, state: &mut ViewState) {
+    let mut dated = state.dated();
+    if ui.checkbox(&mut dated, "date and place").changed() {
+        // Off keeps the sun where the date put it; on starts from now.
+        let now = chrono::DateTime::<chrono::Utc>::from(std::time::SystemTime::now());
+        let _ = state.set_dated(dated, now);
+    }
     if state.dated() {
-        let at = state
-            .scene
-            .time
-            .as_ref()
-            .map(|t| t.at.clone())
-            .unwrap_or_default();
-        ui.label(format!("Time: {at}"));
-        ui.horizontal(|ui| {
-            for (label, hours) in [
-                ("−1 h", -1.0),
-                ("−10 min", -1.0 / 6.0),
-                ("+10 min", 1.0 / 6.0),
-                ("+1 h", 1.0),
-            ] {
-                if ui.button(label).clicked() {
-                    // A date the ephemerides refuse stays where it was.
-                    let _ = state.shift_time(hours);
-                }
-            }
-        });
+        date_section(ui, state);
     } else {
         ui.label("Sun (drag with the right mouse button)");
         let mut elevation = state.sun_elevation_deg();
@@ -160,6 +153,162 @@ fn sun_section(ui: &mut egui::Ui, state: &mut ViewState) {
         );
     });
     ui.checkbox(&mut state.scene.sun.disk, "sun disk");
+}
+
+/// The date, the time of day and the place of a dated scene.
+fn date_section(ui: &mut egui::Ui, state: &mut ViewState) {
+    let at = state
+        .scene
+        .time
+        .as_ref()
+        .map(|t| t.at.clone())
+        .unwrap_or_default();
+    ui.label(format!("Time: {at}"));
+    if let Ok(instant) = firmament::astro::Instant::parse(&at, "time.at") {
+        use chrono::Datelike;
+        let d = instant.utc.date_naive();
+        let (mut y, mut m, mut day) = (d.year(), d.month(), d.day());
+        let changed = ui
+            .horizontal(|ui| {
+                let field = |ui: &mut egui::Ui, name: &str, v: &mut u32, hi: u32| {
+                    let label = ui.label(name);
+                    ui.add(egui::DragValue::new(v).range(1..=hi))
+                        .labelled_by(label.id)
+                        .changed()
+                };
+                let mut year = y as u32;
+                let a = field(ui, "year", &mut year, 2200);
+                y = year.max(1800) as i32;
+                let b = field(ui, "month", &mut m, 12);
+                let c = field(ui, "day", &mut day, 31);
+                a || b || c
+            })
+            .inner;
+        if changed {
+            // The last day of a shorter month when the day is past it.
+            for last in (28..=day.max(28)).rev() {
+                if state
+                    .set_date(&format!("{y:04}-{m:02}-{:02}", day.min(last)))
+                    .is_ok()
+                {
+                    break;
+                }
+            }
+        }
+    }
+    if let Some(mut h) = state.solar_hours() {
+        if ui
+            .add(egui::Slider::new(&mut h, 0.0..=24.0).text("local solar time h"))
+            .changed()
+        {
+            let _ = state.set_solar_hours(h);
+        }
+    }
+    ui.horizontal(|ui| {
+        for (label, hours) in [
+            ("−1 h", -1.0),
+            ("−10 min", -1.0 / 6.0),
+            ("+10 min", 1.0 / 6.0),
+            ("+1 h", 1.0),
+        ] {
+            if ui.button(label).clicked() {
+                // A date the ephemerides refuse stays where it was.
+                let _ = state.shift_time(hours);
+            }
+        }
+    });
+    if let Some(l) = state.scene.location.as_mut() {
+        ui.add(egui::Slider::new(&mut l.lat_deg, -90.0..=90.0).text("latitude °"));
+        ui.add(egui::Slider::new(&mut l.lon_deg, -180.0..=180.0).text("longitude °"));
+    }
+    if let Some(t) = state.scene.time.as_mut() {
+        ui.checkbox(&mut t.moon_disk, "moon disk");
+    }
+}
+
+/// The atmosphere's adjustments (`[atmosphere.adjust]`), each slider starting from the
+/// atmosphere's own value.
+fn air_section(ui: &mut egui::Ui, state: &mut ViewState) {
+    let Some(own) = state.air_values() else {
+        return;
+    };
+    let terrain = state.scene.terrain.is_some();
+    let a = &mut state.scene.atmosphere.adjust;
+    adjust_slider(
+        ui,
+        &mut a.aerosol_optical_depth,
+        own.aerosol_optical_depth,
+        (0.0, 3.0),
+        "aerosol optical depth (550 nm)",
+        (true, own.aerosol_optical_depth > 0.0),
+    );
+    adjust_slider(
+        ui,
+        &mut a.ozone_du,
+        own.ozone_du,
+        (0.0, 1000.0),
+        "ozone DU",
+        (false, own.ozone_du > 0.0),
+    );
+    adjust_slider(
+        ui,
+        &mut a.rayleigh_scale,
+        1.0,
+        (0.0, 10.0),
+        "Rayleigh scale",
+        (true, true),
+    );
+    adjust_slider(
+        ui,
+        &mut a.ground_albedo,
+        own.ground_albedo,
+        (0.0, 1.0),
+        "ground albedo",
+        (false, !terrain),
+    );
+    if terrain {
+        ui.small("(the terrain's materials light the tables' ground)");
+    }
+    let mut km = a.planet_radius_m.unwrap_or(own.planet_radius_m) / 1e3;
+    if ui
+        .add(
+            egui::Slider::new(&mut km, 100.0..=100_000.0)
+                .logarithmic(true)
+                .text("planet radius km"),
+        )
+        .changed()
+    {
+        a.planet_radius_m = Some(km * 1e3);
+    }
+    ui.horizontal(|ui| {
+        if ui.button("the atmosphere's own values").clicked() {
+            state.scene.atmosphere.adjust = Default::default();
+        }
+        let label = ui.label("4D update frames");
+        ui.add(egui::DragValue::new(&mut state.update_frames).range(1..=120))
+            .labelled_by(label.id)
+            .on_hover_text(
+                "a new atmosphere's 4D tables are spread over this many frames on a software rasteriser",
+            );
+    });
+}
+
+/// A slider for an adjustment: shows `own` until moved, then holds the value moved to.
+fn adjust_slider(
+    ui: &mut egui::Ui,
+    value: &mut Option<f64>,
+    own: f64,
+    (lo, hi): (f64, f64),
+    label: &str,
+    (logarithmic, enabled): (bool, bool),
+) {
+    let mut v = value.unwrap_or(own);
+    let slider = egui::Slider::new(&mut v, lo..=hi)
+        .logarithmic(logarithmic)
+        .text(label);
+    if ui.add_enabled(enabled, slider).changed() {
+        *value = Some(v);
+    }
 }
 
 fn camera_section(ui: &mut egui::Ui, state: &mut ViewState) {
@@ -231,6 +380,7 @@ fn exposure_section(ui: &mut egui::Ui, state: &mut ViewState, info: &PanelInfo) 
 mod tests {
     use super::*;
     use crate::method::Method;
+    use egui::accesskit::Role;
     use egui_kittest::kittest::Queryable;
     use egui_kittest::Harness;
 
@@ -239,14 +389,17 @@ mod tests {
     }
 
     fn harness(state: ViewState) -> Harness<'static, ViewState> {
-        Harness::new_ui_state(
-            |ui, s: &mut ViewState| {
-                egui::ScrollArea::vertical().show(ui, |ui| {
-                    panel(ui, s, &PanelInfo::default());
-                });
-            },
-            state,
-        )
+        // Tall enough for the whole panel: clicks land on what is shown.
+        Harness::builder()
+            .with_size((420.0, 1400.0))
+            .build_ui_state(
+                |ui, s: &mut ViewState| {
+                    egui::ScrollArea::vertical().show(ui, |ui| {
+                        panel(ui, s, &PanelInfo::default());
+                    });
+                },
+                state,
+            )
     }
 
     #[test]
@@ -303,16 +456,18 @@ mod tests {
         });
         let asked = std::rc::Rc::new(std::cell::Cell::new(PanelActions::default()));
         let seen = asked.clone();
-        let mut h = Harness::new_ui_state(
-            move |ui, s: &mut ViewState| {
-                let a = panel(ui, s, &PanelInfo::default());
-                let mut all = seen.get();
-                all.screenshot |= a.screenshot;
-                all.save_scene |= a.save_scene;
-                seen.set(all);
-            },
-            s,
-        );
+        let mut h = Harness::builder()
+            .with_size((420.0, 1400.0))
+            .build_ui_state(
+                move |ui, s: &mut ViewState| {
+                    let a = panel(ui, s, &PanelInfo::default());
+                    let mut all = seen.get();
+                    all.screenshot |= a.screenshot;
+                    all.save_scene |= a.save_scene;
+                    seen.set(all);
+                },
+                s,
+            );
         h.get_by_label("+1 h").click();
         h.run();
         assert!(h
@@ -333,5 +488,63 @@ mod tests {
                 save_scene: true
             }
         );
+    }
+
+    #[test]
+    fn the_air_sliders_write_the_scenes_adjustments_and_reset() {
+        let mut h = harness(state());
+        h.get_by_role_and_label(Role::Slider, "aerosol optical depth (550 nm)")
+            .set_value_accesskit(0.5);
+        h.get_by_role_and_label(Role::Slider, "ozone DU")
+            .set_value_accesskit(420.0);
+        h.get_by_role_and_label(Role::Slider, "Rayleigh scale")
+            .set_value_accesskit(2.0);
+        h.get_by_role_and_label(Role::Slider, "ground albedo")
+            .set_value_accesskit(0.3);
+        h.get_by_role_and_label(Role::Slider, "planet radius km")
+            .set_value_accesskit(3389.5);
+        h.run();
+        let a = h.state().scene.atmosphere.adjust.clone();
+        assert_eq!(a.aerosol_optical_depth, Some(0.5));
+        assert_eq!(a.ozone_du, Some(420.0));
+        assert_eq!(a.rayleigh_scale, Some(2.0));
+        assert_eq!(a.ground_albedo, Some(0.3));
+        assert!((a.planet_radius_m.unwrap() - 3.3895e6).abs() < 1e-3);
+        // Whatever the panel writes, the library takes.
+        firmament::atmosphere::Atmosphere::earth()
+            .adjusted(&a)
+            .unwrap();
+        h.get_by_label("the atmosphere's own values").click();
+        h.run();
+        assert!(h.state().scene.atmosphere.adjust.is_empty());
+        h.get_by_label("4D update frames").set_value_accesskit(20.0);
+        h.run();
+        assert_eq!(h.state().update_frames, 20);
+    }
+
+    #[test]
+    fn the_date_panel_turns_on_and_moves_the_day_the_hour_and_the_place() {
+        let mut h = harness(state());
+        h.get_by_label("date and place").click();
+        h.run();
+        assert!(h.state().dated());
+        h.get_by_label("year").set_value_accesskit(2027.0);
+        h.get_by_label("month").set_value_accesskit(2.0);
+        h.get_by_label("day").set_value_accesskit(31.0);
+        h.run();
+        // February 31st is the last day of February.
+        let at = h.state().scene.time.as_ref().unwrap().at.clone();
+        assert!(at.starts_with("2027-02-28T"), "{at}");
+        h.get_by_role_and_label(Role::Slider, "local solar time h")
+            .set_value_accesskit(18.5);
+        h.get_by_role_and_label(Role::Slider, "latitude °")
+            .set_value_accesskit(-33.9);
+        h.run();
+        assert!((h.state().solar_hours().unwrap() - 18.5).abs() < 1e-3);
+        assert_eq!(h.state().scene.location.as_ref().unwrap().lat_deg, -33.9);
+        // Off again: the angles of the sun the date put there.
+        h.get_by_label("date and place").click();
+        h.run();
+        assert!(!h.state().dated());
     }
 }

@@ -307,6 +307,7 @@ impl App {
             self.info.build_s = g.path.last_build_s;
             self.reset_exposure = true;
         }
+        self.info.update = g.path.update_line();
         let sources: SkySources = g.path.sources(&self.state)?;
         let frame = match g.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t)

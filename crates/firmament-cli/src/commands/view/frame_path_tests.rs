@@ -1,0 +1,110 @@
+//! The viewer's frame path when the atmosphere changes under it (on the test adapter:
+//! lavapipe in CI): the 4D tables' amortised update draws the previous tables until its
+//! swap, then what a fresh sky of the new atmosphere draws; Hillaire 2020 re-runs its
+//! tables at once with its passes kept.
+
+use super::*;
+use crate::backend::Gpu;
+use firmament::scene::SceneFile;
+
+/// The test adapter as the viewer's backend, or None (skipped outside CI).
+fn backend() -> Option<&'static Backend> {
+    let ctx = firmament_gpu::test_context()?;
+    Some(Box::leak(Box::new(Backend::Gpu(Box::new(Gpu { ctx })))))
+}
+
+/// A small clear-sky view in RGB under a 30° sun, looking at the horizon.
+fn view(method: Method) -> ViewState {
+    let mut scene = SceneFile {
+        terrain: None,
+        ..SceneFile::default()
+    };
+    scene.atmosphere.wavelengths = Some("rgb".into());
+    scene.sun.zenith_deg = 60.0;
+    scene.camera.pitch_deg = 10.0;
+    let mut state = ViewState::new(scene, method, true);
+    state.render_scale = 1.0;
+    state
+}
+
+const SIZE: (u32, u32) = (48, 27);
+
+fn frame(path: &mut FramePath, state: &ViewState) -> Vec<[f32; 3]> {
+    let display = display_settings(state, 1.0 / 60.0, false);
+    path.draw_offscreen(state, SIZE, display)
+        .unwrap()
+        .0
+        .image
+        .data
+}
+
+/// Mean relative luminance difference of two frames.
+fn mean_rel(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
+    let y = |p: &[f32; 3]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
+    let sum: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(p, q)| (y(p) - y(q)).abs() / y(q).max(1e-9))
+        .sum();
+    sum / a.len() as f64
+}
+
+#[test]
+fn a_new_atmosphere_reaches_the_4d_view_over_frames_and_never_stalls_it() {
+    let Some(backend) = backend() else { return };
+    if !backend_is_software(backend) {
+        // Hardware adapters compute the 4D tables on the device at once (not amortised).
+        return;
+    }
+    let mut state = view(Method::Bruneton4d);
+    let mut path = FramePath::new(backend, &state, None, "small").unwrap();
+    let before = frame(&mut path, &state);
+    state.update_frames = 3;
+    state.scene.atmosphere.adjust.aerosol_optical_depth = Some(0.6);
+    // Frames 1 and 2 of 3: the previous tables, drawn bit for bit, the update reported.
+    for k in 1..=2 {
+        let f = frame(&mut path, &state);
+        assert_eq!(f, before, "frame {k} of the update drew other tables");
+        let line = path.update_line().expect("an update in flight");
+        assert!(line.contains("frames left"), "{line}");
+    }
+    // Frame 3 swaps the new tables in: the haze brightens the sky near the horizon.
+    let after = frame(&mut path, &state);
+    assert!(path.update_line().is_none());
+    let change = mean_rel(&after, &before);
+    assert!(change > 0.05, "the haze changed the frame by {change}");
+    // What a fresh sky of the hazy atmosphere draws (its tables from the cache or
+    // computed directly: the same texels).
+    let mut fresh = FramePath::new(backend, &state, None, "small").unwrap();
+    let direct = frame(&mut fresh, &state);
+    let d = mean_rel(&after, &direct);
+    eprintln!("amortised vs fresh: mean |ΔL|/L {d:.2e} (the update changed it by {change:.3})");
+    // The cache keeps half floats (docs/accuracy.md): 4.6e-5 here.
+    assert!(d < 5e-4, "amortised vs fresh sky: {d}");
+}
+
+#[test]
+fn hillaire_redraws_a_new_atmosphere_in_the_next_frame() {
+    let Some(backend) = backend() else { return };
+    let mut state = view(Method::Hillaire2020);
+    let mut path = FramePath::new(backend, &state, None, "small").unwrap();
+    let before = frame(&mut path, &state);
+    state.scene.atmosphere.adjust.ozone_du = Some(600.0);
+    state.scene.atmosphere.adjust.rayleigh_scale = Some(1.5);
+    let after = frame(&mut path, &state);
+    assert!(path.update_line().is_none());
+    let change = mean_rel(&after, &before);
+    let mut fresh = FramePath::new(backend, &state, None, "small").unwrap();
+    let direct = frame(&mut fresh, &state);
+    let d = mean_rel(&after, &direct);
+    eprintln!("hillaire retabled vs fresh: mean |ΔL|/L {d:.2e} (the change {change:.3})");
+    assert!(
+        change > 0.05,
+        "more air and ozone changed the frame by {change}"
+    );
+    assert!(d < 1e-5, "retabled vs fresh sky: {d}");
+}
+
+fn backend_is_software(backend: &Backend) -> bool {
+    matches!(backend, Backend::Gpu(g) if g.ctx.is_software())
+}
