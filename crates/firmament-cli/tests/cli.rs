@@ -93,8 +93,16 @@ fn adjusted_atmospheres_have_the_depths_asked_and_refuse_what_they_cannot() {
     // 0.0973 (Bodhaine 1999).
     assert!((tau("mie") - 0.5).abs() < 1e-9, "{}", tau("mie"));
     let ozone = firmament::spectrum::ozone_cross_section_m2(550.0) * 450.0 * 2.6867e20;
-    assert!((tau("ozone") / ozone - 1.0).abs() < 1e-6, "{} {ozone}", tau("ozone"));
-    assert!((tau("rayleigh") - 1.5 * 0.0973).abs() < 0.003, "{}", tau("rayleigh"));
+    assert!(
+        (tau("ozone") / ozone - 1.0).abs() < 1e-6,
+        "{} {ozone}",
+        tau("ozone")
+    );
+    assert!(
+        (tau("rayleigh") - 1.5 * 0.0973).abs() < 0.003,
+        "{}",
+        tau("rayleigh")
+    );
     let dir = tmp().join("adjust-refused");
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("never.png");

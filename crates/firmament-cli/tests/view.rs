@@ -236,6 +236,83 @@ fn the_viewer_draws_the_terrain_as_render_does() {
     assert!(rel <= 0.01 && mean.abs() <= 0.01, "{rel} {mean}");
 }
 
+/// The offscreen viewer's frame of the clear sky at 32×18 with `extra` flags, into
+/// `STEM.exr` and `STEM.png`.
+fn small_view(dir: &Path, stem: &str, extra: &[&str]) {
+    let scene = clear_scene(dir);
+    let (exr, png) = (
+        dir.join(format!("{stem}.exr")),
+        dir.join(format!("{stem}.png")),
+    );
+    let mut args = vec![
+        "view",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--offscreen",
+        "--frames",
+        "1",
+        "--width",
+        "32",
+        "--height",
+        "18",
+        "--render-scale",
+        "1",
+        "--tables",
+        tables_arg(),
+        "--screenshot",
+        exr.to_str().unwrap(),
+        "--screenshot",
+        png.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    succeeds(&run(&args));
+}
+
+#[test]
+fn the_reference_traced_in_the_view_agrees_with_the_tables_beside_it() {
+    let Some(_gpu) = gpu() else { return };
+    let dir = tmp_subdir("view-reference");
+    small_view(&dir, "tables", &[]);
+    small_view(
+        &dir,
+        "reference",
+        &["--reference", "whole", "--reference-passes", "3"],
+    );
+    small_view(
+        &dir,
+        "split",
+        &["--reference", "split", "--reference-passes", "1"],
+    );
+    // The whole frame traced: 6 paths per wavelength a pixel, so each pixel is noisy but
+    // their mean is the tables' to their accuracy (0.5 % median in daylight) and the noise.
+    let (rel, mean, _) = exr_difference(&dir.join("reference.exr"), &dir.join("tables.exr"));
+    eprintln!(
+        "reference in the view vs the tables: mean luminance {mean:+.3}, mean |ΔL|/L {rel:.3}"
+    );
+    assert!(mean.abs() < 0.03, "mean luminance {mean}");
+    assert!(
+        rel > 0.002 && rel < 0.5,
+        "per pixel {rel}: not traced, or wrong"
+    );
+    // Split: the left half is the tables' frame itself, the right half the tracer's.
+    let t = firmament::io::read_exr(dir.join("tables.exr")).unwrap();
+    let s = firmament::io::read_exr(dir.join("split.exr")).unwrap();
+    let w = t.width;
+    for y in 0..t.height {
+        for x in 0..w / 2 {
+            assert_eq!(s.data[y * w + x], t.data[y * w + x], "left half at {x},{y}");
+        }
+    }
+    let right = (0..t.height)
+        .flat_map(|y| (w / 2..w).map(move |x| y * w + x))
+        .filter(|&i| s.data[i] != t.data[i])
+        .count();
+    assert!(
+        right > t.height * (w / 2) / 2,
+        "only {right} right-half pixels traced"
+    );
+}
+
 #[test]
 fn the_viewer_refuses_what_it_cannot_do() {
     let dir = tmp_subdir("view-refusals");

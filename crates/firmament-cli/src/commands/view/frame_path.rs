@@ -17,6 +17,9 @@ use firmament_gpu::display::{
 use firmament_gpu::pass_timer::{PassTimer, PassTimes};
 use firmament_gpu::{GpuTerrain, RenderTarget};
 
+use std::sync::Arc;
+
+use super::progressive::{Compare, Job, Overlay};
 use super::state::ViewState;
 use crate::backend::{gpu_failure, Backend, RenderSky};
 use crate::commands::render::{sources_of_scene, terrain_and_atmosphere};
@@ -98,12 +101,16 @@ pub struct FramePath {
     /// Per-pass GPU times (None without timestamp queries).
     timer: Option<PassTimer>,
     /// The scene's terrain on the sky's planet (built with the sky).
-    terrain: Option<Heightfield>,
+    terrain: Option<Arc<Heightfield>>,
     /// Its shadow fields, sky domes and air volume on the device for the current lights and
     /// observer (the 4D tables only).
     gpu_terrain: Option<(TerrainKey, GpuTerrain)>,
     /// Seconds the last terrain upload took (its CPU parts).
     pub last_terrain_s: f64,
+    /// The reference path tracer's passes over the frame (`state.compare`).
+    reference: Overlay,
+    /// The atmosphere the reference traces, and the keys it was made for.
+    ref_model: Option<((SkyKey, AirKey), Arc<firmament::atmosphere::Model>)>,
 }
 
 /// The size the sky is drawn at for a target of `size` pixels.
@@ -144,6 +151,8 @@ impl FramePath {
             terrain: None,
             gpu_terrain: None,
             last_terrain_s: 0.0,
+            reference: Overlay::default(),
+            ref_model: None,
         })
     }
 
@@ -226,7 +235,7 @@ impl FramePath {
         );
         self.args = Some(atmosphere);
         self.sky = Some((key, air, sky));
-        self.terrain = terrain;
+        self.terrain = terrain.map(Arc::new);
         self.gpu_terrain = None;
         self.amortised = None;
         self.update = None;
@@ -267,7 +276,53 @@ impl FramePath {
             self.gpu_terrain = None;
         }
         *held = air;
+        self.args = Some(args);
         Ok(())
+    }
+
+    /// What the reference traces for this frame, or why it cannot.
+    fn reference_job(
+        &mut self,
+        state: &ViewState,
+        sources: &SkySources,
+        camera: &firmament::scene::Camera,
+        size: (u32, u32),
+    ) -> std::result::Result<Job, String> {
+        if state.compare == Compare::Off {
+            return Err(String::new());
+        }
+        if sources.lights.len() != 1 || sources.background.is_some() {
+            return Err(
+                "traces the sun's light only so far (not with the moon up or the sun below the horizon)"
+                    .into(),
+            );
+        }
+        let key = (SkyKey::of(state), AirKey::of(state));
+        if self.ref_model.as_ref().is_none_or(|(k, _)| *k != key) {
+            // The planet's own ground: the tracer meets the terrain itself.
+            let args = self.args.as_ref().ok_or("no sky yet")?.unlifted();
+            let model = args.model().map_err(|e| format!("{e:#}"))?;
+            self.ref_model = Some((key, Arc::new(model)));
+        }
+        let (_, model) = self.ref_model.as_ref().expect("just made");
+        Ok(Job {
+            model: model.clone(),
+            terrain: self.terrain.clone(),
+            camera: camera.clone(),
+            sun: sources.lights[0].clone(),
+            size,
+            white_balance: state.scene.output.white_balance,
+        })
+    }
+
+    /// What the panel says of the reference, when shown.
+    pub fn reference_line(&self) -> Option<String> {
+        self.reference.line.clone()
+    }
+
+    /// Passes the reference has averaged for the view last drawn (0 before the first).
+    pub fn reference_passes(&self) -> usize {
+        self.reference.tracer.latest().map_or(0, |r| r.passes)
     }
 
     /// A line for the panel while the 4D tables of a new atmosphere are computed over
@@ -309,12 +364,12 @@ impl FramePath {
         if self.hdr.as_ref().is_none_or(|(_, s)| *s != size) {
             self.hdr = Some((hdr_buffer(self.ctx(), size.0, size.1), size));
         }
+        let radius = self.sky().context("no sky yet")?.model().bottom_radius_m;
+        // The camera's altitude is above the terrain under it, as in `render`.
+        let camera = state.scene.camera_over(self.terrain.as_deref(), radius);
+        let job = self.reference_job(state, sources, &camera, size);
         let (hdr, _) = self.hdr.as_ref().expect("just made");
         let sky = self.sky.as_ref().map(|(_, _, s)| s).context("no sky yet")?;
-        // The camera's altitude is above the terrain under it, as in `render`.
-        let camera = state
-            .scene
-            .camera_over(self.terrain.as_ref(), sky.model().bottom_radius_m);
         let settings = RenderSettings {
             camera: &camera,
             width: size.0 as usize,
@@ -351,6 +406,12 @@ impl FramePath {
             set,
             terrain,
         )?;
+        let ctx = match self.backend {
+            Backend::Gpu(gpu) => &gpu.ctx,
+            Backend::Cpu => unreachable!("FramePath::new refuses the CPU"),
+        };
+        self.reference
+            .encode(ctx, encoder, hdr, size, state.compare, job);
         self.display.encode(
             self.ctx(),
             encoder,

@@ -13,6 +13,7 @@ pub mod controls;
 pub mod frame_path;
 pub mod panel;
 pub mod presets;
+pub mod progressive;
 pub mod state;
 pub mod window;
 
@@ -73,6 +74,14 @@ pub struct ViewArgs {
     /// Where F12's captures and Ctrl+S's scenes are written.
     #[arg(long, default_value = ".", value_name = "DIR")]
     pub capture_dir: PathBuf,
+    /// The reference path tracer beside the method (`split`: the right half) or instead of
+    /// it (`whole`), traced progressively on the CPU; `off` by default.
+    #[arg(long, default_value = "off", value_name = "off|split|whole")]
+    pub reference: String,
+    /// With --frames and --reference: the last frame waits for this many of the
+    /// reference's passes (2 paths per wavelength each).
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    pub reference_passes: usize,
     /// Print nothing but errors.
     #[arg(long, short)]
     pub quiet: bool,
@@ -108,7 +117,7 @@ pub fn load_scene(path: Option<&PathBuf>) -> Result<(SceneFile, Vec<String>)> {
 
 fn check(args: &ViewArgs) -> Result<()> {
     if args.method == Method::Reference {
-        anyhow::bail!("invalid value for `--method`: reference (accepted in the viewer: bruneton4d, hillaire2020, elek3d; the reference's progressive path tracing is not in the viewer yet)");
+        anyhow::bail!("invalid value for `--method`: reference (accepted in the viewer: bruneton4d, hillaire2020, elek3d; the reference is `--reference split|whole` beside one of them)");
     }
     if let Some(s) = args.render_scale {
         if !(0.1..=1.0).contains(&s) {
@@ -137,6 +146,13 @@ fn check(args: &ViewArgs) -> Result<()> {
             args.table_size
         );
     }
+    compare_of(&args.reference)?;
+    if !(1..=10_000).contains(&args.reference_passes) {
+        anyhow::bail!(
+            "invalid value for `--reference-passes`: {} (accepted: 1 to 10000)",
+            args.reference_passes
+        );
+    }
     if args.offscreen && args.frames.is_none() {
         anyhow::bail!("`--offscreen` draws `--frames N` and exits: give --frames");
     }
@@ -150,6 +166,19 @@ fn check(args: &ViewArgs) -> Result<()> {
     Ok(())
 }
 
+/// `--reference`'s value.
+fn compare_of(text: &str) -> Result<progressive::Compare> {
+    use progressive::Compare;
+    Ok(match text {
+        "off" => Compare::Off,
+        "split" => Compare::Split,
+        "whole" => Compare::Whole,
+        other => {
+            anyhow::bail!("invalid value for `--reference`: {other} (accepted: off, split, whole)")
+        }
+    })
+}
+
 /// Run `firmament view`.
 pub fn run(args: &ViewArgs) -> Result<()> {
     check(args)?;
@@ -160,6 +189,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         }
     }
     let mut state = ViewState::new(scene, args.method, false);
+    state.compare = compare_of(&args.reference)?;
     if let Some(s) = args.render_scale {
         state.render_scale = s;
     }
@@ -205,6 +235,22 @@ fn run_offscreen(args: &ViewArgs, mut state: ViewState) -> Result<()> {
                 "view: GPU times of a frame (timestamp queries): sky {:.3} ms, display {:.3} ms",
                 t.sky_ms, t.display_ms
             );
+        }
+    }
+    if state.compare != progressive::Compare::Off {
+        // The tracer runs beside the frames: the last one waits for its passes.
+        while path.reference_passes() < args.reference_passes {
+            if crate::common::cancel_flag().load(std::sync::atomic::Ordering::Relaxed) {
+                anyhow::bail!("interrupted");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+        let display = display_settings(&state, 1.0 / 60.0, false);
+        last = Some(path.draw_offscreen(&state, size, display)?);
+        if !args.quiet {
+            if let Some(line) = path.reference_line() {
+                eprintln!("view: {line}");
+            }
         }
     }
     let (hdr, shown) = last.expect("at least one frame");

@@ -6,6 +6,7 @@
 use firmament::render::tonemap::ToneCurve;
 
 use super::presets::PRESETS as VIEW_PRESETS;
+use super::progressive::Compare;
 use super::state::{ViewState, MAX_ALTITUDE_M, PRESETS, VIEW_METHODS};
 
 /// What the panel asked for this frame, besides editing the state.
@@ -34,6 +35,8 @@ pub struct PanelInfo {
     pub build_s: f64,
     /// The amortised update of the 4D tables in flight, in words.
     pub update: Option<String>,
+    /// The reference's progress, in words.
+    pub reference: Option<String>,
     /// A line about the last capture or save, or an error.
     pub message: String,
     /// What the scene has that the viewer does not draw yet.
@@ -59,6 +62,21 @@ pub fn panel(ui: &mut egui::Ui, state: &mut ViewState, info: &PanelInfo) -> Pane
         }
     });
     if let Some(line) = &info.update {
+        ui.small(line);
+    }
+    ui.horizontal(|ui| {
+        ui.label("reference");
+        for (label, c) in [
+            ("off", Compare::Off),
+            ("split", Compare::Split),
+            ("whole", Compare::Whole),
+        ] {
+            ui.radio_value(&mut state.compare, c, label);
+        }
+    })
+    .response
+    .on_hover_text("the Monte Carlo path tracer, traced progressively on the CPU and restarted when anything moves");
+    if let Some(line) = &info.reference {
         ui.small(line);
     }
     ui.separator();
@@ -518,8 +536,10 @@ mod tests {
         h.run();
         assert!(h.state().scene.atmosphere.adjust.is_empty());
         h.get_by_label("4D update frames").set_value_accesskit(20.0);
+        h.get_by_label("split").click();
         h.run();
         assert_eq!(h.state().update_frames, 20);
+        assert_eq!(h.state().compare, Compare::Split);
     }
 
     #[test]

@@ -9,6 +9,7 @@ use firmament::render::tonemap::ToneCurve;
 use firmament::scene::file::{SceneLocation, SceneTime};
 use firmament::scene::SceneFile;
 
+use super::progressive::Compare;
 use crate::method::Method;
 
 /// The methods the viewer draws with (on the GPU).
@@ -38,6 +39,8 @@ pub struct ViewState {
     /// Frames a new atmosphere's 4D tables are spread over on a software rasteriser
     /// (`AmortisedTables`), the previous tables drawn meanwhile.
     pub update_frames: usize,
+    /// The reference path tracer beside the method's frame (or instead of it).
+    pub compare: Compare,
     /// [`ViewState::air_values`] of the atmosphere last asked (preset, file).
     air_cache: Option<(AirSource, Option<AirValues>)>,
 }
@@ -93,6 +96,7 @@ impl ViewState {
             // A software rasteriser's frames take seconds: a few of them carry the update.
             update_frames: 8,
             air_cache: None,
+            compare: Compare::Off,
         }
     }
 

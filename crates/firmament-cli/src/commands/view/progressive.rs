@@ -1,0 +1,350 @@
+//! The reference path tracer in the viewer: the view traced progressively on a worker
+//! thread (passes of a few paths per wavelength per pixel, each with its own random streams,
+//! averaged), restarted whenever the camera, the light, the atmosphere or the size changes,
+//! and shown beside the sky method's frame (the right half) or instead of it, so the fast
+//! methods are compared with ground truth in place. The window never waits for it: each
+//! frame shows the passes done so far.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+
+use firmament::atmosphere::Model;
+use firmament::reference::{self, ReferenceSettings};
+use firmament::render::RenderSettings;
+use firmament::scene::terrain::Heightfield;
+use firmament::scene::{Camera, Light, Surface};
+
+/// Paths per wavelength per pixel in one pass (the tracer's smallest: two give a standard
+/// error).
+pub const PATHS_PER_PASS: usize = 2;
+
+/// How the reference is shown.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Compare {
+    /// Not traced.
+    #[default]
+    Off,
+    /// The right half of the view is the reference's.
+    Split,
+    /// The whole view is the reference's.
+    Whole,
+}
+
+/// What a trace depends on: a change restarts it.
+#[derive(Clone)]
+pub struct Job {
+    /// The atmosphere as the tracer sees it (the planet's own ground, not the tables'
+    /// lifted one).
+    pub model: Arc<Model>,
+    /// The terrain the paths meet, if any.
+    pub terrain: Option<Arc<Heightfield>>,
+    /// The camera (its altitude already above the terrain).
+    pub camera: Camera,
+    /// The sun.
+    pub sun: Light,
+    /// The frame's size.
+    pub size: (u32, u32),
+    /// Whether the frame is white-balanced to the sun.
+    pub white_balance: bool,
+}
+
+impl Job {
+    fn same(&self, o: &Job) -> bool {
+        self.model.hash == o.model.hash
+            && self.camera == o.camera
+            && self.sun.direction == o.sun.direction
+            && self.sun.visible_disk == o.sun.visible_disk
+            && self.size == o.size
+            && self.white_balance == o.white_balance
+            && self.terrain.as_ref().map(Arc::as_ptr) == o.terrain.as_ref().map(Arc::as_ptr)
+    }
+}
+
+/// The average of the passes done for the current job.
+#[derive(Clone, Debug, Default)]
+pub struct Accumulated {
+    /// The job's number (increases with every restart).
+    pub generation: u64,
+    /// Passes averaged.
+    pub passes: usize,
+    /// Per pixel, rows from the top: linear sRGB with Y in cd/m² and the mask (1 or 0), as
+    /// the GPU's HDR frame holds them.
+    pub pixels: Vec<f32>,
+    /// Mean relative standard error of the pixels' luminance over the passes so far.
+    pub noise: f64,
+    /// Why the trace stopped, if it failed.
+    pub error: Option<String>,
+}
+
+#[derive(Default)]
+struct Shared {
+    job: Mutex<Option<(u64, Job)>>,
+    result: Mutex<Accumulated>,
+    /// Set when the job changes (stops the pass in flight) or the viewer closes.
+    cancel: AtomicBool,
+    quit: AtomicBool,
+}
+
+/// The worker and what it shares with the viewer.
+pub struct Progressive {
+    shared: Arc<Shared>,
+    worker: Option<JoinHandle<()>>,
+    generation: u64,
+    current: Option<Job>,
+}
+
+impl Default for Progressive {
+    fn default() -> Self {
+        Progressive::new()
+    }
+}
+
+impl Progressive {
+    /// An idle tracer (its thread starts with the first job).
+    pub fn new() -> Progressive {
+        Progressive {
+            shared: Arc::new(Shared::default()),
+            worker: None,
+            generation: 0,
+            current: None,
+        }
+    }
+
+    /// Trace `job` (restarting when it differs from the one in flight), or nothing.
+    pub fn set(&mut self, job: Option<Job>) {
+        let same = match (&self.current, &job) {
+            (Some(a), Some(b)) => a.same(b),
+            (None, None) => true,
+            _ => false,
+        };
+        if same {
+            return;
+        }
+        self.generation += 1;
+        self.shared.cancel.store(true, Ordering::Relaxed);
+        *self.shared.job.lock().expect("job lock") = job.clone().map(|j| (self.generation, j));
+        self.current = job;
+        if self.current.is_some() && self.worker.is_none() {
+            let shared = self.shared.clone();
+            self.worker = Some(std::thread::spawn(move || work(&shared)));
+        }
+    }
+
+    /// The passes done for the current job (None before the first ends).
+    pub fn latest(&self) -> Option<Accumulated> {
+        let r = self.shared.result.lock().expect("result lock");
+        (self.current.is_some()
+            && r.generation == self.generation
+            && (r.passes > 0 || r.error.is_some()))
+        .then(|| r.clone())
+    }
+}
+
+impl Drop for Progressive {
+    fn drop(&mut self) {
+        self.shared.quit.store(true, Ordering::Relaxed);
+        self.shared.cancel.store(true, Ordering::Relaxed);
+        if let Some(w) = self.worker.take() {
+            let _ = w.join();
+        }
+    }
+}
+
+/// The worker: passes of the current job until it changes; idle without one.
+fn work(shared: &Shared) {
+    let mut sums: Vec<f64> = Vec::new();
+    let mut noise_sum = 0.0;
+    let mut running: Option<(u64, Job)> = None;
+    let mut pass = 0usize;
+    while !shared.quit.load(Ordering::Relaxed) {
+        let asked = shared.job.lock().expect("job lock").clone();
+        if asked.as_ref().map(|(g, _)| *g) != running.as_ref().map(|(g, _)| *g) {
+            shared.cancel.store(false, Ordering::Relaxed);
+            running = asked;
+            pass = 0;
+            sums.clear();
+            noise_sum = 0.0;
+        }
+        let Some((generation, job)) = &running else {
+            std::thread::sleep(std::time::Duration::from_millis(20));
+            continue;
+        };
+        match trace_pass(job, pass as u64, &shared.cancel) {
+            Ok((pixels, noise)) => {
+                if sums.is_empty() {
+                    sums = vec![0.0; pixels.len()];
+                }
+                for (s, p) in sums.iter_mut().zip(&pixels) {
+                    *s += *p as f64;
+                }
+                pass += 1;
+                noise_sum += noise;
+                let n = pass as f64;
+                let mut r = shared.result.lock().expect("result lock");
+                *r = Accumulated {
+                    generation: *generation,
+                    passes: pass,
+                    pixels: sums.iter().map(|s| (s / n) as f32).collect(),
+                    // Independent passes: the mean's error falls as 1/√passes.
+                    noise: noise_sum / n / n.sqrt(),
+                    error: None,
+                };
+            }
+            Err(firmament::Error::Interrupted) => {}
+            Err(e) => {
+                *shared.result.lock().expect("result lock") = Accumulated {
+                    generation: *generation,
+                    error: Some(e.to_string()),
+                    ..Default::default()
+                };
+                // Wait for another job.
+                while shared
+                    .job
+                    .lock()
+                    .expect("job lock")
+                    .as_ref()
+                    .map(|(g, _)| *g)
+                    == Some(*generation)
+                    && !shared.quit.load(Ordering::Relaxed)
+                {
+                    std::thread::sleep(std::time::Duration::from_millis(20));
+                }
+            }
+        }
+    }
+}
+
+/// One pass: the frame at [`PATHS_PER_PASS`] paths per wavelength with the pass's random
+/// streams; its pixels (RGBA as the HDR frame) and its mean relative noise.
+fn trace_pass(job: &Job, pass: u64, cancel: &AtomicBool) -> firmament::Result<(Vec<f32>, f64)> {
+    let surfaces: Vec<Box<dyn Surface + '_>> = job
+        .terrain
+        .iter()
+        .map(|t| Box::new(t.as_ref()) as _)
+        .collect();
+    let settings = RenderSettings {
+        camera: &job.camera,
+        width: job.size.0 as usize,
+        height: job.size.1 as usize,
+        white_balance: job.white_balance,
+    };
+    let reference = ReferenceSettings {
+        seed: 0x5eed_0000 + pass,
+        ..ReferenceSettings::with_samples(PATHS_PER_PASS)
+    };
+    let (frame, noise) = reference::render_frame(
+        &job.model,
+        &[],
+        &surfaces,
+        &settings,
+        &job.sun,
+        &reference,
+        &|_| {},
+        Some(cancel),
+    )?;
+    let pixels = frame
+        .image
+        .data
+        .iter()
+        .zip(&frame.mask)
+        .flat_map(|(p, &m)| [p[0], p[1], p[2], if m { 1.0 } else { 0.0 }])
+        .collect();
+    Ok((pixels, noise))
+}
+
+/// The reference's passes on the device: uploaded when a pass ends, copied over the sky
+/// method's HDR frame (its right half, or all of it) before the display pass.
+#[derive(Default)]
+pub struct Overlay {
+    /// The tracer.
+    pub tracer: Progressive,
+    /// The latest average on the device, its size, and which (generation, passes) it is.
+    buffer: Option<(wgpu::Buffer, (u32, u32))>,
+    uploaded: Option<(u64, usize)>,
+    /// What the panel says about it.
+    pub line: Option<String>,
+}
+
+impl Overlay {
+    /// Trace `job` when `compare` asks for the reference (else stop), upload a newly ended
+    /// pass, and record its copy over `hdr` (the frame of `size`) into `encoder`.
+    pub fn encode(
+        &mut self,
+        ctx: &firmament_gpu::GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        hdr: &wgpu::Buffer,
+        size: (u32, u32),
+        compare: Compare,
+        job: Result<Job, String>,
+    ) {
+        let job = match (compare, job) {
+            (Compare::Off, _) => {
+                self.tracer.set(None);
+                self.line = None;
+                return;
+            }
+            (_, Err(why)) => {
+                self.tracer.set(None);
+                self.line = Some(format!("reference: {why}"));
+                return;
+            }
+            (_, Ok(job)) => job,
+        };
+        self.tracer.set(Some(job));
+        let Some(latest) = self.tracer.latest() else {
+            self.line =
+                Some("reference: tracing its first pass (the method's frame meanwhile)".into());
+            return;
+        };
+        if let Some(e) = &latest.error {
+            self.line = Some(format!("reference: {e}"));
+            return;
+        }
+        let bytes = size.0 as u64 * size.1 as u64 * firmament_gpu::PIXEL_BYTES;
+        if self.buffer.as_ref().is_none_or(|(_, s)| *s != size) {
+            let buffer = ctx.device().create_buffer(&wgpu::BufferDescriptor {
+                label: Some("reference frame"),
+                size: bytes,
+                usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            self.buffer = Some((buffer, size));
+            self.uploaded = None;
+        }
+        let (buffer, _) = self.buffer.as_ref().expect("just made");
+        let mark = (latest.generation, latest.passes);
+        if self.uploaded != Some(mark) && latest.pixels.len() as u64 * 4 == bytes {
+            let raw: Vec<u8> = latest.pixels.iter().flat_map(|v| v.to_le_bytes()).collect();
+            ctx.queue().write_buffer(buffer, 0, &raw);
+            self.uploaded = Some(mark);
+        }
+        self.line = Some(format!(
+            "reference{}: {} passes, {} paths/λ a pixel, noise {:.1} %",
+            if compare == Compare::Split {
+                " (right half)"
+            } else {
+                ""
+            },
+            latest.passes,
+            latest.passes * PATHS_PER_PASS,
+            100.0 * latest.noise
+        ));
+        if self.uploaded.is_none() {
+            return;
+        }
+        match compare {
+            Compare::Whole => encoder.copy_buffer_to_buffer(buffer, 0, hdr, 0, bytes),
+            _ => {
+                // Row by row, the columns from the middle on.
+                let (w, h) = (size.0 as u64, size.1 as u64);
+                let px = firmament_gpu::PIXEL_BYTES;
+                let from = w / 2;
+                for y in 0..h {
+                    let offset = (y * w + from) * px;
+                    encoder.copy_buffer_to_buffer(buffer, offset, hdr, offset, (w - from) * px);
+                }
+            }
+        }
+    }
+}
