@@ -12,7 +12,7 @@ use std::path::Path;
 use std::process::Command;
 use std::sync::{Mutex, MutexGuard, OnceLock};
 
-use common::{fails_with, run, succeeds, tables_arg, tmp_subdir};
+use common::{fails_with, run, run_past_lavapipe_crashes, succeeds, tables_arg, tmp_subdir};
 
 fn gpu() -> Option<MutexGuard<'static, ()>> {
     static AVAILABLE: OnceLock<bool> = OnceLock::new();
@@ -57,7 +57,7 @@ fn clear_scene(dir: &Path) -> std::path::PathBuf {
 
 /// The offscreen viewer's frame of `scene`, its scene saved.
 fn offscreen(dir: &Path, scene: &Path, size: (u32, u32), method: &str) -> std::process::Output {
-    run(&[
+    run_past_lavapipe_crashes(&[
         "view",
         "--scene",
         scene.to_str().unwrap(),
@@ -86,7 +86,7 @@ fn offscreen(dir: &Path, scene: &Path, size: (u32, u32), method: &str) -> std::p
 /// `firmament render` of the scene the viewer saved in `dir`, on the GPU from the same
 /// tables: `render.exr` and `render.png`.
 fn render_saved_scene(dir: &Path) {
-    succeeds(&run(&[
+    succeeds(&run_past_lavapipe_crashes(&[
         "render",
         "--scene",
         dir.join("scene.toml").to_str().unwrap(),
@@ -311,6 +311,32 @@ fn the_reference_traced_in_the_view_agrees_with_the_tables_beside_it() {
         right > t.height * (w / 2) / 2,
         "only {right} right-half pixels traced"
     );
+}
+
+#[test]
+fn the_viewer_draws_the_clouds_as_render_does() {
+    let Some(_gpu) = gpu() else { return };
+    let dir = tmp_subdir("view-clouds");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/clouds-cumulus-noon.toml");
+    succeeds(&offscreen(&dir, &scene, (64, 36), "bruneton4d"));
+    // The saved scene keeps the clouds, and render draws them on the GPU from it.
+    let text = std::fs::read_to_string(dir.join("scene.toml")).unwrap();
+    assert!(text.contains("[[clouds]]"), "{text}");
+    render_saved_scene(&dir);
+    let (rel, mean, _) = exr_difference(&dir.join("view.exr"), &dir.join("render.exr"));
+    eprintln!("clouds: view vs render: mean |ΔL|/L {rel:.2e}, mean luminance {mean:+.2e}");
+    assert!(rel <= 0.01 && mean.abs() <= 0.01, "{rel} {mean}");
+    // And they are there: the cloudy view is not the clear sky's.
+    let clear = dir.join("clear-sky.toml");
+    let mut s: firmament::scene::SceneFile =
+        toml::from_str(&std::fs::read_to_string(&scene).unwrap()).unwrap();
+    s.clouds.clear();
+    std::fs::write(&clear, toml::to_string(&s).unwrap()).unwrap();
+    let clear_dir = dir.join("clear");
+    std::fs::create_dir_all(&clear_dir).unwrap();
+    succeeds(&offscreen(&clear_dir, &clear, (64, 36), "bruneton4d"));
+    let (rel, _, _) = exr_difference(&dir.join("view.exr"), &clear_dir.join("view.exr"));
+    assert!(rel > 0.1, "the clouds changed the view by {rel} only");
 }
 
 #[test]

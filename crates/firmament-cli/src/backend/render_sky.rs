@@ -313,9 +313,10 @@ impl<'a> RenderSky<'a> {
 
     /// Record a frame lit by `sources` into `target` on the GPU (nothing submitted), over
     /// `terrain` when given (uploaded by [`RenderSky::gpu_terrain`] for these lights and
-    /// this camera; the 4D tables only); no clouds or stars (those need the CPU's parts of
-    /// [`RenderSky::render`]); `timestamps` as `RenderInputs::timestamps`. The viewer's
-    /// frame path.
+    /// this camera; the 4D tables only), or under `clouds` (uploaded by
+    /// [`RenderSky::gpu_clouds`]; the 4D tables without a terrain only); no stars (those
+    /// need the CPU's parts of [`RenderSky::render`]); `timestamps` as
+    /// `RenderInputs::timestamps`. The viewer's frame path.
     pub fn encode_frame(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -324,14 +325,16 @@ impl<'a> RenderSky<'a> {
         target: RenderTarget,
         timestamps: Option<&wgpu::QuerySet>,
         terrain: Option<&GpuTerrain>,
+        clouds: Option<&GpuClouds>,
     ) -> Result<()> {
-        if terrain.is_some() && !matches!(self, RenderSky::Gpu { .. }) {
-            anyhow::bail!("a terrain is drawn on the GPU by the 4D tables only so far");
+        if (terrain.is_some() || clouds.is_some()) && !matches!(self, RenderSky::Gpu { .. }) {
+            anyhow::bail!("a terrain or clouds are drawn on the GPU by the 4D tables only so far");
         }
         let inputs = RenderInputs {
             background: sources.background.as_ref(),
             timestamps,
             terrain,
+            clouds,
             ..RenderInputs::default()
         };
         let lights = &sources.lights;
@@ -420,7 +423,7 @@ impl<'a> RenderSky<'a> {
 
     /// The cloud layers on the device for a GPU frame: their noise, weather and two-stream
     /// tables, and each light's cloud-shadow map computed on the CPU.
-    fn gpu_clouds(
+    pub fn gpu_clouds(
         &self,
         media: &[CloudMedium],
         settings: &RenderSettings,

@@ -49,6 +49,27 @@ pub fn run(args: &[&str]) -> Output {
     bin().args(args).output().expect("run the firmament binary")
 }
 
+/// [`run`], again (up to six runs) when the process is killed by a signal: Mesa's
+/// lavapipe (22.3, LLVM 15) crashes in its queue thread in some runs of the cloud shader
+/// (a jump to a wild address in `libvulkan_lvp.so` (gdb), or glibc's heap abort; during
+/// the frame or at exit after the output is written; 6 of 16 `render --backend gpu` runs
+/// of `clouds-cumulus-noon` on a 2-core host, 2026-12-06; the runs that finish give
+/// identical frames; see firmament-gpu's `clouds_parity`). An exit code is returned at
+/// once.
+pub fn run_past_lavapipe_crashes(args: &[&str]) -> Output {
+    for attempt in 1..=6 {
+        let o = run(args);
+        if o.status.code().is_some() {
+            return o;
+        }
+        eprintln!(
+            "attempt {attempt}: killed by a signal ({}): lavapipe's crash, running it again",
+            o.status
+        );
+    }
+    panic!("killed by a signal six times: {args:?}");
+}
+
 /// `firmament render --scene SCENE --tables (the small tables) --out OUT`, and `extra`.
 pub fn render_scene(scene: &Path, out: &Path, extra: &[&str]) -> Output {
     let mut args = vec![

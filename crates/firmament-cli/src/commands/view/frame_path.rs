@@ -7,6 +7,7 @@
 use anyhow::{Context, Result};
 use firmament::atmosphere::Adjustments;
 use firmament::render::{Frame, RenderSettings};
+use firmament::scene::clouds::CloudMedium;
 use firmament::scene::sky_lights::SkySources;
 use firmament::scene::terrain::Heightfield;
 use firmament::sky::bruneton4d::amortised::{AmortisedTables, UpdateProgress};
@@ -15,7 +16,7 @@ use firmament_gpu::display::{
     hdr_buffer, read_hdr_frame, read_rgba8, Display, DisplaySettings, Exposure,
 };
 use firmament_gpu::pass_timer::{PassTimer, PassTimes};
-use firmament_gpu::{GpuTerrain, RenderTarget};
+use firmament_gpu::{GpuClouds, GpuTerrain, RenderTarget};
 
 use std::sync::Arc;
 
@@ -107,6 +108,10 @@ pub struct FramePath {
     gpu_terrain: Option<(TerrainKey, GpuTerrain)>,
     /// Seconds the last terrain upload took (its CPU parts).
     pub last_terrain_s: f64,
+    /// The scene's cloud layers as media (their TOML and planet radius as the key).
+    clouds: Option<(String, f64, Arc<Vec<CloudMedium>>)>,
+    /// Their shadow maps on the device for the current lights and observer.
+    gpu_clouds: Option<(TerrainKey, GpuClouds)>,
     /// The reference path tracer's passes over the frame (`state.compare`).
     reference: Overlay,
     /// The atmosphere the reference traces, and the keys it was made for.
@@ -153,6 +158,8 @@ impl FramePath {
             last_terrain_s: 0.0,
             reference: Overlay::default(),
             ref_model: None,
+            clouds: None,
+            gpu_clouds: None,
         })
     }
 
@@ -199,6 +206,7 @@ impl FramePath {
         let (_, _, sky) = self.sky.as_mut().expect("an update runs for a sky");
         sky.set_tables(tables)?;
         self.gpu_terrain = None;
+        self.gpu_clouds = None;
         Ok(true)
     }
 
@@ -237,6 +245,7 @@ impl FramePath {
         self.sky = Some((key, air, sky));
         self.terrain = terrain.map(Arc::new);
         self.gpu_terrain = None;
+        self.gpu_clouds = None;
         self.amortised = None;
         self.update = None;
         Ok(())
@@ -274,10 +283,36 @@ impl FramePath {
                 .with_context(|| format!("the {} tables", key.method.name()))?;
             self.last_build_s = started.elapsed().as_secs_f64();
             self.gpu_terrain = None;
+            self.gpu_clouds = None;
         }
         *held = air;
         self.args = Some(args);
         Ok(())
+    }
+
+    /// The scene's cloud layers as media on a planet of `radius_m` (built when their
+    /// settings change: the noise volumes come from the disk cache).
+    fn ensure_clouds(&mut self, state: &ViewState, radius_m: f64) -> Result<()> {
+        let key = toml::to_string(&state.scene.clouds).unwrap_or_default();
+        if self
+            .clouds
+            .as_ref()
+            .is_some_and(|(k, r, _)| *k == key && *r == radius_m)
+        {
+            return Ok(());
+        }
+        let media = crate::common::scene_clouds(&state.scene, radius_m, true)?;
+        self.clouds = Some((key, radius_m, Arc::new(media)));
+        self.gpu_clouds = None;
+        Ok(())
+    }
+
+    /// Whether the scene's clouds are drawn with this method (the 4D tables over the
+    /// planet's sphere), for the panel.
+    pub fn clouds_drawn(&self, state: &ViewState) -> bool {
+        state.method == Method::Bruneton4d
+            && self.terrain.is_none()
+            && self.clouds.as_ref().is_some_and(|(_, _, m)| !m.is_empty())
     }
 
     /// What the reference traces for this frame, or why it cannot.
@@ -305,9 +340,15 @@ impl FramePath {
             self.ref_model = Some((key, Arc::new(model)));
         }
         let (_, model) = self.ref_model.as_ref().expect("just made");
+        // The clouds the method draws, the tracer meets too.
+        let volumes = match &self.clouds {
+            Some((_, _, media)) if self.clouds_drawn(state) => Some(media.clone()),
+            _ => None,
+        };
         Ok(Job {
             model: model.clone(),
             terrain: self.terrain.clone(),
+            volumes,
             camera: camera.clone(),
             sun: sources.lights[0].clone(),
             size,
@@ -365,6 +406,7 @@ impl FramePath {
             self.hdr = Some((hdr_buffer(self.ctx(), size.0, size.1), size));
         }
         let radius = self.sky().context("no sky yet")?.model().bottom_radius_m;
+        self.ensure_clouds(state, radius)?;
         // The camera's altitude is above the terrain under it, as in `render`.
         let camera = state.scene.camera_over(self.terrain.as_deref(), radius);
         let job = self.reference_job(state, sources, &camera, size);
@@ -397,6 +439,30 @@ impl FramePath {
             }
             _ => None,
         };
+        // The clouds with the 4D tables over the planet's sphere (the GPU draws clouds over a
+        // terrain not yet); their shadow maps follow the lights and the observer.
+        let light_key = TerrainKey {
+            lights: sources
+                .lights
+                .iter()
+                .map(|l| [l.direction.x, l.direction.y, l.direction.z])
+                .collect(),
+            altitude_m: camera.altitude_m,
+        };
+        let clouds = match (&self.clouds, state.method, &self.terrain) {
+            (Some((_, _, media)), Method::Bruneton4d, None) if !media.is_empty() => {
+                if self
+                    .gpu_clouds
+                    .as_ref()
+                    .is_none_or(|(k, _)| *k != light_key)
+                {
+                    let uploaded = sky.gpu_clouds(media, &settings, sources, true)?;
+                    self.gpu_clouds = Some((light_key, uploaded));
+                }
+                self.gpu_clouds.as_ref().map(|(_, c)| c)
+            }
+            _ => None,
+        };
         let set = self.timer.as_ref().map(|t| t.query_set());
         sky.encode_frame(
             encoder,
@@ -405,6 +471,7 @@ impl FramePath {
             RenderTarget::Buffer(hdr),
             set,
             terrain,
+            clouds,
         )?;
         let ctx = match self.backend {
             Backend::Gpu(gpu) => &gpu.ctx,

@@ -101,9 +101,10 @@ pub fn load_scene(path: Option<&PathBuf>) -> Result<(SceneFile, Vec<String>)> {
         );
     }
     if !scene.clouds.is_empty() {
-        scene.clouds.clear();
-        not_drawn
-            .push("the scene's clouds: `firmament render` draws them, the viewer not yet".into());
+        not_drawn.push(
+            "the scene's clouds: drawn with bruneton4d over the planet's sphere (over a terrain, `firmament render` draws them on the CPU)"
+                .into(),
+        );
     }
     if scene.surface.take().is_some() {
         not_drawn.push(

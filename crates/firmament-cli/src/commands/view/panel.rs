@@ -105,6 +105,7 @@ pub fn panel(ui: &mut egui::Ui, state: &mut ViewState, info: &PanelInfo) -> Pane
         }
     });
     air_section(ui, state);
+    clouds_section(ui, state);
     ui.separator();
     exposure_section(ui, state, info);
     ui.separator();
@@ -309,6 +310,47 @@ fn air_section(ui: &mut egui::Ui, state: &mut ViewState) {
                 "a new atmosphere's 4D tables are spread over this many frames on a software rasteriser",
             );
     });
+}
+
+/// The scene's cloud layers: coverage, base (the thickness kept) and the wind's offset.
+fn clouds_section(ui: &mut egui::Ui, state: &mut ViewState) {
+    if state.scene.clouds.is_empty() {
+        return;
+    }
+    ui.label("Clouds (drawn with bruneton4d over the planet's sphere)");
+    for (i, layer) in state.scene.clouds.iter_mut().enumerate() {
+        let p = layer.resolved();
+        let name = format!("{:?}", p.kind).to_lowercase();
+        let mut coverage = p.coverage;
+        if ui
+            .add(egui::Slider::new(&mut coverage, 0.0..=1.0).text(format!("{name} {i}: coverage")))
+            .changed()
+        {
+            layer.coverage = Some(coverage);
+        }
+        let mut base_km = p.bottom_m / 1e3;
+        if ui
+            .add(egui::Slider::new(&mut base_km, 0.1..=15.0).text(format!("{name} {i}: base km")))
+            .changed()
+        {
+            let thickness = p.top_m - p.bottom_m;
+            layer.bottom_m = Some(base_km * 1e3);
+            layer.top_m = Some(base_km * 1e3 + thickness);
+        }
+        ui.horizontal(|ui| {
+            let label = ui.label(format!("{name} {i}: wind offset km (east, north)"));
+            for k in 0..2 {
+                let mut km = layer.wind_offset_m[k] / 1e3;
+                if ui
+                    .add(egui::DragValue::new(&mut km).speed(0.1))
+                    .labelled_by(label.id)
+                    .changed()
+                {
+                    layer.wind_offset_m[k] = km * 1e3;
+                }
+            }
+        });
+    }
 }
 
 /// A slider for an adjustment: shows `own` until moved, then holds the value moved to.
@@ -566,5 +608,21 @@ mod tests {
         h.get_by_label("date and place").click();
         h.run();
         assert!(!h.state().dated());
+    }
+
+    #[test]
+    fn the_cloud_sliders_move_the_layer() {
+        let mut s = state();
+        s.scene.clouds = vec![toml::from_str("kind = \"cumulus\"").unwrap()];
+        let mut h = harness(s);
+        h.get_by_role_and_label(Role::Slider, "cumulus 0: coverage")
+            .set_value_accesskit(0.7);
+        h.get_by_role_and_label(Role::Slider, "cumulus 0: base km")
+            .set_value_accesskit(2.0);
+        h.run();
+        let layer = &h.state().scene.clouds[0];
+        assert_eq!(layer.coverage, Some(0.7));
+        // The layer keeps its 2 km thickness.
+        assert_eq!((layer.bottom_m, layer.top_m), (Some(2000.0), Some(4000.0)));
     }
 }

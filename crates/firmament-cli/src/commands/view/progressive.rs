@@ -12,8 +12,9 @@ use std::thread::JoinHandle;
 use firmament::atmosphere::Model;
 use firmament::reference::{self, ReferenceSettings};
 use firmament::render::RenderSettings;
+use firmament::scene::clouds::CloudMedium;
 use firmament::scene::terrain::Heightfield;
-use firmament::scene::{Camera, Light, Surface};
+use firmament::scene::{Camera, Light, Surface, Volume};
 
 /// Paths per wavelength per pixel in one pass (the tracer's smallest: two give a standard
 /// error).
@@ -39,6 +40,8 @@ pub struct Job {
     pub model: Arc<Model>,
     /// The terrain the paths meet, if any.
     pub terrain: Option<Arc<Heightfield>>,
+    /// The cloud layers the paths meet (delta tracking), if any.
+    pub volumes: Option<Arc<Vec<CloudMedium>>>,
     /// The camera (its altitude already above the terrain).
     pub camera: Camera,
     /// The sun.
@@ -58,6 +61,7 @@ impl Job {
             && self.size == o.size
             && self.white_balance == o.white_balance
             && self.terrain.as_ref().map(Arc::as_ptr) == o.terrain.as_ref().map(Arc::as_ptr)
+            && self.volumes.as_ref().map(Arc::as_ptr) == o.volumes.as_ref().map(Arc::as_ptr)
     }
 }
 
@@ -223,6 +227,12 @@ fn trace_pass(job: &Job, pass: u64, cancel: &AtomicBool) -> firmament::Result<(V
         .iter()
         .map(|t| Box::new(t.as_ref()) as _)
         .collect();
+    let volumes: Vec<Box<dyn Volume + '_>> = job
+        .volumes
+        .iter()
+        .flat_map(|v| v.iter())
+        .map(|c| Box::new(c) as _)
+        .collect();
     let settings = RenderSettings {
         camera: &job.camera,
         width: job.size.0 as usize,
@@ -235,7 +245,7 @@ fn trace_pass(job: &Job, pass: u64, cancel: &AtomicBool) -> firmament::Result<(V
     };
     let (frame, noise) = reference::render_frame(
         &job.model,
-        &[],
+        &volumes,
         &surfaces,
         &settings,
         &job.sun,
