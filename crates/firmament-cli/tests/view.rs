@@ -340,6 +340,31 @@ fn the_viewer_draws_the_clouds_as_render_does() {
 }
 
 #[test]
+fn the_viewer_draws_the_moon_and_the_stars_as_render_does() {
+    let Some(_gpu) = gpu() else { return };
+    let dir = tmp_subdir("view-night");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/moonlit.toml");
+    succeeds(&offscreen(&dir, &scene, (96, 54), "bruneton4d"));
+    render_saved_scene(&dir);
+    let (rel, mean, _) = exr_difference(&dir.join("view.exr"), &dir.join("render.exr"));
+    eprintln!("night: view vs render: mean |ΔL|/L {rel:.2e}, mean luminance {mean:+.2e}");
+    assert!(rel <= 0.01 && mean.abs() <= 0.01, "{rel} {mean}");
+    // The points are there: pixels of the sky far brighter than their four neighbours (the
+    // moon, splatted as a point at this size, and at least the brightest star).
+    let v = firmament::io::read_exr(dir.join("view.exr")).unwrap();
+    let (w, h) = (v.width, v.height);
+    let y = |x: usize, y: usize| luminance(&v.data[y * w + x]);
+    let points = (1..h / 2)
+        .flat_map(|j| (1..w - 1).map(move |i| (i, j)))
+        .filter(|&(i, j)| {
+            let around = (y(i - 1, j) + y(i + 1, j) + y(i, j - 1) + y(i, j + 1)) / 4.0;
+            y(i, j) > 2.0 * around
+        })
+        .count();
+    assert!(points >= 2, "{points} point-like pixels in the night sky");
+}
+
+#[test]
 fn the_viewer_refuses_what_it_cannot_do() {
     let dir = tmp_subdir("view-refusals");
     fails_with(

@@ -20,7 +20,7 @@ use crate::common::{cancel_flag, print_tables_time, spinner, AtmosphereArgs};
 mod render_sky;
 mod retable;
 
-pub use render_sky::RenderSky;
+pub use render_sky::{gpu_lights, RenderSky};
 
 /// The `--backend` flag of render, bake, query and gallery.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]

@@ -499,7 +499,7 @@ fn gpu_frame(
 
 /// The lights a GPU frame draws, and the disks smaller than four pixels, which are points
 /// (as on the CPU) left out of its lights.
-fn gpu_lights(
+pub fn gpu_lights(
     sources: &SkySources,
     settings: &RenderSettings,
     model: &Model,

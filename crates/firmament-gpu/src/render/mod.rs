@@ -45,6 +45,7 @@
 //! ```
 
 pub(crate) mod frame;
+pub mod stars;
 mod timing;
 
 pub use timing::RenderTiming;

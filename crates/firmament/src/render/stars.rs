@@ -35,9 +35,29 @@ pub fn draw_points<'p>(
     image: &mut ImageRgbF32,
     mask: &[bool],
 ) {
+    let (w, h) = (image.width, image.height);
+    splat_points(points, channels, view, (w, h), &mut |i, c| {
+        if mask[i] {
+            let p = &mut image.data[i];
+            for k in 0..3 {
+                p[k] += c[k];
+            }
+        }
+    });
+}
+
+/// Each point's share of each pixel of a `size` image as `view` sees it: `add(pixel index,
+/// linear sRGB radiance in cd/m² terms)` for the four pixels around the point, bilinear
+/// weights summing to one, each share over its pixel's solid angle.
+pub fn splat_points<'p>(
+    points: impl IntoIterator<Item = &'p PointSource>,
+    channels: usize,
+    view: &PointView,
+    (w, h): (usize, usize),
+    add: &mut dyn FnMut(usize, [f32; 3]),
+) {
     let (camera, colour, balance) = (view.camera, view.colour, view.balance);
     let n = channels;
-    let (w, h) = (image.width, image.height);
     let (mut t, mut e) = (vec![0.0; n], vec![0.0; n]);
     for star in points {
         let Some((px, py)) = camera.pixel_of(star.direction) else {
@@ -63,13 +83,11 @@ pub fn draw_points<'p>(
             }
             let (x, y) = (x as usize, y as usize);
             let omega = camera.pixel_solid_angle(x, y);
-            if !mask[y * w + x] || omega <= 0.0 {
+            if omega <= 0.0 {
                 continue;
             }
-            let p = &mut image.data[y * w + x];
-            for i in 0..3 {
-                p[i] += (c[i] * balance[i] * weight / omega) as f32;
-            }
+            let share = |i: usize| (c[i] * balance[i] * weight / omega) as f32;
+            add(y * w + x, [share(0), share(1), share(2)]);
         }
     }
 }
@@ -169,6 +187,49 @@ pub fn draw_points_into(
     settings: &super::RenderSettings,
     occluders: &[&dyn Surface],
 ) {
+    let super::Frame { image, mask } = frame;
+    with_point_view(model, settings, occluders, &mut |view| {
+        draw_points(points, model.channels(), view, image, mask)
+    });
+}
+
+/// [`draw_points_into`]'s additions without a frame: per pixel touched (once each, in
+/// increasing index), the linear sRGB to add, for a frame that stays on the device (the
+/// viewer's: `firmament_gpu::render::stars` adds them there). Pixels outside the
+/// projection are the caller's to skip (the GPU frame's mask).
+pub fn point_splats(
+    points: &[PointSource],
+    model: &Model,
+    settings: &super::RenderSettings,
+    occluders: &[&dyn Surface],
+) -> Vec<(u32, [f32; 3])> {
+    let mut adds: Vec<(u32, [f32; 3])> = Vec::new();
+    let size = (settings.width, settings.height);
+    with_point_view(model, settings, occluders, &mut |view| {
+        splat_points(points, model.channels(), view, size, &mut |i, c| {
+            adds.push((i as u32, c))
+        })
+    });
+    // One entry per pixel: the GPU adds them without two threads on one pixel.
+    adds.sort_by_key(|(i, _)| *i);
+    let mut merged: Vec<(u32, [f32; 3])> = Vec::with_capacity(adds.len());
+    for (i, c) in adds {
+        match merged.last_mut() {
+            Some((j, m)) if *j == i => (0..3).for_each(|k| m[k] += c[k]),
+            _ => merged.push((i, c)),
+        }
+    }
+    merged
+}
+
+/// The [`PointView`] of a frame drawn elsewhere: the model's transmittance to space from the
+/// camera, zero behind `occluders`.
+fn with_point_view(
+    model: &Model,
+    settings: &super::RenderSettings,
+    occluders: &[&dyn Surface],
+    then: &mut dyn FnMut(&PointView),
+) {
     let (w, h) = (settings.width, settings.height);
     let camera = settings.camera.prepare(model.bottom_radius_m, w, h);
     let observer = Vec3::new(0.0, 0.0, model.bottom_radius_m + settings.camera.altitude_m);
@@ -193,6 +254,74 @@ pub fn draw_points_into(
         colour: &colour,
         balance: colour.white_balance(&model.solar_irradiance, settings.white_balance),
     };
-    let super::Frame { image, mask } = frame;
-    draw_points(points, model.channels(), &view, image, mask);
+    then(&view);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::{Frame, RenderSettings};
+    use crate::scene::camera::{Camera, Projection};
+    use crate::spectrum::Wavelengths;
+
+    #[test]
+    fn the_sparse_splats_are_the_frames_additions_once_per_pixel() {
+        let model = crate::atmosphere::Atmosphere::earth()
+            .resolve(&Wavelengths::parse("rgb").unwrap())
+            .unwrap();
+        let camera = Camera {
+            projection: Projection::Perspective,
+            altitude_m: 10.0,
+            heading_deg: 0.0,
+            pitch_deg: 30.0,
+            roll_deg: 0.0,
+            fov_deg: 60.0,
+        };
+        let settings = RenderSettings {
+            camera: &camera,
+            width: 40,
+            height: 30,
+            white_balance: false,
+        };
+        // Points on a grid of directions, some sharing pixels, some out of view.
+        let mut points = Vec::new();
+        for i in 0..200 {
+            let (az, el) = (i as f64 * 0.071, 0.05 + (i % 17) as f64 * 0.06);
+            let d = Vec3::new(az.sin() * el.cos(), az.cos() * el.cos(), el.sin());
+            points.push(PointSource {
+                direction: d,
+                irradiance: vec![1e-6 * (1 + i % 5) as f64; 3],
+            });
+            points.push(PointSource {
+                direction: d,
+                irradiance: vec![2e-7; 3],
+            });
+        }
+        let mut frame = Frame {
+            image: ImageRgbF32::new(40, 30),
+            mask: vec![true; 1200],
+        };
+        draw_points_into(&mut frame, &points, &model, &settings, &[]);
+        let splats = point_splats(&points, &model, &settings, &[]);
+        assert!(
+            splats.windows(2).all(|p| p[0].0 < p[1].0),
+            "one entry per pixel, in order"
+        );
+        let mut sparse = ImageRgbF32::new(40, 30);
+        for (i, c) in &splats {
+            sparse.data[*i as usize] = *c;
+        }
+        let mut touched = 0;
+        for (a, b) in frame.image.data.iter().zip(&sparse.data) {
+            for k in 0..3 {
+                assert!(
+                    (a[k] - b[k]).abs() <= 1e-6 * a[k].abs().max(1e-30),
+                    "{a:?} {b:?}"
+                );
+            }
+            touched += (a[1] > 0.0) as usize;
+        }
+        assert_eq!(touched, splats.len());
+        assert!(touched > 20, "{touched}");
+    }
 }

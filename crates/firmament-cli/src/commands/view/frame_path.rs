@@ -6,6 +6,7 @@
 
 use anyhow::{Context, Result};
 use firmament::atmosphere::Adjustments;
+use firmament::render::stars::point_splats;
 use firmament::render::{Frame, RenderSettings};
 use firmament::scene::clouds::CloudMedium;
 use firmament::scene::sky_lights::SkySources;
@@ -16,13 +17,14 @@ use firmament_gpu::display::{
     hdr_buffer, read_hdr_frame, read_rgba8, Display, DisplaySettings, Exposure,
 };
 use firmament_gpu::pass_timer::{PassTimer, PassTimes};
+use firmament_gpu::render::stars::PointSplats;
 use firmament_gpu::{GpuClouds, GpuTerrain, RenderTarget};
 
 use std::sync::Arc;
 
 use super::progressive::{Compare, Job, Overlay};
 use super::state::ViewState;
-use crate::backend::{gpu_failure, Backend, RenderSky};
+use crate::backend::{gpu_failure, gpu_lights, Backend, RenderSky};
 use crate::commands::render::{sources_of_scene, terrain_and_atmosphere};
 use crate::method::Method;
 
@@ -112,6 +114,8 @@ pub struct FramePath {
     clouds: Option<(String, f64, Arc<Vec<CloudMedium>>)>,
     /// Their shadow maps on the device for the current lights and observer.
     gpu_clouds: Option<(TerrainKey, GpuClouds)>,
+    /// The pass adding the stars and small disks into the frame (made when first needed).
+    points: Option<PointSplats>,
     /// The reference path tracer's passes over the frame (`state.compare`).
     reference: Overlay,
     /// The atmosphere the reference traces, and the keys it was made for.
@@ -160,6 +164,7 @@ impl FramePath {
             ref_model: None,
             clouds: None,
             gpu_clouds: None,
+            points: None,
         })
     }
 
@@ -463,11 +468,28 @@ impl FramePath {
             }
             _ => None,
         };
+        // Disks under four pixels and the stars are points, splatted as `render` does: the
+        // CPU weighs them, the device adds them into the frame.
+        let (lights, small) = gpu_lights(sources, &settings, sky.model());
+        let drawn = SkySources {
+            lights,
+            background: sources.background.clone(),
+            stars: Vec::new(),
+        };
+        let points: Vec<_> = (sources.stars.iter().cloned())
+            .chain(small.into_iter().map(|(_, p)| p))
+            .collect();
+        let occluders: Vec<&dyn firmament::scene::Surface> = self
+            .terrain
+            .iter()
+            .map(|t| t.as_ref() as &dyn firmament::scene::Surface)
+            .collect();
+        let splats = point_splats(&points, sky.model(), &settings, &occluders);
         let set = self.timer.as_ref().map(|t| t.query_set());
         sky.encode_frame(
             encoder,
             &settings,
-            sources,
+            &drawn,
             RenderTarget::Buffer(hdr),
             set,
             terrain,
@@ -477,6 +499,14 @@ impl FramePath {
             Backend::Gpu(gpu) => &gpu.ctx,
             Backend::Cpu => unreachable!("FramePath::new refuses the CPU"),
         };
+        if !splats.is_empty() {
+            if self.points.is_none() {
+                self.points =
+                    Some(PointSplats::new(ctx).map_err(|e| gpu_failure("the stars' pass", e))?);
+            }
+            let pass = self.points.as_mut().expect("just made");
+            pass.encode(ctx, encoder, hdr, &splats);
+        }
         self.reference
             .encode(ctx, encoder, hdr, size, state.compare, job);
         self.display.encode(

@@ -111,8 +111,6 @@ pub fn load_scene(path: Option<&PathBuf>) -> Result<(SceneFile, Vec<String>)> {
             "the planet's surface map: `firmament render` draws it, the viewer not yet".into(),
         );
     }
-    not_drawn
-        .push("stars: splatted on the CPU by `firmament render`, not in the viewer yet".into());
     Ok((scene, not_drawn))
 }
 
