@@ -362,6 +362,24 @@ fn the_viewer_draws_the_moon_and_the_stars_as_render_does() {
         })
         .count();
     assert!(points >= 2, "{points} point-like pixels in the night sky");
+    // The reference traces the sun's light only: at night it is refused, not awaited.
+    let o = run(&[
+        "view",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--offscreen",
+        "--frames",
+        "1",
+        "--width",
+        "32",
+        "--height",
+        "18",
+        "--tables",
+        tables_arg(),
+        "--reference",
+        "whole",
+    ]);
+    fails_with(&o, &["--reference", "sun's light only"]);
 }
 
 #[test]
@@ -391,6 +409,17 @@ fn the_viewer_refuses_what_it_cannot_do() {
         &["--screenshot", ".png or .exr"],
     );
     fails_with(&run(&["view", "--offscreen"]), &["--frames"]);
+    fails_with(
+        &run(&[
+            "view",
+            "--offscreen",
+            "--frames",
+            "1",
+            "--reference",
+            "half",
+        ]),
+        &["--reference", "off, split, whole"],
+    );
     fails_with(
         &run(&[
             "view",

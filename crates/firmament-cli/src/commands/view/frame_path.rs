@@ -366,6 +366,11 @@ impl FramePath {
         self.reference.line.clone()
     }
 
+    /// Why the reference is not traced for the view last drawn, when it is not.
+    pub fn reference_refused(&self) -> Option<&str> {
+        self.reference.refused.as_deref()
+    }
+
     /// Passes the reference has averaged for the view last drawn (0 before the first).
     pub fn reference_passes(&self) -> usize {
         self.reference.tracer.latest().map_or(0, |r| r.passes)

@@ -239,6 +239,9 @@ fn run_offscreen(args: &ViewArgs, mut state: ViewState) -> Result<()> {
     if state.compare != progressive::Compare::Off {
         // The tracer runs beside the frames: the last one waits for its passes.
         while path.reference_passes() < args.reference_passes {
+            if let Some(why) = path.reference_refused() {
+                anyhow::bail!("`--reference`: the reference {why}");
+            }
             if crate::common::cancel_flag().load(std::sync::atomic::Ordering::Relaxed) {
                 anyhow::bail!("interrupted");
             }

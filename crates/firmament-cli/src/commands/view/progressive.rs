@@ -274,6 +274,8 @@ pub struct Overlay {
     uploaded: Option<(u64, usize)>,
     /// What the panel says about it.
     pub line: Option<String>,
+    /// Why it is not traced (refused for this view, or failed), when so.
+    pub refused: Option<String>,
 }
 
 impl Overlay {
@@ -288,6 +290,7 @@ impl Overlay {
         compare: Compare,
         job: Result<Job, String>,
     ) {
+        self.refused = None;
         let job = match (compare, job) {
             (Compare::Off, _) => {
                 self.tracer.set(None);
@@ -297,6 +300,7 @@ impl Overlay {
             (_, Err(why)) => {
                 self.tracer.set(None);
                 self.line = Some(format!("reference: {why}"));
+                self.refused = Some(why);
                 return;
             }
             (_, Ok(job)) => job,
@@ -309,6 +313,7 @@ impl Overlay {
         };
         if let Some(e) = &latest.error {
             self.line = Some(format!("reference: {e}"));
+            self.refused = Some(e.clone());
             return;
         }
         let bytes = size.0 as u64 * size.1 as u64 * firmament_gpu::PIXEL_BYTES;
