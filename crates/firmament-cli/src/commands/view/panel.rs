@@ -5,9 +5,13 @@
 
 use firmament::render::tonemap::ToneCurve;
 
+#[path = "panel_sky.rs"]
+mod sky;
+
 use super::presets::PRESETS as VIEW_PRESETS;
 use super::progressive::Compare;
 use super::state::{ViewState, MAX_ALTITUDE_M, PRESETS, VIEW_METHODS};
+use sky::{air_section, clouds_section, date_section};
 
 /// What the panel asked for this frame, besides editing the state.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -172,203 +176,6 @@ fn sun_section(ui: &mut egui::Ui, state: &mut ViewState) {
         );
     });
     ui.checkbox(&mut state.scene.sun.disk, "sun disk");
-}
-
-/// The date, the time of day and the place of a dated scene.
-fn date_section(ui: &mut egui::Ui, state: &mut ViewState) {
-    let at = state
-        .scene
-        .time
-        .as_ref()
-        .map(|t| t.at.clone())
-        .unwrap_or_default();
-    ui.label(format!("Time: {at}"));
-    if let Ok(instant) = firmament::astro::Instant::parse(&at, "time.at") {
-        use chrono::Datelike;
-        let d = instant.utc.date_naive();
-        let (mut y, mut m, mut day) = (d.year(), d.month(), d.day());
-        let changed = ui
-            .horizontal(|ui| {
-                let field = |ui: &mut egui::Ui, name: &str, v: &mut u32, hi: u32| {
-                    let label = ui.label(name);
-                    ui.add(egui::DragValue::new(v).range(1..=hi))
-                        .labelled_by(label.id)
-                        .changed()
-                };
-                let mut year = y as u32;
-                let a = field(ui, "year", &mut year, 2200);
-                y = year.max(1800) as i32;
-                let b = field(ui, "month", &mut m, 12);
-                let c = field(ui, "day", &mut day, 31);
-                a || b || c
-            })
-            .inner;
-        if changed {
-            // The last day of a shorter month when the day is past it.
-            for last in (28..=day.max(28)).rev() {
-                if state
-                    .set_date(&format!("{y:04}-{m:02}-{:02}", day.min(last)))
-                    .is_ok()
-                {
-                    break;
-                }
-            }
-        }
-    }
-    if let Some(mut h) = state.solar_hours() {
-        if ui
-            .add(egui::Slider::new(&mut h, 0.0..=24.0).text("local solar time h"))
-            .changed()
-        {
-            let _ = state.set_solar_hours(h);
-        }
-    }
-    ui.horizontal(|ui| {
-        for (label, hours) in [
-            ("−1 h", -1.0),
-            ("−10 min", -1.0 / 6.0),
-            ("+10 min", 1.0 / 6.0),
-            ("+1 h", 1.0),
-        ] {
-            if ui.button(label).clicked() {
-                // A date the ephemerides refuse stays where it was.
-                let _ = state.shift_time(hours);
-            }
-        }
-    });
-    if let Some(l) = state.scene.location.as_mut() {
-        ui.add(egui::Slider::new(&mut l.lat_deg, -90.0..=90.0).text("latitude °"));
-        ui.add(egui::Slider::new(&mut l.lon_deg, -180.0..=180.0).text("longitude °"));
-    }
-    if let Some(t) = state.scene.time.as_mut() {
-        ui.checkbox(&mut t.moon_disk, "moon disk");
-    }
-}
-
-/// The atmosphere's adjustments (`[atmosphere.adjust]`), each slider starting from the
-/// atmosphere's own value.
-fn air_section(ui: &mut egui::Ui, state: &mut ViewState) {
-    let Some(own) = state.air_values() else {
-        return;
-    };
-    let terrain = state.scene.terrain.is_some();
-    let a = &mut state.scene.atmosphere.adjust;
-    adjust_slider(
-        ui,
-        &mut a.aerosol_optical_depth,
-        own.aerosol_optical_depth,
-        (0.0, 3.0),
-        "aerosol optical depth (550 nm)",
-        (true, own.aerosol_optical_depth > 0.0),
-    );
-    adjust_slider(
-        ui,
-        &mut a.ozone_du,
-        own.ozone_du,
-        (0.0, 1000.0),
-        "ozone DU",
-        (false, own.ozone_du > 0.0),
-    );
-    adjust_slider(
-        ui,
-        &mut a.rayleigh_scale,
-        1.0,
-        (0.0, 10.0),
-        "Rayleigh scale",
-        (true, true),
-    );
-    adjust_slider(
-        ui,
-        &mut a.ground_albedo,
-        own.ground_albedo,
-        (0.0, 1.0),
-        "ground albedo",
-        (false, !terrain),
-    );
-    if terrain {
-        ui.small("(the terrain's materials light the tables' ground)");
-    }
-    let mut km = a.planet_radius_m.unwrap_or(own.planet_radius_m) / 1e3;
-    if ui
-        .add(
-            egui::Slider::new(&mut km, 100.0..=100_000.0)
-                .logarithmic(true)
-                .text("planet radius km"),
-        )
-        .changed()
-    {
-        a.planet_radius_m = Some(km * 1e3);
-    }
-    ui.horizontal(|ui| {
-        if ui.button("the atmosphere's own values").clicked() {
-            state.scene.atmosphere.adjust = Default::default();
-        }
-        let label = ui.label("4D update frames");
-        ui.add(egui::DragValue::new(&mut state.update_frames).range(1..=120))
-            .labelled_by(label.id)
-            .on_hover_text(
-                "a new atmosphere's 4D tables are spread over this many frames on a software rasteriser",
-            );
-    });
-}
-
-/// The scene's cloud layers: coverage, base (the thickness kept) and the wind's offset.
-fn clouds_section(ui: &mut egui::Ui, state: &mut ViewState) {
-    if state.scene.clouds.is_empty() {
-        return;
-    }
-    ui.label("Clouds (drawn with bruneton4d over the planet's sphere)");
-    for (i, layer) in state.scene.clouds.iter_mut().enumerate() {
-        let p = layer.resolved();
-        let name = format!("{:?}", p.kind).to_lowercase();
-        let mut coverage = p.coverage;
-        if ui
-            .add(egui::Slider::new(&mut coverage, 0.0..=1.0).text(format!("{name} {i}: coverage")))
-            .changed()
-        {
-            layer.coverage = Some(coverage);
-        }
-        let mut base_km = p.bottom_m / 1e3;
-        if ui
-            .add(egui::Slider::new(&mut base_km, 0.1..=15.0).text(format!("{name} {i}: base km")))
-            .changed()
-        {
-            let thickness = p.top_m - p.bottom_m;
-            layer.bottom_m = Some(base_km * 1e3);
-            layer.top_m = Some(base_km * 1e3 + thickness);
-        }
-        ui.horizontal(|ui| {
-            let label = ui.label(format!("{name} {i}: wind offset km (east, north)"));
-            for k in 0..2 {
-                let mut km = layer.wind_offset_m[k] / 1e3;
-                if ui
-                    .add(egui::DragValue::new(&mut km).speed(0.1))
-                    .labelled_by(label.id)
-                    .changed()
-                {
-                    layer.wind_offset_m[k] = km * 1e3;
-                }
-            }
-        });
-    }
-}
-
-/// A slider for an adjustment: shows `own` until moved, then holds the value moved to.
-fn adjust_slider(
-    ui: &mut egui::Ui,
-    value: &mut Option<f64>,
-    own: f64,
-    (lo, hi): (f64, f64),
-    label: &str,
-    (logarithmic, enabled): (bool, bool),
-) {
-    let mut v = value.unwrap_or(own);
-    let slider = egui::Slider::new(&mut v, lo..=hi)
-        .logarithmic(logarithmic)
-        .text(label);
-    if ui.add_enabled(enabled, slider).changed() {
-        *value = Some(v);
-    }
 }
 
 fn camera_section(ui: &mut egui::Ui, state: &mut ViewState) {
@@ -624,5 +431,20 @@ mod tests {
         assert_eq!(layer.coverage, Some(0.7));
         // The layer keeps its 2 km thickness.
         assert_eq!((layer.bottom_m, layer.top_m), (Some(2000.0), Some(4000.0)));
+        // Another kind takes its own defaults (cirrus: 8–9.5 km).
+        h.get_by_label("cirrus 0").click();
+        h.run();
+        let p = h.state().scene.clouds[0].resolved();
+        assert_eq!((p.bottom_m, p.top_m), (8000.0, 9500.0));
+        h.get_by_label("add a layer").click();
+        h.run();
+        assert_eq!(h.state().scene.clouds.len(), 2);
+        h.get_by_label("remove 0").click();
+        h.run();
+        assert_eq!(h.state().scene.clouds.len(), 1);
+        assert_eq!(
+            h.state().scene.clouds[0].kind,
+            firmament::scene::clouds::CloudKind::Cumulus
+        );
     }
 }
