@@ -206,6 +206,12 @@ impl FramePath {
         self.reference.refused.as_deref()
     }
 
+    /// The method against the reference when its last pass arrived: the relative
+    /// difference of the mean luminances and the mean |ΔL|/L (the reference's noise in it).
+    pub fn reference_difference(&self) -> Option<(f64, f64)> {
+        self.reference.difference()
+    }
+
     /// Passes the reference has averaged for the view last drawn (0 before the first).
     pub fn reference_passes(&self) -> usize {
         self.reference.tracer.latest().map_or(0, |r| r.passes)
@@ -328,6 +334,9 @@ impl FramePath {
             Backend::Gpu(gpu) => &gpu.ctx,
             Backend::Cpu => unreachable!("FramePath::new refuses the CPU"),
         };
+        // The method's frame is compared with the reference before the points are added.
+        self.reference
+            .encode(ctx, encoder, hdr, size, state.compare, job);
         if !splats.is_empty() {
             if self.points.is_none() {
                 self.points =
@@ -336,8 +345,7 @@ impl FramePath {
             let pass = self.points.as_mut().expect("just made");
             pass.encode(ctx, encoder, hdr, &splats);
         }
-        self.reference
-            .encode(ctx, encoder, hdr, size, state.compare, job);
+        self.reference.cover(encoder, hdr, size);
         self.display.encode(
             self.ctx(),
             encoder,
@@ -361,6 +369,9 @@ impl FramePath {
     pub fn submitted(&mut self) {
         if let Some(t) = self.timer.as_mut() {
             t.after_submit();
+        }
+        if let Backend::Gpu(gpu) = self.backend {
+            self.reference.submitted(&gpu.ctx);
         }
     }
 

@@ -253,6 +253,14 @@ fn run_offscreen(args: &ViewArgs, mut state: ViewState) -> Result<()> {
             if let Some(line) = path.reference_line() {
                 eprintln!("view: {line}");
             }
+            if let Some((bias, mean_abs)) = path.reference_difference() {
+                eprintln!(
+                    "view: {} against the reference over the frame: mean luminance {:+.2} %, mean |ΔL|/L {:.2} % (the reference's noise included)",
+                    state.method.name(),
+                    100.0 * bias,
+                    100.0 * mean_abs
+                );
+            }
         }
     }
     let (hdr, shown) = last.expect("at least one frame");

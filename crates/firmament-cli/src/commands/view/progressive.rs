@@ -276,11 +276,22 @@ pub struct Overlay {
     pub line: Option<String>,
     /// Why it is not traced (refused for this view, or failed), when so.
     pub refused: Option<String>,
+    /// The method's frame copied when a pass was uploaded (read after the submission),
+    /// and the pass's pixels it is compared with.
+    method_copy: Option<wgpu::Buffer>,
+    compare_with: Option<Vec<f32>>,
+    /// The method against the reference over the frame when the last pass arrived: the
+    /// mean luminance's relative difference and the mean relative |ΔL| per pixel.
+    difference: Option<(f64, f64)>,
+    /// What [`Overlay::cover`] copies over the frame this time (None: nothing).
+    cover: Option<Compare>,
 }
 
 impl Overlay {
-    /// Trace `job` when `compare` asks for the reference (else stop), upload a newly ended
-    /// pass, and record its copy over `hdr` (the frame of `size`) into `encoder`.
+    /// Trace `job` when `compare` asks for the reference (else stop) and upload a newly
+    /// ended pass, recording a copy of the method's frame `hdr` (of `size`) as it is now for
+    /// the comparison (call it right after the sky's dispatch, before the points are added:
+    /// the tracer draws disks its own way); [`Overlay::cover`] then records the overwrite.
     pub fn encode(
         &mut self,
         ctx: &firmament_gpu::GpuContext,
@@ -291,8 +302,10 @@ impl Overlay {
         job: Result<Job, String>,
     ) {
         self.refused = None;
+        self.cover = None;
         let job = match (compare, job) {
             (Compare::Off, _) => {
+                self.difference = None;
                 self.tracer.set(None);
                 self.line = None;
                 return;
@@ -333,9 +346,20 @@ impl Overlay {
             let raw: Vec<u8> = latest.pixels.iter().flat_map(|v| v.to_le_bytes()).collect();
             ctx.queue().write_buffer(buffer, 0, &raw);
             self.uploaded = Some(mark);
+            // The method's frame of the same view, before the reference covers it: compared
+            // once the frame is submitted (`Overlay::submitted`).
+            let copy = ctx.device().create_buffer(&wgpu::BufferDescriptor {
+                label: Some("method frame for the reference"),
+                size: bytes,
+                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                mapped_at_creation: false,
+            });
+            encoder.copy_buffer_to_buffer(hdr, 0, &copy, 0, bytes);
+            self.method_copy = Some(copy);
+            self.compare_with = Some(latest.pixels.clone());
         }
         self.line = Some(format!(
-            "reference{}: {} passes, {} paths/λ a pixel, noise {:.1} %",
+            "reference{}: {} passes, {} paths/λ a pixel, noise {:.1} %{}",
             if compare == Compare::Split {
                 " (right half)"
             } else {
@@ -343,23 +367,107 @@ impl Overlay {
             },
             latest.passes,
             latest.passes * PATHS_PER_PASS,
-            100.0 * latest.noise
+            100.0 * latest.noise,
+            match self.difference {
+                Some((bias, mean_abs)) => format!(
+                    "; the method against it over the frame (the disks apart): mean luminance {:+.2} %, mean |ΔL|/L {:.2} % (its noise included)",
+                    100.0 * bias,
+                    100.0 * mean_abs
+                ),
+                None => String::new(),
+            }
         ));
-        if self.uploaded.is_none() {
+        self.cover = self.uploaded.map(|_| compare);
+    }
+
+    /// Record the reference's average over the frame (its right half, or all of it), after
+    /// [`Overlay::encode`] and the passes that add to the method's frame (the points).
+    pub fn cover(&self, encoder: &mut wgpu::CommandEncoder, hdr: &wgpu::Buffer, size: (u32, u32)) {
+        let (Some(compare), Some((buffer, _))) = (self.cover, &self.buffer) else {
             return;
-        }
+        };
+        let px = firmament_gpu::PIXEL_BYTES;
+        let (w, h) = (size.0 as u64, size.1 as u64);
         match compare {
-            Compare::Whole => encoder.copy_buffer_to_buffer(buffer, 0, hdr, 0, bytes),
-            _ => {
+            Compare::Whole => encoder.copy_buffer_to_buffer(buffer, 0, hdr, 0, w * h * px),
+            Compare::Split => {
                 // Row by row, the columns from the middle on.
-                let (w, h) = (size.0 as u64, size.1 as u64);
-                let px = firmament_gpu::PIXEL_BYTES;
                 let from = w / 2;
                 for y in 0..h {
                     let offset = (y * w + from) * px;
                     encoder.copy_buffer_to_buffer(buffer, offset, hdr, offset, (w - from) * px);
                 }
             }
+            Compare::Off => {}
         }
     }
+}
+
+impl Overlay {
+    /// [`FramePath::reference_difference`](super::frame_path::FramePath::reference_difference).
+    pub fn difference(&self) -> Option<(f64, f64)> {
+        self.difference
+    }
+
+    /// After the frame [`Overlay::encode`] recorded is submitted: when it copied the
+    /// method's frame for a new pass, read it (waiting for the device, once a pass) and
+    /// compare it with the pass's average over the pixels inside the projection.
+    pub fn submitted(&mut self, ctx: &firmament_gpu::GpuContext) {
+        let (Some(copy), Some(reference)) = (self.method_copy.take(), self.compare_with.take())
+        else {
+            return;
+        };
+        let slice = copy.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |_| {});
+        if ctx
+            .device()
+            .poll(wgpu::PollType::wait_indefinitely())
+            .is_err()
+        {
+            return;
+        }
+        let Ok(view) = slice.get_mapped_range() else {
+            return;
+        };
+        let method: Vec<f32> = view
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        drop(view);
+        copy.unmap();
+        self.difference = difference(&method, &reference);
+    }
+}
+
+/// Luminance (Rec. 709 / sRGB primaries) of a linear sRGB pixel.
+fn luminance(p: &[f32]) -> f64 {
+    0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64
+}
+
+/// Pixels brighter than this (cd/m²) hold a light's disk (the sun's is ~10⁹), which the
+/// method splats as a point below four pixels and the tracer draws where a pixel's centre
+/// meets it: compared apart from the sky, as `tests/view.rs` does.
+const DISK_CD_M2: f64 = 1.0e6;
+
+/// `method` against `reference` (RGBA per pixel, the mask in alpha): the relative
+/// difference of their mean luminances and the mean of |ΔL|/L over the pixels inside both
+/// where the reference is lit, the lights' disks left out.
+fn difference(method: &[f32], reference: &[f32]) -> Option<(f64, f64)> {
+    let (mut sm, mut sr, mut rel, mut n) = (0.0, 0.0, 0.0, 0usize);
+    for (m, r) in method.chunks_exact(4).zip(reference.chunks_exact(4)) {
+        if m[3] < 0.5 || r[3] < 0.5 {
+            continue;
+        }
+        let (lm, lr) = (luminance(m), luminance(r));
+        if lm > DISK_CD_M2 || lr > DISK_CD_M2 {
+            continue;
+        }
+        sm += lm;
+        sr += lr;
+        if lr > 0.0 {
+            rel += (lm - lr).abs() / lr;
+            n += 1;
+        }
+    }
+    (sr > 0.0 && n > 0).then(|| (sm / sr - 1.0, rel / n as f64))
 }
