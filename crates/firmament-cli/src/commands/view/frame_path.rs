@@ -258,17 +258,19 @@ impl FramePath {
             height: size.1 as usize,
             white_balance: state.scene.output.white_balance,
         };
-        // The terrain's uploads follow the lights and the observer (the 4D tables only).
+        // The terrain's and the clouds' uploads follow the lights and the observer.
+        let light_key = TerrainKey {
+            lights: sources
+                .lights
+                .iter()
+                .map(|l| [l.direction.x, l.direction.y, l.direction.z])
+                .collect(),
+            altitude_m: camera.altitude_m,
+        };
+        // The terrain with the 4D tables only.
         let terrain = match (&self.terrain, state.method) {
             (Some(t), Method::Bruneton4d) => {
-                let key = TerrainKey {
-                    lights: sources
-                        .lights
-                        .iter()
-                        .map(|l| [l.direction.x, l.direction.y, l.direction.z])
-                        .collect(),
-                    altitude_m: camera.altitude_m,
-                };
+                let key = light_key.clone();
                 if self.gpu_terrain.as_ref().is_none_or(|(k, _)| *k != key) {
                     let started = std::time::Instant::now();
                     let uploaded = sky.gpu_terrain(t, &settings, sources, true)?;
@@ -280,15 +282,7 @@ impl FramePath {
             _ => None,
         };
         // The clouds with the 4D tables over the planet's sphere (the GPU draws clouds over a
-        // terrain not yet); their shadow maps follow the lights and the observer.
-        let light_key = TerrainKey {
-            lights: sources
-                .lights
-                .iter()
-                .map(|l| [l.direction.x, l.direction.y, l.direction.z])
-                .collect(),
-            altitude_m: camera.altitude_m,
-        };
+        // terrain not yet).
         let clouds = match (&self.clouds, state.method, &self.terrain) {
             (Some((_, _, media)), Method::Bruneton4d, None) if !media.is_empty() => {
                 if self
