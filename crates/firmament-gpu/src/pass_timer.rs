@@ -25,6 +25,17 @@ pub struct PassTimes {
     pub display_ms: f64,
 }
 
+/// Which of slots 0–3 the sky's passes wrote ([`crate::RenderInputs::timestamps`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SkySlots {
+    /// One pass at 0–1 (the 4D and 3D tables).
+    One,
+    /// Hillaire 2020's sky view at 0–1 and pixels at 2–3 (an observer in the atmosphere).
+    Two,
+    /// Hillaire 2020's pixels alone at 2–3 (an observer in space: no sky view).
+    Pixels,
+}
+
 /// Staging states.
 const IDLE: u8 = 0;
 const MAPPING: u8 = 1;
@@ -37,8 +48,8 @@ pub struct PassTimer {
     resolve: wgpu::Buffer,
     staging: wgpu::Buffer,
     state: Arc<AtomicU8>,
-    /// Whether the sky wrote slots 2–3 (Hillaire's two passes) in the frame in flight.
-    two_sky_passes: bool,
+    /// The slots of the sky's first start and last end in the frame in flight.
+    sky_slots: SkySlots,
     /// A copy was recorded and not yet mapped.
     copy_recorded: bool,
     period_ns: f64,
@@ -71,7 +82,7 @@ impl PassTimer {
                 mapped_at_creation: false,
             }),
             state: Arc::new(AtomicU8::new(IDLE)),
-            two_sky_passes: false,
+            sky_slots: SkySlots::One,
             copy_recorded: false,
             period_ns: ctx.queue().get_timestamp_period() as f64,
             last: None,
@@ -84,9 +95,9 @@ impl PassTimer {
     }
 
     /// After the frame's passes: resolve the timestamps and, when no copy is in flight,
-    /// copy them out. `two_sky_passes`: the sky wrote 0–3 (Hillaire 2020), else 0–1.
+    /// copy them out. `sky_slots`: which of slots 0–3 the sky wrote.
     /// Returns whether a copy was recorded ([`PassTimer::after_submit`] then maps it).
-    pub fn resolve(&mut self, encoder: &mut wgpu::CommandEncoder, two_sky_passes: bool) -> bool {
+    pub fn resolve(&mut self, encoder: &mut wgpu::CommandEncoder, sky_slots: SkySlots) -> bool {
         if self.state.load(Ordering::Acquire) != IDLE {
             return false;
         }
@@ -94,7 +105,7 @@ impl PassTimer {
         // a resolve's offset must be a multiple of 256 bytes.
         encoder.resolve_query_set(&self.set, 0..PASS_QUERIES, &self.resolve, 0);
         encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.staging, 0, BYTES);
-        self.two_sky_passes = two_sky_passes;
+        self.sky_slots = sky_slots;
         self.copy_recorded = true;
         true
     }
@@ -126,13 +137,13 @@ impl PassTimer {
                 self.state.store(IDLE, Ordering::Release);
                 if ticks.len() == PASS_QUERIES as usize {
                     let ms = |a: u64, b: u64| b.saturating_sub(a) as f64 * self.period_ns * 1e-6;
-                    let sky_end = if self.two_sky_passes {
-                        ticks[3]
-                    } else {
-                        ticks[1]
+                    let (start, end) = match self.sky_slots {
+                        SkySlots::One => (0, 1),
+                        SkySlots::Two => (0, 3),
+                        SkySlots::Pixels => (2, 3),
                     };
                     self.last = Some(PassTimes {
-                        sky_ms: ms(ticks[0], sky_end),
+                        sky_ms: ms(ticks[start], ticks[end]),
                         display_ms: ms(ticks[4], ticks[7]),
                     });
                 }

@@ -219,14 +219,14 @@ fn the_pass_timer_reads_the_display_passes_back_without_a_stall() {
         &settings,
         Some(timer.query_set()),
     );
-    assert!(timer.resolve(&mut encoder, false));
+    assert!(timer.resolve(&mut encoder, firmament_gpu::pass_timer::SkySlots::One));
     ctx.queue().submit([encoder.finish()]);
     timer.after_submit();
     // While the copy is mapped, a second frame records no copy.
     let mut second = ctx
         .device()
         .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-    assert!(!timer.resolve(&mut second, false));
+    assert!(!timer.resolve(&mut second, firmament_gpu::pass_timer::SkySlots::One));
     ctx.device()
         .poll(wgpu::PollType::wait_indefinitely())
         .unwrap();

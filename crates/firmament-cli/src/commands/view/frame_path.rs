@@ -14,7 +14,7 @@ use firmament::sky::bruneton4d::amortised::{AmortisedTables, UpdateProgress};
 use firmament_gpu::display::{
     hdr_buffer, read_hdr_frame, read_rgba8, Display, DisplaySettings, Exposure,
 };
-use firmament_gpu::pass_timer::{PassTimer, PassTimes};
+use firmament_gpu::pass_timer::{PassTimer, PassTimes, SkySlots};
 use firmament_gpu::render::stars::PointSplats;
 use firmament_gpu::{GpuClouds, GpuTerrain, RenderTarget};
 
@@ -351,9 +351,17 @@ impl FramePath {
             &display,
             set,
         );
-        let hillaire = state.method == Method::Hillaire2020;
+        // Hillaire 2020 draws its sky-view pass (slots 0–1) from inside the atmosphere only
+        // (FrameConstants::inside); its pixels at 2–3.
+        let model = self.sky().context("no sky yet")?.model();
+        let inside = model.bottom_radius_m + camera.altitude_m <= model.top_radius_m;
+        let slots = match (state.method, inside) {
+            (Method::Hillaire2020, true) => SkySlots::Two,
+            (Method::Hillaire2020, false) => SkySlots::Pixels,
+            _ => SkySlots::One,
+        };
         if let Some(t) = self.timer.as_mut() {
-            t.resolve(encoder, hillaire);
+            t.resolve(encoder, slots);
         }
         Ok(())
     }
