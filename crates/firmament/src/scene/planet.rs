@@ -22,6 +22,12 @@ use crate::spectrum::table::Table;
 
 const OCEAN_ALBEDO_CSV: &str = include_str!("../../data/ocean_albedo.csv");
 
+/// Spectra a map mixes ([`PlanetSurface::basis`]).
+pub const BASIS: usize = 5;
+
+/// Width of a procedural map's texture ([`PlanetSurface::texture_size`]).
+pub const PROCEDURAL_TEXTURE_WIDTH: usize = 2048;
+
 /// Refractive index of sea water in the visible (Quan & Fry 1995: 1.339–1.345).
 pub const SEA_WATER_INDEX: f64 = 1.34;
 
@@ -169,6 +175,120 @@ impl PlanetSurface {
         sea as f64 / points.len() as f64
     }
 
+    /// The albedo at a planet-fixed unit direction as weights of the five spectra of
+    /// [`PlanetSurface::basis`] (the albedo is their weighted sum; the GPU bakes these weights
+    /// into a texture, `firmament_gpu::planet`): for a procedural map, the shares of ocean,
+    /// ice, rock, forest and grass (summing to 1; the first is 1 at sea, 0 on land); for an
+    /// image, its linear red, green and blue (then 0, 0).
+    pub fn weights(&self, d: Vec3) -> [f64; BASIS] {
+        match &self.map {
+            SurfaceMap::Procedural { seed, .. } => {
+                if self.is_sea(d) {
+                    return [1.0, 0.0, 0.0, 0.0, 0.0];
+                }
+                let lat = d.z.clamp(-1.0, 1.0).asin().to_degrees().abs();
+                let wiggle = 8.0 * noise3(*seed ^ 0x1ce, 4.0 * d);
+                let ice = smoothstep(66.0, 72.0, lat + wiggle);
+                // Moisture: wet tropics and mid-latitudes, dry subtropics (Hadley cells).
+                let belt = (-(lat - 25.0).powi(2) / (2.0 * 9.0 * 9.0)).exp();
+                let wet = 0.5 + 0.5 * noise3(*seed ^ 0xdee, 3.0 * d) - 0.9 * belt;
+                let desert = smoothstep(0.15, 0.0, wet);
+                let forest = smoothstep(0.35, 0.6, wet);
+                // ice + (1 − ice)·(desert·rock + (1 − desert)·(forest·forest + (1 − forest)·grass)).
+                let land = 1.0 - ice;
+                let green = land * (1.0 - desert);
+                [
+                    0.0,
+                    ice,
+                    land * desert,
+                    green * forest,
+                    green * (1.0 - forest),
+                ]
+            }
+            SurfaceMap::Image { width, height, rgb } => {
+                let lat = d.z.clamp(-1.0, 1.0).asin();
+                let lon = d.y.atan2(d.x);
+                let x = (lon / std::f64::consts::TAU + 0.5) * *width as f64 - 0.5;
+                let y = (0.5 - lat / std::f64::consts::PI) * *height as f64 - 0.5;
+                let c = bilinear_wrap(rgb, *width, *height, x, y);
+                [c[0], c[1], c[2], 0.0, 0.0]
+            }
+        }
+    }
+
+    /// The five spectra [`PlanetSurface::weights`] mix, at the surface's wavelengths: ocean,
+    /// ice, rock, forest, grass for a procedural map; for an image the spectra of its pure
+    /// red, green and blue (linear between 680, 550 and 440 nm, [`colour_basis`]), then two
+    /// of zeros.
+    pub fn basis(&self) -> [Vec<f64>; BASIS] {
+        match self.map {
+            SurfaceMap::Procedural { .. } => [
+                self.ocean.clone(),
+                self.ice.clone(),
+                self.rock.clone(),
+                self.forest.clone(),
+                self.grass.clone(),
+            ],
+            SurfaceMap::Image { .. } => {
+                let column = |i: usize| -> Vec<f64> {
+                    self.wavelengths_nm
+                        .iter()
+                        .map(|&nm| colour_basis(nm)[i])
+                        .collect()
+                };
+                let zeros = vec![0.0; self.wavelengths_nm.len()];
+                [column(0), column(1), column(2), zeros.clone(), zeros]
+            }
+        }
+    }
+
+    /// The size (width, height) of the equirectangular grid [`PlanetSurface::weight_texture`]
+    /// fills by default: an image's own; for a procedural map 2048 × 1024 (20 km per texel at
+    /// the equator of an Earth-sized planet, finer than the continents' smallest noise cells,
+    /// about 30 km).
+    pub fn texture_size(&self) -> (usize, usize) {
+        match &self.map {
+            SurfaceMap::Procedural { .. } => {
+                (PROCEDURAL_TEXTURE_WIDTH, PROCEDURAL_TEXTURE_WIDTH / 2)
+            }
+            SurfaceMap::Image { width, height, .. } => (*width, *height),
+        }
+    }
+
+    /// The first four of [`PlanetSurface::weights`] at the centres of a `width` × `height`
+    /// equirectangular grid (row 0 at 90° N, column 0 at 180° W, as an image map), row-major;
+    /// the fifth weight is 1 minus their sum for a procedural map and 0 for an image. At an
+    /// image's own size the texels are its pixels.
+    pub fn weight_texture(&self, width: usize, height: usize) -> Vec<[f32; 4]> {
+        use rayon::prelude::*;
+        let mut texels = vec![[0.0f32; 4]; width * height];
+        texels
+            .par_chunks_mut(width.max(1))
+            .enumerate()
+            .for_each(|(y, row)| {
+                let lat = (0.5 - (y as f64 + 0.5) / height as f64) * std::f64::consts::PI;
+                for (x, t) in row.iter_mut().enumerate() {
+                    let lon = ((x as f64 + 0.5) / width as f64 - 0.5) * std::f64::consts::TAU;
+                    let d = Vec3::new(lat.cos() * lon.cos(), lat.cos() * lon.sin(), lat.sin());
+                    let w = self.weights(d);
+                    *t = [w[0] as f32, w[1] as f32, w[2] as f32, w[3] as f32];
+                }
+            });
+        texels
+    }
+
+    /// Whether the first weight of [`PlanetSurface::weights`] is the sea's share (a
+    /// procedural map with a glint): the glint's weight on the GPU.
+    pub fn sea_is_first(&self) -> bool {
+        matches!(self.map, SurfaceMap::Procedural { .. })
+    }
+
+    /// The observer's east, north and up in the map's planet-fixed frame (z to 90° N, x to
+    /// 0° E).
+    pub fn frame(&self) -> [Vec3; 3] {
+        self.frame
+    }
+
     /// The Cox & Munk (1954) glint BRDF (sr⁻¹) of the sea for light from `to_light` seen
     /// from `to_viewer` (units) over the local `normal`: F(β_i)·P(tan β)/(4 cos θ_i cos θ_v
     /// cos⁴ β), P the isotropic Gaussian of the facets' slopes with variance σ², β the
@@ -194,38 +314,10 @@ impl Surface for PlanetSurface {
     }
 
     fn albedo(&self, hit: &SurfaceHit, out: &mut [f64]) {
-        let d = self.fixed(hit.position);
-        match &self.map {
-            SurfaceMap::Procedural { seed, .. } => {
-                let n = out.len();
-                if self.is_sea(d) {
-                    out.copy_from_slice(&self.ocean[..n]);
-                    return;
-                }
-                let lat = d.z.clamp(-1.0, 1.0).asin().to_degrees().abs();
-                let wiggle = 8.0 * noise3(*seed ^ 0x1ce, 4.0 * d);
-                let ice = smoothstep(66.0, 72.0, lat + wiggle);
-                // Moisture: wet tropics and mid-latitudes, dry subtropics (Hadley cells).
-                let belt = (-(lat - 25.0).powi(2) / (2.0 * 9.0 * 9.0)).exp();
-                let wet = 0.5 + 0.5 * noise3(*seed ^ 0xdee, 3.0 * d) - 0.9 * belt;
-                let desert = smoothstep(0.15, 0.0, wet);
-                let forest = smoothstep(0.35, 0.6, wet);
-                for k in 0..n {
-                    let green = forest * self.forest[k] + (1.0 - forest) * self.grass[k];
-                    let land = desert * self.rock[k] + (1.0 - desert) * green;
-                    out[k] = ice * self.ice[k] + (1.0 - ice) * land;
-                }
-            }
-            SurfaceMap::Image { width, height, rgb } => {
-                let lat = d.z.clamp(-1.0, 1.0).asin();
-                let lon = d.y.atan2(d.x);
-                let x = (lon / std::f64::consts::TAU + 0.5) * *width as f64 - 0.5;
-                let y = (0.5 - lat / std::f64::consts::PI) * *height as f64 - 0.5;
-                let c = bilinear_wrap(rgb, *width, *height, x, y);
-                for (o, &nm) in out.iter_mut().zip(&self.wavelengths_nm) {
-                    *o = colour_at(c, nm);
-                }
-            }
+        let w = self.weights(self.fixed(hit.position));
+        let basis = self.basis();
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = (0..BASIS).map(|j| w[j] * basis[j][k]).sum();
         }
     }
 
@@ -318,17 +410,19 @@ fn bilinear_wrap(rgb: &[[f32; 3]], w: usize, h: usize, x: f64, y: f64) -> [f64; 
     c
 }
 
-/// A linear sRGB colour's value at `nm`: the channels at 680 (R), 550 (G) and 440 nm (B),
-/// linear between them, held beyond.
-fn colour_at(c: [f64; 3], nm: f64) -> f64 {
+/// The weights of a linear sRGB colour's channels in its value at `nm`: the channels stand
+/// at 680 (R), 550 (G) and 440 nm (B), linear between them, held beyond.
+pub fn colour_basis(nm: f64) -> [f64; 3] {
     if nm >= 680.0 {
-        c[0]
+        [1.0, 0.0, 0.0]
     } else if nm >= 550.0 {
-        c[1] + (c[0] - c[1]) * (nm - 550.0) / 130.0
+        let f = (nm - 550.0) / 130.0;
+        [f, 1.0 - f, 0.0]
     } else if nm >= 440.0 {
-        c[2] + (c[1] - c[2]) * (nm - 440.0) / 110.0
+        let f = (nm - 440.0) / 110.0;
+        [0.0, f, 1.0 - f]
     } else {
-        c[2]
+        [0.0, 0.0, 1.0]
     }
 }
 
@@ -452,5 +546,114 @@ mod tests {
         };
         p.albedo(&south, &mut out);
         assert!(out[0] < 1e-9, "{out:?}");
+    }
+
+    #[test]
+    fn the_weights_sum_to_one_and_mix_the_spectra() {
+        let p = earth();
+        let basis = p.basis();
+        let (mut sea, mut land) = (0, 0);
+        for d in sphere_directions(4000) {
+            let w = p.weights(d);
+            assert!(w.iter().all(|&x| (0.0..=1.0).contains(&x)), "{w:?}");
+            assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12, "{w:?}");
+            if p.is_sea(d) {
+                sea += 1;
+                assert_eq!(w, [1.0, 0.0, 0.0, 0.0, 0.0]);
+            } else {
+                land += 1;
+                assert_eq!(w[0], 0.0);
+            }
+        }
+        assert!(sea > 0 && land > 0);
+        // The sea's albedo is the ocean spectrum.
+        assert_eq!(basis[0], ocean_spectrum(&[680.0, 550.0, 440.0]));
+    }
+
+    #[test]
+    fn the_weight_texture_of_an_image_holds_its_pixels() {
+        let (w, h) = (6, 3);
+        let rgb: Vec<[f32; 3]> = (0..w * h)
+            .map(|i| [i as f32 / 20.0, 0.5, 1.0 - i as f32 / 20.0])
+            .collect();
+        let map = SurfaceMap::Image {
+            width: w,
+            height: h,
+            rgb: rgb.clone(),
+        };
+        let p = PlanetSurface::new(1.0, map, 10.0, 20.0, &[700.0, 600.0, 500.0, 400.0], None);
+        assert_eq!(p.texture_size(), (w, h));
+        let texels = p.weight_texture(w, h);
+        for (t, c) in texels.iter().zip(&rgb) {
+            for k in 0..3 {
+                assert!((t[k] - c[k]).abs() < 1e-6, "{t:?} {c:?}");
+            }
+            assert_eq!(t[3], 0.0);
+        }
+        // The basis reproduces colour_at's spread: 600 nm is 50/130 of the way from G to R.
+        let b = p.basis();
+        assert!((b[0][1] - 50.0 / 130.0).abs() < 1e-12 && (b[1][1] - 80.0 / 130.0).abs() < 1e-12);
+        assert_eq!((b[2][0], b[2][3]), (0.0, 1.0));
+    }
+
+    /// The GPU's surface map: the procedural Earth's weights baked at the default texture
+    /// size and interpolated bilinearly between texel centres (as render/planet.wgsl does),
+    /// against the albedo evaluated at the point, over 20 000 evenly spread points. Coasts
+    /// inside a texel blend sea and land; elsewhere the weights are smooth.
+    #[test]
+    fn the_baked_procedural_map_interpolates_the_albedo() {
+        let p = earth();
+        let (w, h) = p.texture_size();
+        let started = std::time::Instant::now();
+        let texels = p.weight_texture(w, h);
+        eprintln!("baked in {:.2} s", started.elapsed().as_secs_f64());
+        let basis = p.basis();
+        let k = 1; // 550 nm
+        let (mut errors, mut over) = (Vec::new(), 0);
+        let points = sphere_directions(20_000);
+        for &d in &points {
+            let lat = d.z.asin();
+            let lon = d.y.atan2(d.x);
+            let x = (lon / std::f64::consts::TAU + 0.5) * w as f64 - 0.5;
+            let y =
+                ((0.5 - lat / std::f64::consts::PI) * h as f64 - 0.5).clamp(0.0, (h - 1) as f64);
+            let (x0, y0) = (x.floor(), y.floor());
+            let (fx, fy) = (x - x0, y - y0);
+            let xi = |dx: i64| ((x0 as i64 + dx).rem_euclid(w as i64)) as usize;
+            let yi = |dy: usize| (y0 as usize + dy).min(h - 1);
+            let mut wt = [0.0; 4];
+            for (dx, dy, f) in [
+                (0, 0, (1.0 - fx) * (1.0 - fy)),
+                (1, 0, fx * (1.0 - fy)),
+                (0, 1, (1.0 - fx) * fy),
+                (1, 1, fx * fy),
+            ] {
+                let t = texels[yi(dy) * w + xi(dx)];
+                for j in 0..4 {
+                    wt[j] += f * t[j] as f64;
+                }
+            }
+            let fifth = 1.0 - wt.iter().sum::<f64>();
+            let baked = (0..4).map(|j| wt[j] * basis[j][k]).sum::<f64>() + fifth * basis[4][k];
+            let exact: f64 = (0..BASIS).map(|j| p.weights(d)[j] * basis[j][k]).sum();
+            let e = (baked / exact - 1.0).abs();
+            over += usize::from(e > 0.05);
+            errors.push(e);
+        }
+        errors.sort_by(f64::total_cmp);
+        let mean = errors.iter().sum::<f64>() / errors.len() as f64;
+        let median = errors[errors.len() / 2];
+        let p95 = errors[errors.len() * 95 / 100];
+        eprintln!(
+            "procedural map at {w}×{h}, albedo at 550 nm, 20 000 points: mean |e| {:.2} %, median {:.3} %, p95 {:.2} %, {:.1} % of points over 5 %",
+            100.0 * mean,
+            100.0 * median,
+            100.0 * p95,
+            100.0 * over as f64 / errors.len() as f64
+        );
+        assert!(
+            mean < 0.02 && over * 100 < 3 * errors.len(),
+            "mean {mean}, {over} points over 5 %"
+        );
     }
 }
