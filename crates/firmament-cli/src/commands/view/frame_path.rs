@@ -274,7 +274,7 @@ impl FramePath {
 
     /// Passes the reference has averaged for the view last drawn (0 before the first).
     pub fn reference_passes(&self) -> usize {
-        self.reference.tracer.latest().map_or(0, |r| r.passes)
+        self.reference.tracer.passes()
     }
 
     /// The sky in use (after [`FramePath::ensure_sky`]).

@@ -199,3 +199,47 @@ fn the_planet_map_is_drawn_and_follows_the_place_without_a_new_texture() {
     eprintln!("planet map: moved 120° east {a:.3}, the grey ground {b:.3} (mean |ΔL|/L)");
     assert!(a > 0.02 && b > 0.05, "{a} {b}");
 }
+
+#[test]
+fn the_difference_view_shows_the_method_against_the_reference_in_false_colour() {
+    let Some(backend) = backend() else { return };
+    let mut state = view(Method::Bruneton4d);
+    let size = (32, 18);
+    let display = display_settings(&state, 1.0 / 60.0, false);
+    let mut path = FramePath::new(backend, &state, None, "small").unwrap();
+    let (method, _) = path.draw_offscreen(&state, size, display).unwrap();
+    state.compare = Compare::Difference;
+    path.draw_offscreen(&state, size, display).unwrap();
+    while path.reference_passes() < 2 {
+        assert!(path.reference_refused().is_none());
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    // The frame that takes a pass compares it; the false colour shows from the next one.
+    path.draw_offscreen(&state, size, display).unwrap();
+    let (shown, _) = path.draw_offscreen(&state, size, display).unwrap();
+    let y = |p: &[f32; 3]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
+    let mean = |f: &[[f32; 3]]| f.iter().map(y).sum::<f64>() / f.len() as f64;
+    // White to red or blue at the method's mean luminance (the sun's disk apart, the
+    // method's mean is the sky's): the colours' luminances lie between the blue end's
+    // (0.29 of white) and white's.
+    let (m, s) = (mean(&method.image.data), mean(&shown.image.data));
+    let sky = method
+        .image
+        .data
+        .iter()
+        .map(y)
+        .filter(|&l| l < 1e6)
+        .sum::<f64>()
+        / method.image.data.iter().filter(|p| y(p) < 1e6).count() as f64;
+    eprintln!("difference view: its mean luminance {s:.1}, the sky's {sky:.1} (the frame's with the disk {m:.1})");
+    assert!(s < 1.01 * sky && s > 0.25 * sky, "{s} against {sky}");
+    // Somewhere the reference's noise (4 paths/λ) colours a pixel red or blue.
+    let coloured = shown
+        .image
+        .data
+        .iter()
+        .filter(|p| (p[0] - p[2]).abs() > 0.05 * p[1].max(1e-9))
+        .count();
+    assert!(coloured > 0, "no pixel coloured");
+    assert!(path.reference_line().unwrap().contains("red brighter"));
+}

@@ -10,6 +10,7 @@
 
 pub mod capture;
 pub mod controls;
+pub mod difference;
 pub mod frame_path;
 pub mod panel;
 pub mod presets;
@@ -75,8 +76,10 @@ pub struct ViewArgs {
     #[arg(long, default_value = ".", value_name = "DIR")]
     pub capture_dir: PathBuf,
     /// The reference path tracer beside the method (`split`: the right half) or instead of
-    /// it (`whole`), traced progressively on the CPU; `off` by default.
-    #[arg(long, default_value = "off", value_name = "off|split|whole")]
+    /// it (`whole`), or the method against it in false colour (`difference`: red where the
+    /// method is brighter, blue where darker, full at ±10 %), traced progressively on the
+    /// CPU; `off` by default.
+    #[arg(long, default_value = "off", value_name = "off|split|whole|difference")]
     pub reference: String,
     /// With --frames and --reference: the last frame waits for this many of the
     /// reference's passes (2 paths per wavelength each).
@@ -167,8 +170,11 @@ fn compare_of(text: &str) -> Result<progressive::Compare> {
         "off" => Compare::Off,
         "split" => Compare::Split,
         "whole" => Compare::Whole,
+        "difference" => Compare::Difference,
         other => {
-            anyhow::bail!("invalid value for `--reference`: {other} (accepted: off, split, whole)")
+            anyhow::bail!(
+                "invalid value for `--reference`: {other} (accepted: off, split, whole, difference)"
+            )
         }
     })
 }
@@ -244,6 +250,11 @@ fn run_offscreen(args: &ViewArgs, mut state: ViewState) -> Result<()> {
         }
         let display = display_settings(&state, 1.0 / 60.0, false);
         last = Some(path.draw_offscreen(&state, size, display)?);
+        if state.compare == progressive::Compare::Difference {
+            // The false colour of a pass is made once the frame that compared it is read
+            // back: it shows from the next frame on.
+            last = Some(path.draw_offscreen(&state, size, display)?);
+        }
         if !args.quiet {
             if let Some(line) = path.reference_line() {
                 eprintln!("view: {line}");

@@ -74,6 +74,7 @@ pub fn panel(ui: &mut egui::Ui, state: &mut ViewState, info: &PanelInfo) -> Pane
             ("off", Compare::Off),
             ("split", Compare::Split),
             ("whole", Compare::Whole),
+            ("difference", Compare::Difference),
         ] {
             ui.radio_value(&mut state.compare, c, label);
         }

@@ -17,6 +17,8 @@ use firmament::scene::planet::PlanetSurface;
 use firmament::scene::terrain::Heightfield;
 use firmament::scene::{Camera, Light, Surface, Volume};
 
+use super::difference::{difference, false_colour, FULL_SCALE};
+
 /// Paths per wavelength per pixel in one pass (the tracer's smallest: two give a standard
 /// error).
 pub const PATHS_PER_PASS: usize = 2;
@@ -31,6 +33,9 @@ pub enum Compare {
     Split,
     /// The whole view is the reference's.
     Whole,
+    /// The whole view is the method against the reference in false colour
+    /// ([`super::difference::false_colour`]).
+    Difference,
 }
 
 /// What a trace depends on: a change restarts it.
@@ -139,13 +144,39 @@ impl Progressive {
         }
     }
 
-    /// The passes done for the current job (None before the first ends).
-    pub fn latest(&self) -> Option<Accumulated> {
+    /// The passes done for the current job (None before the first ends), their pixels
+    /// left empty when they are those of `have` (a (generation, passes) mark already taken):
+    /// a frame loop copies the image once a pass.
+    pub fn latest(&self, have: Option<(u64, usize)>) -> Option<Accumulated> {
         let r = self.shared.result.lock().expect("result lock");
-        (self.current.is_some()
-            && r.generation == self.generation
-            && (r.passes > 0 || r.error.is_some()))
-        .then(|| r.clone())
+        if self.current.is_none()
+            || r.generation != self.generation
+            || (r.passes == 0 && r.error.is_none())
+        {
+            return None;
+        }
+        let pixels = if have == Some((r.generation, r.passes)) {
+            Vec::new()
+        } else {
+            r.pixels.clone()
+        };
+        Some(Accumulated {
+            generation: r.generation,
+            passes: r.passes,
+            pixels,
+            noise: r.noise,
+            error: r.error.clone(),
+        })
+    }
+
+    /// Passes averaged for the current job (0 before the first).
+    pub fn passes(&self) -> usize {
+        let r = self.shared.result.lock().expect("result lock");
+        if self.current.is_some() && r.generation == self.generation {
+            r.passes
+        } else {
+            0
+        }
     }
 }
 
@@ -289,6 +320,12 @@ pub struct Overlay {
     difference: Option<(f64, f64)>,
     /// What [`Overlay::cover`] copies over the frame this time (None: nothing).
     cover: Option<Compare>,
+    /// How the reference was shown last frame, and what the device buffer holds: the
+    /// reference's average (split, whole) or the false colour (difference).
+    mode: Compare,
+    holds: Option<Compare>,
+    /// A false-colour image made after the last submission, to upload.
+    false_colour: Option<Vec<f32>>,
 }
 
 impl Overlay {
@@ -323,7 +360,14 @@ impl Overlay {
             (_, Ok(job)) => job,
         };
         self.tracer.set(Some(job));
-        let Some(latest) = self.tracer.latest() else {
+        if compare != self.mode {
+            // The buffer holds the other kind of image: the pass is taken again.
+            self.mode = compare;
+            self.uploaded = None;
+            self.holds = None;
+            self.false_colour = None;
+        }
+        let Some(latest) = self.tracer.latest(self.uploaded) else {
             self.line =
                 Some("reference: tracing its first pass (the method's frame meanwhile)".into());
             return;
@@ -343,12 +387,24 @@ impl Overlay {
             });
             self.buffer = Some((buffer, size));
             self.uploaded = None;
+            self.holds = None;
+            self.false_colour = None;
         }
         let (buffer, _) = self.buffer.as_ref().expect("just made");
+        if let Some(image) = self.false_colour.take() {
+            if image.len() as u64 * 4 == bytes {
+                ctx.queue()
+                    .write_buffer(buffer, 0, bytemuck::cast_slice(&image));
+                self.holds = Some(Compare::Difference);
+            }
+        }
         let mark = (latest.generation, latest.passes);
         if self.uploaded != Some(mark) && latest.pixels.len() as u64 * 4 == bytes {
-            let raw: Vec<u8> = latest.pixels.iter().flat_map(|v| v.to_le_bytes()).collect();
-            ctx.queue().write_buffer(buffer, 0, &raw);
+            if compare != Compare::Difference {
+                ctx.queue()
+                    .write_buffer(buffer, 0, bytemuck::cast_slice(&latest.pixels));
+                self.holds = Some(compare);
+            }
             self.uploaded = Some(mark);
             // The method's frame of the same view, before the reference covers it: compared
             // once the frame is submitted (`Overlay::submitted`).
@@ -360,14 +416,17 @@ impl Overlay {
             });
             encoder.copy_buffer_to_buffer(hdr, 0, &copy, 0, bytes);
             self.method_copy = Some(copy);
-            self.compare_with = Some(latest.pixels.clone());
+            self.compare_with = Some(latest.pixels);
         }
         self.line = Some(format!(
             "reference{}: {} passes, {} paths/λ a pixel, noise {:.1} %{}",
-            if compare == Compare::Split {
-                " (right half)"
-            } else {
-                ""
+            match compare {
+                Compare::Split => " (right half)".to_string(),
+                Compare::Difference => format!(
+                    " (the method against it: red brighter, blue darker, full at ±{:.0} %)",
+                    100.0 * FULL_SCALE
+                ),
+                _ => String::new(),
             },
             latest.passes,
             latest.passes * PATHS_PER_PASS,
@@ -381,7 +440,7 @@ impl Overlay {
                 None => String::new(),
             }
         ));
-        self.cover = self.uploaded.map(|_| compare);
+        self.cover = self.holds.filter(|&h| h == compare);
     }
 
     /// Record the reference's average over the frame (its right half, or all of it), after
@@ -393,7 +452,9 @@ impl Overlay {
         let px = firmament_gpu::PIXEL_BYTES;
         let (w, h) = (size.0 as u64, size.1 as u64);
         match compare {
-            Compare::Whole => encoder.copy_buffer_to_buffer(buffer, 0, hdr, 0, w * h * px),
+            Compare::Whole | Compare::Difference => {
+                encoder.copy_buffer_to_buffer(buffer, 0, hdr, 0, w * h * px)
+            }
             Compare::Split => {
                 // Row by row, the columns from the middle on.
                 let from = w / 2;
@@ -440,38 +501,8 @@ impl Overlay {
         drop(view);
         copy.unmap();
         self.difference = difference(&method, &reference);
-    }
-}
-
-/// Luminance (Rec. 709 / sRGB primaries) of a linear sRGB pixel.
-fn luminance(p: &[f32]) -> f64 {
-    0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64
-}
-
-/// Pixels brighter than this (cd/m²) hold a light's disk (the sun's is ~10⁹), which the
-/// method splats as a point below four pixels and the tracer draws where a pixel's centre
-/// meets it: compared apart from the sky, as `tests/view.rs` does.
-const DISK_CD_M2: f64 = 1.0e6;
-
-/// `method` against `reference` (RGBA per pixel, the mask in alpha): the relative
-/// difference of their mean luminances and the mean of |ΔL|/L over the pixels inside both
-/// where the reference is lit, the lights' disks left out.
-fn difference(method: &[f32], reference: &[f32]) -> Option<(f64, f64)> {
-    let (mut sm, mut sr, mut rel, mut n) = (0.0, 0.0, 0.0, 0usize);
-    for (m, r) in method.chunks_exact(4).zip(reference.chunks_exact(4)) {
-        if m[3] < 0.5 || r[3] < 0.5 {
-            continue;
-        }
-        let (lm, lr) = (luminance(m), luminance(r));
-        if lm > DISK_CD_M2 || lr > DISK_CD_M2 {
-            continue;
-        }
-        sm += lm;
-        sr += lr;
-        if lr > 0.0 {
-            rel += (lm - lr).abs() / lr;
-            n += 1;
+        if self.mode == Compare::Difference {
+            self.false_colour = Some(false_colour(&method, &reference));
         }
     }
-    (sr > 0.0 && n > 0).then(|| (sm / sr - 1.0, rel / n as f64))
 }
