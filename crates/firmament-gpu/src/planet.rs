@@ -3,7 +3,8 @@
 //! of five spectra ([`PlanetSurface::weights`], [`PlanetSurface::basis`]): the weights are
 //! baked once on the CPU into an equirectangular `Rgba16Float` texture
 //! ([`PlanetSurface::weight_texture`]: an image map at its own size, a procedural one at
-//! 2048 × 1024) and read bilinearly per pixel; the spectra, the observer's frame on the
+//! 2048 × 1024, cached on disk by `PlanetSurface::cached_weight_texture`) and read
+//! bilinearly per pixel; the spectra, the observer's frame on the
 //! planet and the sea's glint (Cox & Munk 1954) travel in a uniform. What this
 //! approximates: the procedural continents are evaluated at the texels' centres and
 //! interpolated between them (coasts within a texel, 20 km on Earth, blend sea and land,
@@ -42,10 +43,23 @@ fn v4(v: Vec3) -> [u32; 4] {
 
 impl GpuPlanet {
     /// Bake `planet`'s weights at its [`PlanetSurface::texture_size`] and upload them with
-    /// its spectra for `channels` wavelengths (the sky's). Refuses a map larger than the
-    /// device's 2D textures.
+    /// its spectra (at the wavelengths it was made for: the sky's). Refuses a map larger
+    /// than the device's 2D textures.
     pub fn new(ctx: &GpuContext, planet: &PlanetSurface) -> Result<GpuPlanet, GpuError> {
         let (w, h) = planet.texture_size();
+        GpuPlanet::from_texels(ctx, planet, &planet.weight_texture(w, h))
+    }
+
+    /// [`GpuPlanet::new`] with the weights already baked (`texels`, as
+    /// [`PlanetSurface::weight_texture`] at [`PlanetSurface::texture_size`] gives them, or
+    /// [`PlanetSurface::cached_weight_texture`]).
+    pub fn from_texels(
+        ctx: &GpuContext,
+        planet: &PlanetSurface,
+        texels: &[[f32; 4]],
+    ) -> Result<GpuPlanet, GpuError> {
+        let (w, h) = planet.texture_size();
+        assert_eq!(texels.len(), w * h, "a texel per grid point");
         let limit = ctx.limits().max_texture_dimension_2d as usize;
         if w > limit || h > limit {
             return Err(GpuError::Limit {
@@ -56,7 +70,6 @@ impl GpuPlanet {
                 adapter: ctx.adapter_name().to_string(),
             });
         }
-        let texels = planet.weight_texture(w, h);
         let halves: Vec<u16> = texels
             .iter()
             .flat_map(|t| t.map(|v| half::f16::from_f32(v).to_bits()))

@@ -358,7 +358,8 @@ impl<'a> RenderSky<'a> {
     }
 
     /// `planet`'s map on the device of a GPU sky (None without one): its weights baked on
-    /// the CPU ([`GpuPlanet::new`]).
+    /// the CPU, a procedural map's through the table cache's directory
+    /// (`PlanetSurface::cached_weight_texture`).
     pub fn gpu_planet(&self, planet: Option<&PlanetSurface>) -> Result<Option<GpuPlanet>> {
         let Some(planet) = planet else {
             return Ok(None);
@@ -369,7 +370,9 @@ impl<'a> RenderSky<'a> {
             | RenderSky::GpuHillaire { gpu, .. }
             | RenderSky::GpuElek3d { gpu, .. } => gpu,
         };
-        GpuPlanet::new(&gpu.ctx, planet)
+        let cache = firmament::sky::bruneton4d::cache::TableCache::from_env()?.map(|c| c.dir);
+        let (texels, _) = planet.cached_weight_texture(cache.as_deref())?;
+        GpuPlanet::from_texels(&gpu.ctx, planet, &texels)
             .map(Some)
             .map_err(|e| gpu_failure("uploading the planet's surface map", e))
     }

@@ -25,9 +25,6 @@ const OCEAN_ALBEDO_CSV: &str = include_str!("../../data/ocean_albedo.csv");
 /// Spectra a map mixes ([`PlanetSurface::basis`]).
 pub const BASIS: usize = 5;
 
-/// Width of a procedural map's texture ([`PlanetSurface::texture_size`]).
-pub const PROCEDURAL_TEXTURE_WIDTH: usize = 2048;
-
 /// Refractive index of sea water in the visible (Quan & Fry 1995: 1.339–1.345).
 pub const SEA_WATER_INDEX: f64 = 1.34;
 
@@ -92,7 +89,7 @@ pub struct PlanetSurface {
     /// a wind W in m/s at 12.5 m); None: no glint.
     pub slope_variance: Option<f64>,
     /// The noise level under which a procedural point is sea.
-    sea_level: f64,
+    pub(crate) sea_level: f64,
 }
 
 impl PlanetSurface {
@@ -240,41 +237,6 @@ impl PlanetSurface {
                 [column(0), column(1), column(2), zeros.clone(), zeros]
             }
         }
-    }
-
-    /// The size (width, height) of the equirectangular grid [`PlanetSurface::weight_texture`]
-    /// fills by default: an image's own; for a procedural map 2048 × 1024 (20 km per texel at
-    /// the equator of an Earth-sized planet, finer than the continents' smallest noise cells,
-    /// about 30 km).
-    pub fn texture_size(&self) -> (usize, usize) {
-        match &self.map {
-            SurfaceMap::Procedural { .. } => {
-                (PROCEDURAL_TEXTURE_WIDTH, PROCEDURAL_TEXTURE_WIDTH / 2)
-            }
-            SurfaceMap::Image { width, height, .. } => (*width, *height),
-        }
-    }
-
-    /// The first four of [`PlanetSurface::weights`] at the centres of a `width` × `height`
-    /// equirectangular grid (row 0 at 90° N, column 0 at 180° W, as an image map), row-major;
-    /// the fifth weight is 1 minus their sum for a procedural map and 0 for an image. At an
-    /// image's own size the texels are its pixels.
-    pub fn weight_texture(&self, width: usize, height: usize) -> Vec<[f32; 4]> {
-        use rayon::prelude::*;
-        let mut texels = vec![[0.0f32; 4]; width * height];
-        texels
-            .par_chunks_mut(width.max(1))
-            .enumerate()
-            .for_each(|(y, row)| {
-                let lat = (0.5 - (y as f64 + 0.5) / height as f64) * std::f64::consts::PI;
-                for (x, t) in row.iter_mut().enumerate() {
-                    let lon = ((x as f64 + 0.5) / width as f64 - 0.5) * std::f64::consts::TAU;
-                    let d = Vec3::new(lat.cos() * lon.cos(), lat.cos() * lon.sin(), lat.sin());
-                    let w = self.weights(d);
-                    *t = [w[0] as f32, w[1] as f32, w[2] as f32, w[3] as f32];
-                }
-            });
-        texels
     }
 
     /// Whether the first weight of [`PlanetSurface::weights`] is the sea's share (a
@@ -594,66 +556,5 @@ mod tests {
         let b = p.basis();
         assert!((b[0][1] - 50.0 / 130.0).abs() < 1e-12 && (b[1][1] - 80.0 / 130.0).abs() < 1e-12);
         assert_eq!((b[2][0], b[2][3]), (0.0, 1.0));
-    }
-
-    /// The GPU's surface map: the procedural Earth's weights baked at the default texture
-    /// size and interpolated bilinearly between texel centres (as render/planet.wgsl does),
-    /// against the albedo evaluated at the point, over 20 000 evenly spread points. Coasts
-    /// inside a texel blend sea and land; elsewhere the weights are smooth.
-    #[test]
-    fn the_baked_procedural_map_interpolates_the_albedo() {
-        let p = earth();
-        let (w, h) = p.texture_size();
-        let started = std::time::Instant::now();
-        let texels = p.weight_texture(w, h);
-        eprintln!("baked in {:.2} s", started.elapsed().as_secs_f64());
-        let basis = p.basis();
-        let k = 1; // 550 nm
-        let (mut errors, mut over) = (Vec::new(), 0);
-        let points = sphere_directions(20_000);
-        for &d in &points {
-            let lat = d.z.asin();
-            let lon = d.y.atan2(d.x);
-            let x = (lon / std::f64::consts::TAU + 0.5) * w as f64 - 0.5;
-            let y =
-                ((0.5 - lat / std::f64::consts::PI) * h as f64 - 0.5).clamp(0.0, (h - 1) as f64);
-            let (x0, y0) = (x.floor(), y.floor());
-            let (fx, fy) = (x - x0, y - y0);
-            let xi = |dx: i64| ((x0 as i64 + dx).rem_euclid(w as i64)) as usize;
-            let yi = |dy: usize| (y0 as usize + dy).min(h - 1);
-            let mut wt = [0.0; 4];
-            for (dx, dy, f) in [
-                (0, 0, (1.0 - fx) * (1.0 - fy)),
-                (1, 0, fx * (1.0 - fy)),
-                (0, 1, (1.0 - fx) * fy),
-                (1, 1, fx * fy),
-            ] {
-                let t = texels[yi(dy) * w + xi(dx)];
-                for j in 0..4 {
-                    wt[j] += f * t[j] as f64;
-                }
-            }
-            let fifth = 1.0 - wt.iter().sum::<f64>();
-            let baked = (0..4).map(|j| wt[j] * basis[j][k]).sum::<f64>() + fifth * basis[4][k];
-            let exact: f64 = (0..BASIS).map(|j| p.weights(d)[j] * basis[j][k]).sum();
-            let e = (baked / exact - 1.0).abs();
-            over += usize::from(e > 0.05);
-            errors.push(e);
-        }
-        errors.sort_by(f64::total_cmp);
-        let mean = errors.iter().sum::<f64>() / errors.len() as f64;
-        let median = errors[errors.len() / 2];
-        let p95 = errors[errors.len() * 95 / 100];
-        eprintln!(
-            "procedural map at {w}×{h}, albedo at 550 nm, 20 000 points: mean |e| {:.2} %, median {:.3} %, p95 {:.2} %, {:.1} % of points over 5 %",
-            100.0 * mean,
-            100.0 * median,
-            100.0 * p95,
-            100.0 * over as f64 / errors.len() as f64
-        );
-        assert!(
-            mean < 0.02 && over * 100 < 3 * errors.len(),
-            "mean {mean}, {over} points over 5 %"
-        );
     }
 }
