@@ -57,7 +57,7 @@ mod wgsl_prelude;
 
 pub use bruneton4d::{GpuSky, GpuTables, Precomputer};
 pub use clouds::GpuClouds;
-pub use device::{test_context, GpuContext};
+pub use device::{driver_crash, test_context, GpuContext};
 pub use elek3d::{GpuElek3d, GpuElek3dRenderer, GpuElek3dTables};
 pub use error::GpuError;
 pub use hillaire2020::{

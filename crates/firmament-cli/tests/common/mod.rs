@@ -49,34 +49,19 @@ pub fn run(args: &[&str]) -> Output {
     bin().args(args).output().expect("run the firmament binary")
 }
 
-/// [`run`], again (up to six runs) when the process is killed by a signal: Mesa's
-/// lavapipe (22.3, LLVM 15) crashes in its queue thread in some runs of the cloud shader
-/// (a jump to a wild address in `libvulkan_lvp.so` (gdb), or glibc's heap abort; during
-/// the frame or at exit after the output is written; 6 of 16 `render --backend gpu` runs
-/// of `clouds-cumulus-noon` on a 2-core host, 2026-12-06; the runs that finish give
-/// identical frames; see firmament-gpu's `clouds_parity`). An exit code is returned at
-/// once.
-///
-/// The corruption may also surface as a panic inside a dependency (gpu-allocator freeing a
-/// buffer with a wild index, wgpu): a run that panicked in a crate of the registry is run
-/// again too (firmament's own failures are errors with exit code 1, never such panics).
+/// [`run`], again (up to six runs) while the process dies of the test driver's known heap
+/// corruption ([`firmament_gpu::driver_crash`]); an exit code of firmament's own is
+/// returned at once.
 pub fn run_past_lavapipe_crashes(args: &[&str]) -> Output {
     for attempt in 1..=6 {
         let o = run(args);
-        let e = stderr(&o);
-        let dependency_panic = e.contains("panicked at") && e.contains("/.cargo/registry/");
-        if o.status.code().is_some() && !dependency_panic {
-            return o;
+        match firmament_gpu::driver_crash(&o.status, &stderr(&o)) {
+            None => return o,
+            Some(why) => eprintln!(
+                "attempt {attempt}: {args:?} {why} ({}): lavapipe's heap corruption, running it again",
+                o.status
+            ),
         }
-        eprintln!(
-            "attempt {attempt}: {} ({}): lavapipe's heap corruption, running it again",
-            if dependency_panic {
-                "a panic in a dependency"
-            } else {
-                "killed by a signal"
-            },
-            o.status
-        );
     }
     panic!("crashed six times: {args:?}");
 }

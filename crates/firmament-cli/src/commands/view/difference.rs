@@ -23,22 +23,20 @@ pub fn luminance(p: &[f32]) -> f64 {
     0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64
 }
 
-/// Whether a pixel pair is compared: inside both frames, lit in the reference, off the
-/// lights' disks.
-fn compared(m: &[f32], r: &[f32]) -> bool {
+/// The luminances (method, reference) of a pixel pair that is compared: inside both frames,
+/// lit in the reference, off the lights' disks; None for a pair left out.
+fn compared(m: &[f32], r: &[f32]) -> Option<(f64, f64)> {
     let (lm, lr) = (luminance(m), luminance(r));
-    m[3] >= 0.5 && r[3] >= 0.5 && lm <= DISK_CD_M2 && lr <= DISK_CD_M2 && lr > 0.0
+    (m[3] >= 0.5 && r[3] >= 0.5 && lm <= DISK_CD_M2 && lr <= DISK_CD_M2 && lr > 0.0)
+        .then_some((lm, lr))
 }
 
 /// `method` against `reference`: the relative difference of their mean luminances and the
 /// mean of |ΔL|/L over the compared pixels.
 pub fn difference(method: &[f32], reference: &[f32]) -> Option<(f64, f64)> {
     let (mut sm, mut sr, mut rel, mut n) = (0.0, 0.0, 0.0, 0usize);
-    for (m, r) in method.chunks_exact(4).zip(reference.chunks_exact(4)) {
-        if !compared(m, r) {
-            continue;
-        }
-        let (lm, lr) = (luminance(m), luminance(r));
+    let pairs = method.chunks_exact(4).zip(reference.chunks_exact(4));
+    for (lm, lr) in pairs.filter_map(|(m, r)| compared(m, r)) {
         sm += lm;
         sr += lr;
         rel += (lm - lr).abs() / lr;
@@ -52,17 +50,16 @@ pub fn difference(method: &[f32], reference: &[f32]) -> Option<(f64, f64)> {
 /// white where ΔL/L = 0, towards [`BRIGHTER`] or [`DARKER`] linearly up to ±[`FULL_SCALE`].
 pub fn false_colour(method: &[f32], reference: &[f32]) -> Vec<f32> {
     let (mut sum, mut n) = (0.0, 0usize);
-    for (m, r) in method.chunks_exact(4).zip(reference.chunks_exact(4)) {
-        if compared(m, r) {
-            sum += luminance(m);
-            n += 1;
-        }
+    let pairs = method.chunks_exact(4).zip(reference.chunks_exact(4));
+    for (lm, _) in pairs.filter_map(|(m, r)| compared(m, r)) {
+        sum += lm;
+        n += 1;
     }
     let level = if n > 0 { sum / n as f64 } else { 1.0 };
     let mut out = Vec::with_capacity(method.len());
     for (m, r) in method.chunks_exact(4).zip(reference.chunks_exact(4)) {
-        let rgb = if compared(m, r) {
-            let e = luminance(m) / luminance(r) - 1.0;
+        let rgb = if let Some((lm, lr)) = compared(m, r) {
+            let e = lm / lr - 1.0;
             let t = (e / FULL_SCALE).clamp(-1.0, 1.0);
             let end = if t < 0.0 { DARKER } else { BRIGHTER };
             let a = t.abs();

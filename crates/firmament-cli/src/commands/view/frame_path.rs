@@ -217,6 +217,22 @@ impl FramePath {
         self.reference.tracer.passes()
     }
 
+    /// Waits until the reference, which traces beside the frames, has averaged `passes`
+    /// passes for the view last drawn: an error when it refused that view or the user
+    /// interrupted.
+    pub fn wait_for_reference(&self, passes: usize) -> Result<()> {
+        while self.reference_passes() < passes {
+            if let Some(why) = self.reference_refused() {
+                anyhow::bail!("`--reference`: the reference {why}");
+            }
+            if crate::common::cancel_flag().load(std::sync::atomic::Ordering::Relaxed) {
+                anyhow::bail!("interrupted");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+        Ok(())
+    }
+
     /// The sky in use (after [`FramePath::ensure_sky`]).
     pub fn sky(&self) -> Option<&RenderSky<'static>> {
         self.sky.as_ref().map(|(_, _, s)| s)

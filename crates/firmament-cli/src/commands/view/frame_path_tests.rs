@@ -13,11 +13,10 @@ const CHILD: &str = "FIRMAMENT_VIEW_GPU_TEST_CHILD";
 
 /// The test adapter as the viewer's backend, or None: outside CI without an adapter
 /// (skipped), and in the test's own process, which runs the test `name` again in a child
-/// process (this binary, `--exact name`) and returns None once it passed. A child killed by
-/// a signal, or panicking inside a dependency, is run again, up to six times: Mesa 22.3.6's lavapipe corrupts its heap now and
-/// then (see `tests/common::run_past_lavapipe_crashes`); this binary's GPU tests, in one
-/// process, aborted in 8 of 19 runs with this session's planet map on the GPU (since
-/// reverted: its two bindings in every render pass are the suspect; none in 6 at b8bcc24). A child that fails otherwise fails the test with its output.
+/// process (this binary, `--exact name`) and returns None once it passed. A child that dies
+/// of the test driver's heap corruption ([`firmament_gpu::driver_crash`]) is run again, up
+/// to six times (this binary's GPU tests, in one process, aborted in 8 of 19 runs on
+/// 2026-12-05). A child that fails otherwise fails the test with its output.
 /// The lock keeps the children one at a time (lavapipe uses every core).
 fn backend(name: &str) -> Option<(&'static Backend, std::sync::MutexGuard<'static, ()>)> {
     static LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
@@ -52,19 +51,11 @@ fn backend(name: &str) -> Option<(&'static Backend, std::sync::MutexGuard<'stati
             eprintln!("{text}");
             return None;
         }
-        // The corruption may surface as a panic inside a dependency (naga's compaction
-        // indexing 4294967295 once here, gpu-allocator elsewhere): run again too.
-        let dependency_panic = text.contains("panicked at") && text.contains("/.cargo/registry/");
-        if out.status.code().is_some() && !dependency_panic {
+        let Some(why) = firmament_gpu::driver_crash(&out.status, &text) else {
             panic!("{test} failed in its process:\n{text}");
-        }
+        };
         eprintln!(
-            "attempt {attempt}: {test} {} ({}): lavapipe's heap corruption, running it again",
-            if dependency_panic {
-                "panicked in a dependency"
-            } else {
-                "was killed by a signal"
-            },
+            "attempt {attempt}: {test} {why} ({}): lavapipe's heap corruption, running it again",
             out.status
         );
     }
@@ -98,7 +89,7 @@ fn frame(path: &mut FramePath, state: &ViewState) -> Vec<[f32; 3]> {
 
 /// Mean relative luminance difference of two frames.
 fn mean_rel(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
-    let y = |p: &[f32; 3]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
+    let y = |p: &[f32; 3]| crate::commands::view::difference::luminance(p);
     let sum: f64 = a
         .iter()
         .zip(b)
@@ -183,10 +174,7 @@ fn the_panel_compares_the_method_with_the_reference_over_the_frame() {
     let size = (32, 18);
     let display = display_settings(&state, 1.0 / 60.0, false);
     path.draw_offscreen(&state, size, display).unwrap();
-    while path.reference_passes() < 4 {
-        assert!(path.reference_refused().is_none());
-        std::thread::sleep(std::time::Duration::from_millis(50));
-    }
+    path.wait_for_reference(4).unwrap();
     // The next frame uploads the passes and compares the method's frame with them.
     let (shown, _) = path.draw_offscreen(&state, size, display).unwrap();
     let (bias, mean_abs) = path.reference_difference().expect("a comparison");
@@ -223,14 +211,11 @@ fn the_difference_view_shows_the_method_against_the_reference_in_false_colour() 
     let (method, _) = path.draw_offscreen(&state, size, display).unwrap();
     state.compare = Compare::Difference;
     path.draw_offscreen(&state, size, display).unwrap();
-    while path.reference_passes() < 2 {
-        assert!(path.reference_refused().is_none());
-        std::thread::sleep(std::time::Duration::from_millis(50));
-    }
+    path.wait_for_reference(2).unwrap();
     // The frame that takes a pass compares it; the false colour shows from the next one.
     path.draw_offscreen(&state, size, display).unwrap();
     let (shown, _) = path.draw_offscreen(&state, size, display).unwrap();
-    let y = |p: &[f32; 3]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
+    let y = |p: &[f32; 3]| crate::commands::view::difference::luminance(p);
     let mean = |f: &[[f32; 3]]| f.iter().map(y).sum::<f64>() / f.len() as f64;
     // White to red or blue at the method's mean luminance (the sun's disk apart, the
     // method's mean is the sky's): the colours' luminances lie between the blue end's

@@ -244,15 +244,7 @@ fn run_offscreen(args: &ViewArgs, mut state: ViewState) -> Result<()> {
     }
     if state.compare != progressive::Compare::Off {
         // The tracer runs beside the frames: the last one waits for its passes.
-        while path.reference_passes() < args.reference_passes {
-            if let Some(why) = path.reference_refused() {
-                anyhow::bail!("`--reference`: the reference {why}");
-            }
-            if crate::common::cancel_flag().load(std::sync::atomic::Ordering::Relaxed) {
-                anyhow::bail!("interrupted");
-            }
-            std::thread::sleep(std::time::Duration::from_millis(50));
-        }
+        path.wait_for_reference(args.reference_passes)?;
         let display = display_settings(&state, 1.0 / 60.0, false);
         last = Some(path.draw_offscreen(&state, size, display)?);
         if state.compare == progressive::Compare::Difference {
