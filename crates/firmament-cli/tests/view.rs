@@ -12,7 +12,7 @@ use std::path::Path;
 use std::process::Command;
 use std::sync::{Mutex, MutexGuard, OnceLock};
 
-use common::{fails_with, run, run_past_lavapipe_crashes, succeeds, tables_arg, tmp_subdir};
+use common::{fails_with, run, succeeds, tables_arg, tmp_subdir};
 
 fn gpu() -> Option<MutexGuard<'static, ()>> {
     static AVAILABLE: OnceLock<bool> = OnceLock::new();
@@ -57,7 +57,7 @@ fn clear_scene(dir: &Path) -> std::path::PathBuf {
 
 /// The offscreen viewer's frame of `scene`, its scene saved.
 fn offscreen(dir: &Path, scene: &Path, size: (u32, u32), method: &str) -> std::process::Output {
-    run_past_lavapipe_crashes(&[
+    run(&[
         "view",
         "--scene",
         scene.to_str().unwrap(),
@@ -86,7 +86,7 @@ fn offscreen(dir: &Path, scene: &Path, size: (u32, u32), method: &str) -> std::p
 /// `firmament render` of the scene the viewer saved in `dir`, on the GPU from the same
 /// tables: `render.exr` and `render.png`.
 fn render_saved_scene(dir: &Path) {
-    succeeds(&run_past_lavapipe_crashes(&[
+    succeeds(&run(&[
         "render",
         "--scene",
         dir.join("scene.toml").to_str().unwrap(),
