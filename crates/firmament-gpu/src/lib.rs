@@ -50,6 +50,7 @@ mod error;
 pub mod hillaire2020;
 pub mod pass_timer;
 pub mod passes;
+pub mod planet;
 pub mod render;
 pub mod shader;
 pub mod terrain;
@@ -64,6 +65,7 @@ pub use hillaire2020::{
     GpuHillaire, GpuHillaireRenderer, GpuHillaireTables, HillaireFrameTiming, HillairePassTiming,
     HillairePrecomputer, HillaireTables,
 };
+pub use planet::GpuPlanet;
 pub use render::{GpuRenderer, RenderInputs, RenderTarget, RenderTiming, PIXEL_BYTES};
 pub use terrain::GpuTerrain;
 

@@ -108,8 +108,9 @@ pub const TERRAIN: [Module; 7] = [
 
 /// The renderer's modules: lights, cameras, the air volume, the scene over the terrain, the
 /// frame.
-pub const RENDER: [Module; 7] = [
+pub const RENDER: [Module; 8] = [
     module!("render/light.wgsl"),
+    module!("render/planet.wgsl"),
     module!("render/camera.wgsl"),
     module!("render/disk_edges.wgsl"),
     module!("render/air_volume.wgsl"),
@@ -162,9 +163,10 @@ pub const HILLAIRE2020_VIEW: [Module; 2] = [
 
 /// What a Hillaire 2020 frame takes of the renderer's modules (no terrain: its scene is the
 /// clear sky, `hillaire2020/scene.wgsl`): lights, cameras, the disks' edges, the frame.
-pub const HILLAIRE2020_RENDER: [Module; 5] = [
+pub const HILLAIRE2020_RENDER: [Module; 6] = [
     module!("hillaire2020/scene.wgsl"),
     module!("render/light.wgsl"),
+    module!("render/planet.wgsl"),
     module!("render/camera.wgsl"),
     module!("render/disk_edges.wgsl"),
     module!("render/render.wgsl"),
@@ -183,9 +185,10 @@ pub const ELEK3D_VIEW: [Module; 2] = [
 
 /// What a 3D-table frame takes of the renderer's modules (no terrain: its scene is the
 /// clear sky, `elek3d/scene.wgsl`): lights, cameras, the disks' edges, the frame.
-pub const ELEK3D_RENDER: [Module; 5] = [
+pub const ELEK3D_RENDER: [Module; 6] = [
     module!("elek3d/scene.wgsl"),
     module!("render/light.wgsl"),
+    module!("render/planet.wgsl"),
     module!("render/camera.wgsl"),
     module!("render/disk_edges.wgsl"),
     module!("render/render.wgsl"),

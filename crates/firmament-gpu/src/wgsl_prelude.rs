@@ -78,6 +78,8 @@ pub fn prelude() -> String {
         ("AIR_STEPS", air_volume::STEPS),
         ("HORIZON_AZIMUTHS", HORIZON_AZIMUTHS),
         ("DISK_SUBSAMPLES", disk_edges::SUBSAMPLES),
+        ("PLANET_BASIS", firmament::scene::planet::BASIS),
+        ("PLANET_BASIS_VEC4", crate::planet::PLANET_BASIS_VEC4),
     ] {
         s += &u(name, v);
     }

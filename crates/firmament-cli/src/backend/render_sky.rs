@@ -20,7 +20,7 @@ use firmament::sky::SkyMethod;
 use firmament_gpu::elek3d::{GpuElek3d, GpuElek3dRenderer};
 use firmament_gpu::hillaire2020::{GpuHillaire, GpuHillaireRenderer, HillairePrecomputer};
 use firmament_gpu::{
-    GpuClouds, GpuError, GpuRenderer, GpuSky, GpuTerrain, RenderInputs, RenderTarget,
+    GpuClouds, GpuError, GpuPlanet, GpuRenderer, GpuSky, GpuTerrain, RenderInputs, RenderTarget,
 };
 
 use super::{gpu_failure, on_gpu, Backend, Gpu};
@@ -231,11 +231,6 @@ impl<'a> RenderSky<'a> {
                 "`--method elek3d` draws terrain on the CPU only so far: use `--backend cpu` (or `auto`)"
             );
         }
-        if planet.is_some() && !matches!(self, RenderSky::Cpu(..)) {
-            anyhow::bail!(
-                "the planet's surface map ([surface]) renders on the CPU only so far: use `--backend cpu` (or `auto`)"
-            );
-        }
         match self {
             RenderSky::Cpu(sky, aerial) => {
                 let bar = progress_bar(1000, quiet);
@@ -269,10 +264,12 @@ impl<'a> RenderSky<'a> {
                     [] => None,
                     media => Some(self.gpu_clouds(media, settings, sources, quiet)?),
                 };
+                let gpu_planet = self.gpu_planet(planet)?;
                 let inputs = RenderInputs {
                     background: sources.background.as_ref(),
                     terrain: gpu_terrain.as_ref(),
                     clouds: gpu_clouds.as_ref(),
+                    planet: gpu_planet.as_ref(),
                     ..RenderInputs::default()
                 };
                 gpu_frame(sources, settings, sky_model, terrain, quiet, |lights| {
@@ -286,8 +283,10 @@ impl<'a> RenderSky<'a> {
                 renderer,
                 ..
             } => {
+                let gpu_planet = self.gpu_planet(planet)?;
                 let inputs = RenderInputs {
                     background: sources.background.as_ref(),
+                    planet: gpu_planet.as_ref(),
                     ..RenderInputs::default()
                 };
                 gpu_frame(sources, settings, sky_model, None, quiet, |lights| {
@@ -300,8 +299,10 @@ impl<'a> RenderSky<'a> {
                 sky_model,
                 renderer,
             } => {
+                let gpu_planet = self.gpu_planet(planet)?;
                 let inputs = RenderInputs {
                     background: sources.background.as_ref(),
+                    planet: gpu_planet.as_ref(),
                     ..RenderInputs::default()
                 };
                 gpu_frame(sources, settings, sky_model, None, quiet, |lights| {
@@ -316,7 +317,8 @@ impl<'a> RenderSky<'a> {
     /// this camera; the 4D tables only), or under `clouds` (uploaded by
     /// [`RenderSky::gpu_clouds`]; the 4D tables without a terrain only); no stars (those
     /// need the CPU's parts of [`RenderSky::render`]); `timestamps` as
-    /// `RenderInputs::timestamps`. The viewer's frame path.
+    /// `RenderInputs::timestamps`, over the planet's map `planet` ([`RenderSky::gpu_planet`];
+    /// every method). The viewer's frame path.
     pub fn encode_frame(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -326,6 +328,7 @@ impl<'a> RenderSky<'a> {
         timestamps: Option<&wgpu::QuerySet>,
         terrain: Option<&GpuTerrain>,
         clouds: Option<&GpuClouds>,
+        planet: Option<&GpuPlanet>,
     ) -> Result<()> {
         if (terrain.is_some() || clouds.is_some()) && !matches!(self, RenderSky::Gpu { .. }) {
             anyhow::bail!("a terrain or clouds are drawn on the GPU by the 4D tables only so far");
@@ -335,6 +338,7 @@ impl<'a> RenderSky<'a> {
             timestamps,
             terrain,
             clouds,
+            planet,
             ..RenderInputs::default()
         };
         let lights = &sources.lights;
@@ -351,6 +355,26 @@ impl<'a> RenderSky<'a> {
             } => renderer.encode(&gpu.ctx, encoder, sky, lights, settings, target, inputs),
         };
         recorded.map_err(|e| gpu_failure("recording the frame", e))
+    }
+
+    /// `planet`'s map on the device of a GPU sky (None without one): its weights baked on
+    /// the CPU, a procedural map's through the table cache's directory
+    /// (`PlanetSurface::cached_weight_texture`).
+    pub fn gpu_planet(&self, planet: Option<&PlanetSurface>) -> Result<Option<GpuPlanet>> {
+        let Some(planet) = planet else {
+            return Ok(None);
+        };
+        let gpu = match self {
+            RenderSky::Cpu(..) => unreachable!("gpu_planet is called for GPU skies"),
+            RenderSky::Gpu { gpu, .. }
+            | RenderSky::GpuHillaire { gpu, .. }
+            | RenderSky::GpuElek3d { gpu, .. } => gpu,
+        };
+        let cache = firmament::sky::bruneton4d::cache::TableCache::from_env()?.map(|c| c.dir);
+        let (texels, _) = planet.cached_weight_texture(cache.as_deref())?;
+        GpuPlanet::from_texels(&gpu.ctx, planet, &texels)
+            .map(Some)
+            .map_err(|e| gpu_failure("uploading the planet's surface map", e))
     }
 
     /// The CPU twin of the GPU's 4D tables (read back from the device once), with the

@@ -62,7 +62,7 @@ struct View {
     strip: Option<(usize, i64)>,
     /// Over the default scene's terrain.
     terrain: bool,
-    /// With the planet's procedural surface map (`[surface]`, CPU only so far).
+    /// With the planet's procedural surface map (`[surface]`).
     surface: bool,
 }
 
@@ -201,8 +201,8 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
             (Some(terrain_sky), true) => terrain_sky,
             _ => &sky,
         };
-        // The surface map renders on the CPU only so far.
-        scene.surface = (v.surface && matches!(sky, RenderSky::Cpu(..)))
+        scene.surface = v
+            .surface
             .then(firmament::scene::planet_config::SurfaceConfig::default);
         scene.camera = v.camera.clone();
         scene.sun.zenith_deg = v.sun.0;

@@ -292,11 +292,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             }
             Backend::Cpu
         }
-        Backend::Gpu(_) if scene.surface.is_some() && args.backend == BackendChoice::Gpu => {
-            anyhow::bail!(
-                "the planet's surface map ([surface]) renders on the CPU only so far: `--backend cpu` or `auto` render it"
-            )
-        }
         Backend::Gpu(_) if clouds_cpu_only && args.backend == BackendChoice::Gpu => {
             anyhow::bail!(
                 "clouds ([[clouds]]) render on the GPU with `--method bruneton4d` and no terrain so far: `--backend cpu` or `auto` render them here (or `--no-terrain`)"
@@ -305,14 +300,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         Backend::Gpu(_) if clouds_cpu_only => {
             if !args.quiet {
                 eprintln!("note: clouds with hillaire2020, elek3d or a terrain render on the CPU only so far: using the CPU");
-            }
-            Backend::Cpu
-        }
-        Backend::Gpu(_) if scene.surface.is_some() => {
-            if !args.quiet {
-                eprintln!(
-                    "note: the planet's surface map renders on the CPU only so far: using the CPU"
-                );
             }
             Backend::Cpu
         }

@@ -125,6 +125,11 @@ fn shade_clouds(dir: vec3<f32>) -> vec3<f32> {
     }
     let x = q + end_m * dir;
     let up = cloud_point(x).up;
+    // The planet's surface map at the ground point.
+    var map: PlanetWeights;
+    if (hit && planet_on()) {
+        map = planet_weights(ground_point(o.r_km, dir));
+    }
     // The clouds in front, seen through the air to their mean depth under the same shadows.
     var l_vol: array<vec4<f32>, MAX_CHANNEL_GROUPS>;
     let m = march_clouds(q, dir, end_m, &l_vol);
@@ -155,6 +160,10 @@ fn shade_clouds(dir: vec3<f32>) -> vec3<f32> {
             }
             if (hit) {
                 let g = point_light(vl, 0.0, up, up);
+                var glint = 0.0;
+                if (planet_on()) {
+                    glint = planet_specular(map, up, -dir, vl.direction);
+                }
                 for (var k = 0u; k < atm.groups; k++) {
                     let scale = light_scale(light, k);
                     let e = point_irradiance(g, k);
@@ -164,7 +173,11 @@ fn shade_clouds(dir: vec3<f32>) -> vec3<f32> {
                     let t_air = sample_transmittance(g.to_light, k) * g.fraction;
                     s = dim_surface_light(light, x, up, vl.direction, k, t_air, s);
                     let t = t_end[k];
-                    let l = acc[k] * scale + ground_albedo(k) / PI * (s.direct + s.sky) * t;
+                    var albedo = ground_albedo(k);
+                    if (planet_on()) {
+                        albedo = planet_albedo(map, k);
+                    }
+                    let l = acc[k] * scale + (albedo / PI * (s.direct + s.sky) + glint * s.direct) * t;
                     rgb += to_srgb(l, k);
                 }
                 continue;

@@ -64,20 +64,37 @@ fn shade(dir: vec3<f32>, shadow_length_km: f32) -> vec3<f32> {
     var v: View;
     v.mie_layout = frame.mie_layout;
     var rgb = vec3<f32>(0.0);
+    // The planet's surface map at the ray's ground point (planet.wgsl), when one is bound.
+    var map: PlanetWeights;
+    var ground_normal = vec3<f32>(0.0, 0.0, 1.0);
+    if (planet_on() && dir.z < 0.0) {
+        let p = ground_point(o.r_km, dir);
+        map = planet_weights(p);
+        ground_normal = normalize(p);
+    }
     for (var light = 0u; light < frame.lights; light++) {
         let vl = view_light(light);
         let g = ground_ray(v, o, vl, dir, shadow_length_km);
         if (g.hit) {
             // The ground lit by the light and the sky, seen through aerial perspective.
             let gl = ground_light(vl, g.mu_s_ground);
+            var glint = 0.0;
+            if (planet_on()) {
+                glint = planet_specular(map, ground_normal, -dir, vl.direction);
+            }
             for (var k = 0u; k < atm.groups; k++) {
                 let scale = light_scale(light, k);
                 let t = transmittance_to_point(g, k);
                 let e = sun_and_sky_irradiance(gl, k);
                 // A shadowed length on a ray to the ground ends at the ground point: in shadow.
                 let direct = select(e.direct * light_irradiance(light, k), vec4<f32>(0.0), shadow_length_km > 0.0);
+                var albedo = ground_albedo(k);
+                if (planet_on()) {
+                    albedo = planet_albedo(map, k);
+                }
+                // The sea's glint on the direct beam (render::Shader::shade).
                 let l = sky_radiance_to_point(v, g, k) * scale
-                    + ground_albedo(k) / PI * (direct + e.sky * scale) * t;
+                    + (albedo / PI * (direct + e.sky * scale) + glint * direct) * t;
                 rgb += to_srgb(l, k);
             }
             continue;

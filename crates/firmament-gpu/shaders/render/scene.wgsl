@@ -159,6 +159,12 @@ fn shade_scene(dir: vec3<f32>) -> vec3<f32> {
             }
         }
     }
+    // The planet's surface map where the ray meets the sphere beyond the terrain.
+    let on_map = hit.hit && !hit.terrain && planet_on();
+    var map: PlanetWeights;
+    if (on_map) {
+        map = planet_weights(ground_point(o.r_km, dir));
+    }
     var acc: array<vec4<f32>, MAX_CHANNEL_GROUPS>;
     for (var light = 0u; light < frame.lights; light++) {
         let vl = view_light(light);
@@ -177,11 +183,17 @@ fn shade_scene(dir: vec3<f32>) -> vec3<f32> {
         }
         if (hit.hit) {
             let g = point_light(vl, altitude_km, hit.up, hit.normal);
+            var glint = 0.0;
+            if (on_map) {
+                glint = planet_specular(map, hit.up, -dir, vl.direction);
+            }
             for (var k = 0u; k < atm.groups; k++) {
                 let scale = light_scale(light, k);
                 var albedo = ground_albedo(k);
                 if (hit.terrain) {
                     albedo = terrain_albedo(weights, k);
+                } else if (on_map) {
+                    albedo = planet_albedo(map, k);
                 }
                 var e = point_irradiance(g, k);
                 if (domes) {
@@ -195,7 +207,8 @@ fn shade_scene(dir: vec3<f32>) -> vec3<f32> {
                 }
                 let direct = select(vec4<f32>(0.0), e.direct * light_irradiance(light, k), lit_at_end);
                 let t = point_transmittance(pray, endp, k);
-                let l = acc[k] * scale + albedo / PI * (direct + visible_sky * e.sky * scale) * t;
+                let l = acc[k] * scale
+                    + (albedo / PI * (direct + visible_sky * e.sky * scale) + glint * direct) * t;
                 rgb += to_srgb(l, k);
             }
             continue;

@@ -44,6 +44,8 @@ pub struct GpuElek3dRenderer {
     unused_params: wgpu::Buffer,
     /// Binding 16 when no shadowed lengths are given (1×1).
     no_shadow_lengths: wgpu::TextureView,
+    /// Binding 25 when no planet map is given.
+    no_planet: crate::planet::NoPlanet,
     /// Cap on the output bytes one dispatch writes (None: the device's binding limit).
     max_band_bytes: Option<u64>,
 }
@@ -79,6 +81,8 @@ fn compile(ctx: &GpuContext, output: Slot, format: Option<&str>) -> Pipelines {
             (14, Uniform),
             (15, Uniform),
             (16, Texture),
+            (25, Texture),
+            (26, Uniform),
         ],
     );
     Pipelines {
@@ -122,6 +126,7 @@ impl GpuElek3dRenderer {
                 rgba16: OnceLock::new(),
                 unused_params: init(device, "unused", &[0; 16], wgpu::BufferUsages::UNIFORM),
                 no_shadow_lengths: texture.create_view(&Default::default()),
+                no_planet: crate::planet::NoPlanet::new(device),
                 max_band_bytes: None,
             })
         })
@@ -429,6 +434,7 @@ impl GpuElek3dRenderer {
             let light_uniform = uniform("lights", &light_words(sky, lights, inputs.background));
             let coordinates = uniform("slice coordinates", &sky.slice_words(lights, settings));
             let shadow = inputs.shadow_lengths.unwrap_or(&self.no_shadow_lengths);
+            let (planet_map, planet_uniform) = self.no_planet.or(device, inputs.planet);
             let t = sky.tables();
             let mut bind_groups = Vec::new();
             let mut dispatches = Vec::new();
@@ -463,6 +469,8 @@ impl GpuElek3dRenderer {
                     (14, light_uniform.as_entire_binding()),
                     (15, coordinates.as_entire_binding()),
                     (16, wgpu::BindingResource::TextureView(shadow)),
+                    (25, wgpu::BindingResource::TextureView(planet_map)),
+                    (26, planet_uniform.as_entire_binding()),
                 ];
                 let entries: Vec<wgpu::BindGroupEntry> = entries
                     .into_iter()

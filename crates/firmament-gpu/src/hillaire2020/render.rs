@@ -41,6 +41,8 @@ pub struct GpuHillaireRenderer {
     rgba16: OnceLock<Pipelines>,
     /// Binding 16 when no shadowed lengths are given (1×1).
     no_shadow_lengths: wgpu::TextureView,
+    /// Binding 25 when no planet map is given.
+    no_planet: crate::planet::NoPlanet,
     /// Cap on the output bytes one dispatch writes (None: the device's binding limit).
     max_band_bytes: Option<u64>,
 }
@@ -75,6 +77,8 @@ fn compile(ctx: &GpuContext, output: Slot, format: Option<&str>) -> Pipelines {
             (16, Texture),
             (20, Read),
             (21, Read),
+            (25, Texture),
+            (26, Uniform),
         ],
     );
     Pipelines {
@@ -141,6 +145,7 @@ impl GpuHillaireRenderer {
                 rgba32: OnceLock::new(),
                 rgba16: OnceLock::new(),
                 no_shadow_lengths: texture.create_view(&Default::default()),
+                no_planet: crate::planet::NoPlanet::new(device),
                 max_band_bytes: None,
             })
         })
@@ -465,6 +470,7 @@ impl GpuHillaireRenderer {
                 &sky_view_words(sky, lights, settings),
             );
             let shadow = inputs.shadow_lengths.unwrap_or(&self.no_shadow_lengths);
+            let (planet_map, planet_uniform) = self.no_planet.or(device, inputs.planet);
             let t = sky.tables();
             let mut bind_groups = Vec::new();
             let mut dispatches = Vec::new();
@@ -498,6 +504,8 @@ impl GpuHillaireRenderer {
                     (16, wgpu::BindingResource::TextureView(shadow)),
                     (20, t.multiple_scattering.as_entire_binding()),
                     (21, t.irradiance.as_entire_binding()),
+                    (25, wgpu::BindingResource::TextureView(planet_map)),
+                    (26, planet_uniform.as_entire_binding()),
                 ];
                 let entries: Vec<wgpu::BindGroupEntry> = entries
                     .into_iter()

@@ -60,6 +60,7 @@ use crate::bruneton4d::atmosphere::groups;
 use crate::clouds::{no_clouds_words, GpuClouds};
 use crate::device::{f32s, read_back, scoped, staging_buffer};
 use crate::passes::{init, workgroups, Pass, Slot, WORKGROUP};
+use crate::planet::{GpuPlanet, NoPlanet};
 use crate::shader::render_source;
 use crate::terrain::{no_terrain_words, GpuTerrain};
 use crate::{GpuContext, GpuError, GpuSky};
@@ -104,6 +105,10 @@ pub struct RenderInputs<'a> {
     /// under their shadows and light, the air's shafts through their gaps, the clouds
     /// composited at their mean depth), and ignores `shadow_lengths`. Not with a terrain.
     pub clouds: Option<&'a GpuClouds>,
+    /// The planet's surface map ([`GpuPlanet`]): the ground sphere's albedo from it and the
+    /// sea's glint, as `firmament::render::render` with the scene's ground set to that
+    /// `PlanetSurface`. Every sky method's frame takes it.
+    pub planet: Option<&'a GpuPlanet>,
     /// Timestamps written around the frame's compute passes when given (a query set of
     /// at least 4 on a device with `TIMESTAMP_QUERY`): 0 and 1 around the pass of the 4D
     /// and 3D tables' frames; Hillaire 2020's sky-view pass at 0 and 1, its pixels at 2
@@ -133,6 +138,8 @@ pub struct GpuRenderer {
     no_terrain: wgpu::Buffer,
     /// Binding 19 when no clouds are given (one word).
     no_clouds: wgpu::Buffer,
+    /// Binding 25 when no planet map is given.
+    no_planet: NoPlanet,
     /// Cap on the output bytes one dispatch writes (None: the device's binding limit).
     max_band_bytes: Option<u64>,
 }
@@ -173,6 +180,8 @@ fn compile(ctx: &GpuContext, output: Slot, format: Option<&str>) -> Pipelines {
             (18, Uniform),
             (19, Read),
             (20, Uniform),
+            (25, Texture),
+            (26, Uniform),
         ],
     );
     Pipelines {
@@ -220,6 +229,7 @@ impl GpuRenderer {
                 no_shadow_lengths: texture.create_view(&Default::default()),
                 no_terrain: init(device, "no terrain", &[0; 16], wgpu::BufferUsages::STORAGE),
                 no_clouds: init(device, "no clouds", &[0; 16], wgpu::BufferUsages::STORAGE),
+                no_planet: NoPlanet::new(device),
                 max_band_bytes: None,
             })
         })
@@ -529,6 +539,7 @@ impl GpuRenderer {
             let cloud_data = inputs.clouds.map_or(&self.no_clouds, |c| c.data());
             let slice_uniform = uniform("slice coordinates", &slice_words(sky, lights, settings));
             let shadow = inputs.shadow_lengths.unwrap_or(&self.no_shadow_lengths);
+            let (planet_map, planet_uniform) = self.no_planet.or(device, inputs.planet);
             let tables = sky.tables();
             let mut bind_groups = Vec::new();
             let mut dispatches = Vec::new();
@@ -566,6 +577,8 @@ impl GpuRenderer {
                     (18, terrain_uniform.as_entire_binding()),
                     (19, cloud_data.as_entire_binding()),
                     (20, cloud_uniform.as_entire_binding()),
+                    (25, wgpu::BindingResource::TextureView(planet_map)),
+                    (26, planet_uniform.as_entire_binding()),
                 ];
                 let entries: Vec<wgpu::BindGroupEntry> = entries
                     .into_iter()

@@ -12,6 +12,7 @@ pub mod light;
 pub mod lunar;
 pub mod planet;
 pub mod planet_config;
+pub mod planet_texture;
 pub mod sky_lights;
 pub mod surface;
 pub mod terrain;

@@ -22,6 +22,9 @@ use crate::spectrum::table::Table;
 
 const OCEAN_ALBEDO_CSV: &str = include_str!("../../data/ocean_albedo.csv");
 
+/// Spectra a map mixes ([`PlanetSurface::basis`]).
+pub const BASIS: usize = 5;
+
 /// Refractive index of sea water in the visible (Quan & Fry 1995: 1.339–1.345).
 pub const SEA_WATER_INDEX: f64 = 1.34;
 
@@ -86,7 +89,7 @@ pub struct PlanetSurface {
     /// a wind W in m/s at 12.5 m); None: no glint.
     pub slope_variance: Option<f64>,
     /// The noise level under which a procedural point is sea.
-    sea_level: f64,
+    pub(crate) sea_level: f64,
 }
 
 impl PlanetSurface {
@@ -169,6 +172,85 @@ impl PlanetSurface {
         sea as f64 / points.len() as f64
     }
 
+    /// The albedo at a planet-fixed unit direction as weights of the five spectra of
+    /// [`PlanetSurface::basis`] (the albedo is their weighted sum; the GPU bakes these weights
+    /// into a texture, `firmament_gpu::planet`): for a procedural map, the shares of ocean,
+    /// ice, rock, forest and grass (summing to 1; the first is 1 at sea, 0 on land); for an
+    /// image, its linear red, green and blue (then 0, 0).
+    pub fn weights(&self, d: Vec3) -> [f64; BASIS] {
+        match &self.map {
+            SurfaceMap::Procedural { seed, .. } => {
+                if self.is_sea(d) {
+                    return [1.0, 0.0, 0.0, 0.0, 0.0];
+                }
+                let lat = d.z.clamp(-1.0, 1.0).asin().to_degrees().abs();
+                let wiggle = 8.0 * noise3(*seed ^ 0x1ce, 4.0 * d);
+                let ice = smoothstep(66.0, 72.0, lat + wiggle);
+                // Moisture: wet tropics and mid-latitudes, dry subtropics (Hadley cells).
+                let belt = (-(lat - 25.0).powi(2) / (2.0 * 9.0 * 9.0)).exp();
+                let wet = 0.5 + 0.5 * noise3(*seed ^ 0xdee, 3.0 * d) - 0.9 * belt;
+                let desert = smoothstep(0.15, 0.0, wet);
+                let forest = smoothstep(0.35, 0.6, wet);
+                // ice + (1 − ice)·(desert·rock + (1 − desert)·(forest·forest + (1 − forest)·grass)).
+                let land = 1.0 - ice;
+                let green = land * (1.0 - desert);
+                [
+                    0.0,
+                    ice,
+                    land * desert,
+                    green * forest,
+                    green * (1.0 - forest),
+                ]
+            }
+            SurfaceMap::Image { width, height, rgb } => {
+                let lat = d.z.clamp(-1.0, 1.0).asin();
+                let lon = d.y.atan2(d.x);
+                let x = (lon / std::f64::consts::TAU + 0.5) * *width as f64 - 0.5;
+                let y = (0.5 - lat / std::f64::consts::PI) * *height as f64 - 0.5;
+                let c = bilinear_wrap(rgb, *width, *height, x, y);
+                [c[0], c[1], c[2], 0.0, 0.0]
+            }
+        }
+    }
+
+    /// The five spectra [`PlanetSurface::weights`] mix, at the surface's wavelengths: ocean,
+    /// ice, rock, forest, grass for a procedural map; for an image the spectra of its pure
+    /// red, green and blue (linear between 680, 550 and 440 nm, [`colour_basis`]), then two
+    /// of zeros.
+    pub fn basis(&self) -> [Vec<f64>; BASIS] {
+        match self.map {
+            SurfaceMap::Procedural { .. } => [
+                self.ocean.clone(),
+                self.ice.clone(),
+                self.rock.clone(),
+                self.forest.clone(),
+                self.grass.clone(),
+            ],
+            SurfaceMap::Image { .. } => {
+                let column = |i: usize| -> Vec<f64> {
+                    self.wavelengths_nm
+                        .iter()
+                        .map(|&nm| colour_basis(nm)[i])
+                        .collect()
+                };
+                let zeros = vec![0.0; self.wavelengths_nm.len()];
+                [column(0), column(1), column(2), zeros.clone(), zeros]
+            }
+        }
+    }
+
+    /// Whether the first weight of [`PlanetSurface::weights`] is the sea's share (a
+    /// procedural map with a glint): the glint's weight on the GPU.
+    pub fn sea_is_first(&self) -> bool {
+        matches!(self.map, SurfaceMap::Procedural { .. })
+    }
+
+    /// The observer's east, north and up in the map's planet-fixed frame (z to 90° N, x to
+    /// 0° E).
+    pub fn frame(&self) -> [Vec3; 3] {
+        self.frame
+    }
+
     /// The Cox & Munk (1954) glint BRDF (sr⁻¹) of the sea for light from `to_light` seen
     /// from `to_viewer` (units) over the local `normal`: F(β_i)·P(tan β)/(4 cos θ_i cos θ_v
     /// cos⁴ β), P the isotropic Gaussian of the facets' slopes with variance σ², β the
@@ -194,38 +276,10 @@ impl Surface for PlanetSurface {
     }
 
     fn albedo(&self, hit: &SurfaceHit, out: &mut [f64]) {
-        let d = self.fixed(hit.position);
-        match &self.map {
-            SurfaceMap::Procedural { seed, .. } => {
-                let n = out.len();
-                if self.is_sea(d) {
-                    out.copy_from_slice(&self.ocean[..n]);
-                    return;
-                }
-                let lat = d.z.clamp(-1.0, 1.0).asin().to_degrees().abs();
-                let wiggle = 8.0 * noise3(*seed ^ 0x1ce, 4.0 * d);
-                let ice = smoothstep(66.0, 72.0, lat + wiggle);
-                // Moisture: wet tropics and mid-latitudes, dry subtropics (Hadley cells).
-                let belt = (-(lat - 25.0).powi(2) / (2.0 * 9.0 * 9.0)).exp();
-                let wet = 0.5 + 0.5 * noise3(*seed ^ 0xdee, 3.0 * d) - 0.9 * belt;
-                let desert = smoothstep(0.15, 0.0, wet);
-                let forest = smoothstep(0.35, 0.6, wet);
-                for k in 0..n {
-                    let green = forest * self.forest[k] + (1.0 - forest) * self.grass[k];
-                    let land = desert * self.rock[k] + (1.0 - desert) * green;
-                    out[k] = ice * self.ice[k] + (1.0 - ice) * land;
-                }
-            }
-            SurfaceMap::Image { width, height, rgb } => {
-                let lat = d.z.clamp(-1.0, 1.0).asin();
-                let lon = d.y.atan2(d.x);
-                let x = (lon / std::f64::consts::TAU + 0.5) * *width as f64 - 0.5;
-                let y = (0.5 - lat / std::f64::consts::PI) * *height as f64 - 0.5;
-                let c = bilinear_wrap(rgb, *width, *height, x, y);
-                for (o, &nm) in out.iter_mut().zip(&self.wavelengths_nm) {
-                    *o = colour_at(c, nm);
-                }
-            }
+        let w = self.weights(self.fixed(hit.position));
+        let basis = self.basis();
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = (0..BASIS).map(|j| w[j] * basis[j][k]).sum();
         }
     }
 
@@ -318,17 +372,19 @@ fn bilinear_wrap(rgb: &[[f32; 3]], w: usize, h: usize, x: f64, y: f64) -> [f64; 
     c
 }
 
-/// A linear sRGB colour's value at `nm`: the channels at 680 (R), 550 (G) and 440 nm (B),
-/// linear between them, held beyond.
-fn colour_at(c: [f64; 3], nm: f64) -> f64 {
+/// The weights of a linear sRGB colour's channels in its value at `nm`: the channels stand
+/// at 680 (R), 550 (G) and 440 nm (B), linear between them, held beyond.
+pub fn colour_basis(nm: f64) -> [f64; 3] {
     if nm >= 680.0 {
-        c[0]
+        [1.0, 0.0, 0.0]
     } else if nm >= 550.0 {
-        c[1] + (c[0] - c[1]) * (nm - 550.0) / 130.0
+        let f = (nm - 550.0) / 130.0;
+        [f, 1.0 - f, 0.0]
     } else if nm >= 440.0 {
-        c[2] + (c[1] - c[2]) * (nm - 440.0) / 110.0
+        let f = (nm - 440.0) / 110.0;
+        [0.0, f, 1.0 - f]
     } else {
-        c[2]
+        [0.0, 0.0, 1.0]
     }
 }
 
@@ -452,5 +508,53 @@ mod tests {
         };
         p.albedo(&south, &mut out);
         assert!(out[0] < 1e-9, "{out:?}");
+    }
+
+    #[test]
+    fn the_weights_sum_to_one_and_mix_the_spectra() {
+        let p = earth();
+        let basis = p.basis();
+        let (mut sea, mut land) = (0, 0);
+        for d in sphere_directions(4000) {
+            let w = p.weights(d);
+            assert!(w.iter().all(|&x| (0.0..=1.0).contains(&x)), "{w:?}");
+            assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12, "{w:?}");
+            if p.is_sea(d) {
+                sea += 1;
+                assert_eq!(w, [1.0, 0.0, 0.0, 0.0, 0.0]);
+            } else {
+                land += 1;
+                assert_eq!(w[0], 0.0);
+            }
+        }
+        assert!(sea > 0 && land > 0);
+        // The sea's albedo is the ocean spectrum.
+        assert_eq!(basis[0], ocean_spectrum(&[680.0, 550.0, 440.0]));
+    }
+
+    #[test]
+    fn the_weight_texture_of_an_image_holds_its_pixels() {
+        let (w, h) = (6, 3);
+        let rgb: Vec<[f32; 3]> = (0..w * h)
+            .map(|i| [i as f32 / 20.0, 0.5, 1.0 - i as f32 / 20.0])
+            .collect();
+        let map = SurfaceMap::Image {
+            width: w,
+            height: h,
+            rgb: rgb.clone(),
+        };
+        let p = PlanetSurface::new(1.0, map, 10.0, 20.0, &[700.0, 600.0, 500.0, 400.0], None);
+        assert_eq!(p.texture_size(), (w, h));
+        let texels = p.weight_texture(w, h);
+        for (t, c) in texels.iter().zip(&rgb) {
+            for k in 0..3 {
+                assert!((t[k] - c[k]).abs() < 1e-6, "{t:?} {c:?}");
+            }
+            assert_eq!(t[3], 0.0);
+        }
+        // The basis reproduces colour_at's spread: 600 nm is 50/130 of the way from G to R.
+        let b = p.basis();
+        assert!((b[0][1] - 50.0 / 130.0).abs() < 1e-12 && (b[1][1] - 80.0 / 130.0).abs() < 1e-12);
+        assert_eq!((b[2][0], b[2][3]), (0.0, 1.0));
     }
 }

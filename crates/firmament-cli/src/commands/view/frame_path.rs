@@ -8,6 +8,7 @@ use anyhow::{Context, Result};
 use firmament::render::stars::point_splats;
 use firmament::render::{Frame, RenderSettings};
 use firmament::scene::clouds::CloudMedium;
+use firmament::scene::planet::PlanetSurface;
 use firmament::scene::sky_lights::SkySources;
 use firmament::scene::terrain::Heightfield;
 use firmament::sky::bruneton4d::amortised::{AmortisedTables, UpdateProgress};
@@ -16,7 +17,7 @@ use firmament_gpu::display::{
 };
 use firmament_gpu::pass_timer::{PassTimer, PassTimes, SkySlots};
 use firmament_gpu::render::stars::PointSplats;
-use firmament_gpu::{GpuClouds, GpuTerrain, RenderTarget};
+use firmament_gpu::{GpuClouds, GpuPlanet, GpuTerrain, RenderTarget};
 
 use std::sync::Arc;
 
@@ -32,6 +33,16 @@ use sky::{AirKey, SkyKey};
 struct TerrainKey {
     lights: Vec<[f64; 3]>,
     altitude_m: f64,
+}
+
+/// The scene's surface map on the device and on the CPU (the reference traces it).
+struct PlanetMap {
+    /// The map, the planet's radius and the wavelengths its texture was baked for.
+    key: String,
+    /// The observer's latitude and longitude on it (degrees).
+    place: (f64, f64),
+    gpu: GpuPlanet,
+    cpu: Arc<PlanetSurface>,
 }
 
 /// The viewer's GPU frame path.
@@ -71,6 +82,9 @@ pub struct FramePath {
     gpu_clouds: Option<(TerrainKey, GpuClouds)>,
     /// The pass adding the stars and small disks into the frame (made when first needed).
     points: Option<PointSplats>,
+    /// The scene's surface map on the device, what its texture was baked for, and the
+    /// observer's latitude and longitude on it (degrees).
+    planet: Option<PlanetMap>,
     /// The reference path tracer's passes over the frame (`state.compare`).
     reference: Overlay,
     /// The atmosphere the reference traces, and the keys it was made for.
@@ -120,6 +134,7 @@ impl FramePath {
             clouds: None,
             gpu_clouds: None,
             points: None,
+            planet: None,
         })
     }
 
@@ -145,6 +160,47 @@ impl FramePath {
         self.clouds = Some((key, radius_m, Arc::new(media)));
         self.gpu_clouds = None;
         Ok(())
+    }
+
+    /// The scene's surface map (`[surface]`) on the device for a planet of `radius_m` (None
+    /// without one): its texture baked when the map, the planet or the wavelengths change,
+    /// the observer's place on it set every frame (the date-and-place panel moves it).
+    fn ensure_planet(&mut self, state: &ViewState, radius_m: f64) -> Result<Option<&GpuPlanet>> {
+        let Some(surface) = &state.scene.surface else {
+            self.planet = None;
+            return Ok(None);
+        };
+        let sky = self.sky.as_ref().map(|(_, _, s)| s).context("no sky yet")?;
+        let nm = sky.model().wavelengths.nm();
+        let key = format!(
+            "{}|{radius_m}|{nm:?}",
+            toml::to_string(surface).unwrap_or_default()
+        );
+        let place = (state.scene.location.as_ref()).map_or((0.0, 0.0), |l| (l.lat_deg, l.lon_deg));
+        if (self.planet.as_ref()).is_some_and(|m| m.key == key && m.place == place) {
+            return Ok(self.planet.as_ref().map(|m| &m.gpu));
+        }
+        let planet = state
+            .scene
+            .build_surface(radius_m, nm)?
+            .expect("the scene has a [surface]");
+        match &mut self.planet {
+            Some(m) if m.key == key => {
+                m.gpu.set_frame(planet.frame());
+                m.place = place;
+                m.cpu = Arc::new(planet);
+            }
+            _ => {
+                let gpu = sky.gpu_planet(Some(&planet))?.expect("a planet was given");
+                self.planet = Some(PlanetMap {
+                    key,
+                    place,
+                    gpu,
+                    cpu: Arc::new(planet),
+                });
+            }
+        }
+        Ok(self.planet.as_ref().map(|m| &m.gpu))
     }
 
     /// Whether the scene's clouds are drawn with this method (the 4D tables over the
@@ -179,6 +235,9 @@ impl FramePath {
             let model = args.model().map_err(|e| format!("{e:#}"))?;
             self.ref_model = Some((key, Arc::new(model)));
         }
+        if state.scene.surface.as_ref().is_some_and(|s| s.glint) {
+            return Err("traces Lambertian surfaces only: not the sun's glint on the sea (the map's `glint = false` lets it trace the map)".into());
+        }
         let (_, model) = self.ref_model.as_ref().expect("just made");
         // The clouds the method draws, the tracer meets too.
         let volumes = match &self.clouds {
@@ -188,6 +247,7 @@ impl FramePath {
         Ok(Job {
             model: model.clone(),
             terrain: self.terrain.clone(),
+            planet: self.planet.as_ref().map(|m| m.cpu.clone()),
             volumes,
             camera: camera.clone(),
             sun: sources.lights[0].clone(),
@@ -263,6 +323,9 @@ impl FramePath {
         }
         let radius = self.sky().context("no sky yet")?.model().bottom_radius_m;
         self.ensure_clouds(state, radius)?;
+        // The map lies on the terrain's planet when there is one, as in `render`.
+        let planet_radius = self.terrain.as_ref().map_or(radius, |t| t.radius_m);
+        self.ensure_planet(state, planet_radius)?;
         // The camera's altitude is above the terrain under it, as in `render`.
         let camera = state.scene.camera_over(self.terrain.as_deref(), radius);
         let job = self.reference_job(state, sources, &camera, size);
@@ -339,6 +402,7 @@ impl FramePath {
             set,
             terrain,
             clouds,
+            self.planet.as_ref().map(|m| &m.gpu),
         )?;
         let ctx = match self.backend {
             Backend::Gpu(gpu) => &gpu.ctx,

@@ -198,6 +198,69 @@ fn backend_is_software(backend: &Backend) -> bool {
 }
 
 #[test]
+fn the_planet_map_is_drawn_and_follows_the_place_without_a_new_texture() {
+    let Some((backend, _serial)) =
+        backend("the_planet_map_is_drawn_and_follows_the_place_without_a_new_texture")
+    else {
+        return;
+    };
+    let text = r#"
+        [atmosphere]
+        wavelengths = "rgb"
+        [camera]
+        projection = "orbit"
+        altitude_m = 30000000.0
+        fov_deg = 23.4
+        [sun]
+        zenith_deg = 40.0
+        azimuth_deg = 90.0
+        [surface]
+        [location]
+        lat_deg = 10.0
+        lon_deg = 20.0
+        [image]
+        width = 32
+        height = 32
+        [output]
+        files = ["unused.png"]
+    "#;
+    let scene: SceneFile = toml::from_str(text).unwrap();
+    let mut state = ViewState::new(scene, Method::Bruneton4d, true);
+    state.render_scale = 1.0;
+    let size = (32, 32);
+    let draw = |path: &mut FramePath, state: &ViewState| {
+        let display = display_settings(state, 1.0 / 60.0, false);
+        path.draw_offscreen(state, size, display)
+            .unwrap()
+            .0
+            .image
+            .data
+    };
+    let mut path = FramePath::new(backend, &state, None, "small").unwrap();
+    let mapped = draw(&mut path, &state);
+    let baked = path.planet.as_ref().map(|m| m.key.clone()).expect("a map");
+    // The reference refuses the glint (it traces Lambertian surfaces).
+    let sources = path.sources(&state).unwrap();
+    let camera = state.scene.camera.clone();
+    state.compare = Compare::Whole;
+    let refused = path.reference_job(&state, &sources, &camera, size).err();
+    assert!(refused.is_some_and(|r| r.contains("glint")));
+    state.compare = Compare::Off;
+    // Elsewhere on the planet: another frame, the same texture.
+    state.scene.location.as_mut().unwrap().lon_deg = 140.0;
+    let moved = draw(&mut path, &state);
+    let m = path.planet.as_ref().unwrap();
+    assert_eq!((m.key.as_str(), m.place), (baked.as_str(), (10.0, 140.0)));
+    // Without the map: the uniform grey ground.
+    state.scene.surface = None;
+    let grey = draw(&mut path, &state);
+    assert!(path.planet.is_none());
+    let (a, b) = (mean_rel(&moved, &mapped), mean_rel(&grey, &mapped));
+    eprintln!("planet map: moved 120° east {a:.3}, the grey ground {b:.3} (mean |ΔL|/L)");
+    assert!(a > 0.02 && b > 0.05, "{a} {b}");
+}
+
+#[test]
 fn the_difference_view_shows_the_method_against_the_reference_in_false_colour() {
     let Some((backend, _serial)) =
         backend("the_difference_view_shows_the_method_against_the_reference_in_false_colour")

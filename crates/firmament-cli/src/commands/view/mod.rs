@@ -92,7 +92,7 @@ pub struct ViewArgs {
 
 /// The scene the viewer starts from, and what of it the viewer does not draw yet.
 pub fn load_scene(path: Option<&PathBuf>) -> Result<(SceneFile, Vec<String>)> {
-    let mut scene = match path {
+    let scene = match path {
         Some(p) => SceneFile::from_file(p)?,
         None => SceneFile::default(),
     };
@@ -107,11 +107,6 @@ pub fn load_scene(path: Option<&PathBuf>) -> Result<(SceneFile, Vec<String>)> {
         not_drawn.push(
             "the scene's clouds: drawn with bruneton4d over the planet's sphere (over a terrain, `firmament render` draws them on the CPU)"
                 .into(),
-        );
-    }
-    if scene.surface.take().is_some() {
-        not_drawn.push(
-            "the planet's surface map: `firmament render` draws it, the viewer not yet".into(),
         );
     }
     Ok((scene, not_drawn))

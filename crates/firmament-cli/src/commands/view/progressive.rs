@@ -13,6 +13,7 @@ use firmament::atmosphere::Model;
 use firmament::reference::{self, ReferenceSettings};
 use firmament::render::RenderSettings;
 use firmament::scene::clouds::CloudMedium;
+use firmament::scene::planet::PlanetSurface;
 use firmament::scene::terrain::Heightfield;
 use firmament::scene::{Camera, Light, Surface, Volume};
 
@@ -45,6 +46,8 @@ pub struct Job {
     pub model: Arc<Model>,
     /// The terrain the paths meet, if any.
     pub terrain: Option<Arc<Heightfield>>,
+    /// The planet's surface map the paths meet (Lambertian), if any.
+    pub planet: Option<Arc<PlanetSurface>>,
     /// The cloud layers the paths meet (delta tracking), if any.
     pub volumes: Option<Arc<Vec<CloudMedium>>>,
     /// The camera (its altitude already above the terrain).
@@ -67,6 +70,7 @@ impl Job {
             && self.white_balance == o.white_balance
             && self.terrain.as_ref().map(Arc::as_ptr) == o.terrain.as_ref().map(Arc::as_ptr)
             && self.volumes.as_ref().map(Arc::as_ptr) == o.volumes.as_ref().map(Arc::as_ptr)
+            && self.planet.as_ref().map(Arc::as_ptr) == o.planet.as_ref().map(Arc::as_ptr)
     }
 }
 
@@ -253,10 +257,10 @@ fn work(shared: &Shared) {
 /// One pass: the frame at [`PATHS_PER_PASS`] paths per wavelength with the pass's random
 /// streams; its pixels (RGBA as the HDR frame) and its mean relative noise.
 fn trace_pass(job: &Job, pass: u64, cancel: &AtomicBool) -> firmament::Result<(Vec<f32>, f64)> {
-    let surfaces: Vec<Box<dyn Surface + '_>> = job
-        .terrain
-        .iter()
-        .map(|t| Box::new(t.as_ref()) as _)
+    // The map's sphere lies on the ground sphere and wins the tie (after the terrain).
+    let surfaces: Vec<Box<dyn Surface + '_>> = (job.terrain.iter())
+        .map(|t| Box::new(t.as_ref()) as Box<dyn Surface + '_>)
+        .chain(job.planet.iter().map(|p| Box::new(p.as_ref()) as _))
         .collect();
     let volumes: Vec<Box<dyn Volume + '_>> = job
         .volumes
