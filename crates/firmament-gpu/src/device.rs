@@ -150,6 +150,23 @@ impl GpuContext {
         self.info.device_type == wgpu::DeviceType::Cpu
     }
 
+    /// Whether the passes read their uniform blocks as read-only storage buffers: on
+    /// software adapters. Mesa 22.3's lavapipe (Debian 12's, LLVM 15) writes into freed
+    /// memory while it builds a compute pipeline whose shader reads uniform buffers
+    /// (valgrind: 4-byte writes from a recursive walk inside `vkCreateComputePipelines`,
+    /// into unallocated blocks, at every build of the render pipelines), and the process
+    /// dies of it later, in its queue thread or in glibc's allocator: 9 of 25 `render
+    /// --backend gpu` runs of a small cumulus scene, against 0 of 25 with storage buffers,
+    /// interleaved (2026-12-06), the frames identical to the byte. Hardware keeps uniform
+    /// buffers. `FIRMAMENT_GPU_UNIFORMS=uniform` (or `storage`) overrides the choice.
+    pub fn uniforms_as_storage(&self) -> bool {
+        match std::env::var("FIRMAMENT_GPU_UNIFORMS").as_deref() {
+            Ok("uniform") => false,
+            Ok("storage") => true,
+            _ => self.is_software(),
+        }
+    }
+
     /// Whether the device writes timestamp queries (`wgpu::Features::TIMESTAMP_QUERY`).
     pub fn supports_timestamps(&self) -> bool {
         self.device

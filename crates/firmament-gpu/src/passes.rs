@@ -4,6 +4,8 @@
 
 use wgpu::util::DeviceExt;
 
+use crate::GpuContext;
+
 /// Workgroup size of every pass (`WORKGROUP` in the WGSL prelude).
 pub const WORKGROUP: u32 = 64;
 
@@ -22,6 +24,11 @@ pub enum Slot {
     StorageTexture(wgpu::TextureFormat),
 }
 
+/// What every uniform block's buffer may be bound as: a uniform buffer, or a read-only
+/// storage buffer where the passes read them so ([`GpuContext::uniforms_as_storage`]).
+pub const UNIFORM_USAGE: wgpu::BufferUsages =
+    wgpu::BufferUsages::UNIFORM.union(wgpu::BufferUsages::STORAGE);
+
 /// Binding slots every pass has.
 const COMMON: [(u32, Slot); 3] = [(0, Slot::Uniform), (1, Slot::Uniform), (2, Slot::Read)];
 
@@ -37,13 +44,16 @@ pub struct Pass {
 
 impl Pass {
     /// Compile `code` (a whole composed source); `slots` are the pass's own bindings besides
-    /// the common ones.
-    pub fn new(
-        device: &wgpu::Device,
-        name: &'static str,
-        code: String,
-        slots: &[(u32, Slot)],
-    ) -> Pass {
+    /// the common ones. Its uniform blocks become read-only storage buffers where `ctx`
+    /// asks for that ([`GpuContext::uniforms_as_storage`]; WGSL lays both out alike).
+    pub fn new(ctx: &GpuContext, name: &'static str, code: String, slots: &[(u32, Slot)]) -> Pass {
+        let device = ctx.device();
+        let as_storage = ctx.uniforms_as_storage();
+        let code = if as_storage {
+            code.replace("var<uniform>", "var<storage, read>")
+        } else {
+            code
+        };
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(name),
             source: wgpu::ShaderSource::Wgsl(code.into()),
@@ -55,6 +65,11 @@ impl Pass {
                 binding,
                 visibility: wgpu::ShaderStages::COMPUTE,
                 ty: match slot {
+                    Slot::Uniform if as_storage => wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
                     Slot::Uniform => wgpu::BindingType::Buffer {
                         ty: wgpu::BufferBindingType::Uniform,
                         has_dynamic_offset: false,

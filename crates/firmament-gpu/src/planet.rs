@@ -200,7 +200,7 @@ impl NoPlanet {
             device,
             "planet",
             bytemuck::cast_slice(&words),
-            wgpu::BufferUsages::UNIFORM,
+            crate::passes::UNIFORM_USAGE,
         );
         (planet.map_or(&self.view, |p| p.view()), buffer)
     }

@@ -71,10 +71,9 @@ impl Precomputer {
     /// Compile the passes.
     pub fn new(ctx: &GpuContext) -> Result<Precomputer, GpuError> {
         use Slot::{Read, Write};
-        let d = ctx.device();
         scoped(ctx, "shader compilation", || {
             let pass = |module: Module, slots: &[(u32, Slot)]| {
-                Pass::new(d, module.name(), precompute_source(module), slots)
+                Pass::new(ctx, module.name(), precompute_source(module), slots)
             };
             Ok(Precomputer {
                 transmittance: pass(passes::TRANSMITTANCE, &[(7, Write)]),
@@ -174,7 +173,7 @@ impl Precomputer {
         let device = ctx.device();
 
         scoped(ctx, "table precomputation", || {
-            let uniform = wgpu::BufferUsages::UNIFORM;
+            let uniform = crate::passes::UNIFORM_USAGE;
             let atm = init(
                 device,
                 "atmosphere",

@@ -64,7 +64,7 @@ fn compile(ctx: &GpuContext, output: Slot, format: Option<&str>) -> Pipelines {
     use Slot::{Read, Texture, Uniform, Write};
     let device = ctx.device();
     let pass = Pass::new(
-        device,
+        ctx,
         "elek3d render",
         elek3d_render_source(format),
         &[
@@ -124,7 +124,7 @@ impl GpuElek3dRenderer {
                 buffer: compile(ctx, Slot::Write, None),
                 rgba32: OnceLock::new(),
                 rgba16: OnceLock::new(),
-                unused_params: init(device, "unused", &[0; 16], wgpu::BufferUsages::UNIFORM),
+                unused_params: init(device, "unused", &[0; 16], crate::passes::UNIFORM_USAGE),
                 no_shadow_lengths: texture.create_view(&Default::default()),
                 no_planet: crate::planet::NoPlanet::new(device),
                 max_band_bytes: None,
@@ -428,7 +428,7 @@ impl GpuElek3dRenderer {
                     device,
                     label,
                     bytemuck::cast_slice(words),
-                    wgpu::BufferUsages::UNIFORM,
+                    crate::passes::UNIFORM_USAGE,
                 )
             };
             let light_uniform = uniform("lights", &light_words(sky, lights, inputs.background));

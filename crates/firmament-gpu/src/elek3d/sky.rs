@@ -155,7 +155,7 @@ impl GpuElek3d {
                     device,
                     label,
                     bytemuck::cast_slice(words),
-                    wgpu::BufferUsages::UNIFORM,
+                    crate::passes::UNIFORM_USAGE,
                 )
             };
             let tables = GpuElek3dTables {
@@ -174,7 +174,7 @@ impl GpuElek3d {
                     device,
                     "view constants",
                     bytemuck::cast_slice(&constants),
-                    wgpu::BufferUsages::UNIFORM,
+                    crate::passes::UNIFORM_USAGE,
                 ),
                 slice: storage(device, "camera slice (3D)", slice_bytes(&config, g)),
                 params,

@@ -117,7 +117,7 @@ impl HillairePrecomputer {
         let d = ctx.device();
         let precomputer = scoped(ctx, "shader compilation (Hillaire 2020)", || {
             let multiple_scattering = Pass::new(
-                d,
+                ctx,
                 "hillaire2020 multiple scattering",
                 hillaire2020_pass_source(hillaire2020_passes::MULTIPLE_SCATTERING),
                 &[
@@ -132,7 +132,7 @@ impl HillairePrecomputer {
                 ],
             );
             let irradiance = Pass::new(
-                d,
+                ctx,
                 "hillaire2020 irradiance",
                 hillaire2020_pass_source(hillaire2020_passes::IRRADIANCE),
                 &[
@@ -170,7 +170,7 @@ impl HillairePrecomputer {
             "shader compilation (Hillaire 2020 transmittance)",
             || {
                 Ok(Arc::new(Pass::new(
-                    ctx.device(),
+                    ctx,
                     "hillaire2020 transmittance",
                     hillaire2020_transmittance_source(segments),
                     &[(7, Slot::Write)],
@@ -284,7 +284,7 @@ impl HillairePrecomputer {
         let hillaire = config::pack(model, config);
         let device = ctx.device();
         scoped(ctx, "preparing the Hillaire 2020 tables", || {
-            let uniform = wgpu::BufferUsages::UNIFORM;
+            let uniform = crate::passes::UNIFORM_USAGE;
             let read_only = wgpu::BufferUsages::STORAGE;
             let tables = GpuHillaireTables {
                 atmosphere: init(

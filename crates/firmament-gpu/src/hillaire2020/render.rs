@@ -61,7 +61,7 @@ fn compile(ctx: &GpuContext, output: Slot, format: Option<&str>) -> Pipelines {
     use Slot::{Read, Texture, Uniform, Write};
     let device = ctx.device();
     let pass = Pass::new(
-        device,
+        ctx,
         "hillaire2020 render",
         hillaire2020_render_source(format),
         &[
@@ -461,7 +461,7 @@ impl GpuHillaireRenderer {
                     device,
                     label,
                     bytemuck::cast_slice(words),
-                    wgpu::BufferUsages::UNIFORM,
+                    crate::passes::UNIFORM_USAGE,
                 )
             };
             let light_uniform = uniform("lights", &light_words(sky, lights, inputs.background));

@@ -99,7 +99,7 @@ impl GpuHillaire {
                 device,
                 "view constants",
                 bytemuck::cast_slice(&constants),
-                wgpu::BufferUsages::UNIFORM,
+                crate::passes::UNIFORM_USAGE,
             ),
             sky_view: storage(device, "sky-view tables", sky_view_bytes(config, groups(n))),
             tables,

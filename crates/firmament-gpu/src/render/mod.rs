@@ -160,7 +160,7 @@ fn compile(ctx: &GpuContext, output: Slot, format: Option<&str>) -> Pipelines {
     use Slot::{Read, Texture, Uniform, Write};
     let device = ctx.device();
     let pass = Pass::new(
-        device,
+        ctx,
         "render",
         render_source(format),
         &[
@@ -225,7 +225,7 @@ impl GpuRenderer {
                 buffer: compile(ctx, Slot::Write, None),
                 rgba32: OnceLock::new(),
                 rgba16: OnceLock::new(),
-                unused_params: init(device, "unused", &[0; 16], wgpu::BufferUsages::UNIFORM),
+                unused_params: init(device, "unused", &[0; 16], crate::passes::UNIFORM_USAGE),
                 no_shadow_lengths: texture.create_view(&Default::default()),
                 no_terrain: init(device, "no terrain", &[0; 16], wgpu::BufferUsages::STORAGE),
                 no_clouds: init(device, "no clouds", &[0; 16], wgpu::BufferUsages::STORAGE),
@@ -529,7 +529,7 @@ impl GpuRenderer {
                     device,
                     label,
                     bytemuck::cast_slice(words),
-                    wgpu::BufferUsages::UNIFORM,
+                    crate::passes::UNIFORM_USAGE,
                 )
             };
             let light_uniform = uniform("lights", &light_words(sky, lights, inputs.background));
