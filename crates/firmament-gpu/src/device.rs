@@ -364,13 +364,14 @@ pub fn test_context() -> Option<GpuContext> {
 /// Why a child process that drew on the test adapter died of that driver's known heap
 /// corruption, or None for any other outcome (success, or a failure of firmament's own),
 /// for test harnesses that run such a process again. Mesa 22.3's lavapipe (Debian 12's,
-/// LLVM 15) corrupts the process's heap in some runs (27 % of 30 `render --backend gpu`
-/// runs of a small cumulus scene, 2026-12-06): its queue thread jumps to a wild address,
-/// glibc aborts on a corrupted free list, or the corruption surfaces as a panic inside a
-/// dependency (naga's compaction indexing with a wild handle, gpu-allocator, bit-vec):
-/// a signal, or a panic whose location is in a crate of the registry (firmament's own
-/// failures are errors with exit code 1, never such panics). The runs that finish give
-/// identical frames.
+/// LLVM 15) corrupts the process's heap when it builds compute pipelines that read uniform
+/// buffers ([`GpuContext::uniforms_as_storage`], which avoids that since 2026-12-06: 0 of
+/// 25 runs of a small cumulus scene died, against 8 of 25 with uniform buffers); the
+/// harnesses keep running such a process again for whatever else the driver does. The
+/// corruption shows as a signal (its queue thread jumping to a wild address, glibc aborting
+/// on a corrupted free list) or as a panic inside a dependency (naga's compaction indexing
+/// with a wild handle, gpu-allocator, bit-vec): a panic located in a crate of the registry
+/// (firmament's own failures are errors with exit code 1, or panics in its own files).
 pub fn driver_crash(status: &std::process::ExitStatus, output: &str) -> Option<&'static str> {
     if status.success() {
         return None;

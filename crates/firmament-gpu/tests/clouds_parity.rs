@@ -101,13 +101,12 @@ fn clouds_match_the_cpu_child() {
     check("cumulus from above (octaves)", layer, 5000.0, -30.0, 30.0);
 }
 
-/// Runs `clouds_match_the_cpu_child` in a child process. Mesa's lavapipe (22.3, LLVM 15)
-/// corrupts its heap in many runs of the cloud shader: glibc aborts ("corrupted size vs.
-/// prev_size"), a SIGSEGV in its queue thread, or the corruption surfaces as a panic inside
-/// a dependency (gpu-allocator freeing a buffer with an index of 171798691872, CI run of
-/// 2026-12-06); no `unsafe` in firmament, and the results of the runs that finish are
-/// identical. So a child killed by a signal, or one that panicked anywhere but in this
-/// file, is run again, up to six times; a failed comparison (a panic here) fails at once.
+/// Runs `clouds_match_the_cpu_child` in a child process, again (up to six times) while it
+/// dies of the test driver's heap corruption ([`firmament_gpu::driver_crash`]): before the
+/// passes read their uniforms as storage on software adapters (f41b720), Mesa 22.3's
+/// lavapipe killed many runs of the cloud shader (glibc aborts, a SIGSEGV in its queue
+/// thread, a panic inside gpu-allocator in a CI run of 2026-12-06); the runs that finished
+/// gave identical results. A failed comparison (a panic in this file) fails at once.
 #[test]
 fn clouds_match_the_cpu() {
     let exe = std::env::current_exe().expect("the test binary");
@@ -128,18 +127,15 @@ fn clouds_match_the_cpu() {
         );
         print!("{out}");
         eprint!("{err}");
-        match o.status.code() {
-            Some(0) => return,
-            Some(code) if err.contains(file!()) || out.contains(file!()) => {
-                panic!("the CPU–GPU cloud comparison failed (exit code {code})")
-            }
-            Some(code) => eprintln!(
-                "attempt {attempt}: the child failed outside this test's checks (exit code {code}): lavapipe's heap corruption, running it again"
-            ),
-            None => eprintln!(
-                "attempt {attempt}: the child was killed by a signal ({}): lavapipe's crash, running it again",
+        if o.status.success() {
+            return;
+        }
+        match firmament_gpu::driver_crash(&o.status, &format!("{out}{err}")) {
+            Some(why) => eprintln!(
+                "attempt {attempt}: the child {why} ({}): lavapipe's heap corruption, running it again",
                 o.status
             ),
+            None => panic!("the CPU–GPU cloud comparison failed ({})", o.status),
         }
     }
     panic!("the child test crashed six times");
