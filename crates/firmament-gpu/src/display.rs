@@ -18,6 +18,7 @@ use firmament::render::Frame;
 use wgpu::util::DeviceExt;
 
 use crate::device::{read_back, scoped, staging_buffer};
+use crate::passes::uniform_source;
 use crate::render::frame_from_pixels;
 use crate::{GpuContext, GpuError};
 
@@ -65,12 +66,16 @@ pub struct Display {
     state: wgpu::Buffer,
 }
 
-fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+fn uniform_entry(
+    ctx: &GpuContext,
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
         ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
+            ty: crate::passes::uniform_binding(ctx),
             has_dynamic_offset: false,
             min_binding_size: None,
         },
@@ -120,7 +125,7 @@ impl Display {
             let exposure_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("exposure"),
                 source: wgpu::ShaderSource::Wgsl(
-                    include_str!("../shaders/display/exposure.wgsl").into(),
+                    uniform_source(ctx, include_str!("../shaders/display/exposure.wgsl")).into(),
                 ),
             });
             let compute = wgpu::ShaderStages::COMPUTE;
@@ -129,7 +134,7 @@ impl Display {
                     label: Some("exposure"),
                     entries: &[
                         hdr_entry(compute),
-                        uniform_entry(1, compute),
+                        uniform_entry(ctx, 1, compute),
                         storage_entry(2, compute, false),
                     ],
                 });
@@ -154,7 +159,7 @@ impl Display {
                     label: Some("display"),
                     entries: &[
                         hdr_entry(fragment),
-                        uniform_entry(1, fragment),
+                        uniform_entry(ctx, 1, fragment),
                         storage_entry(2, fragment, true),
                     ],
                 });
@@ -167,7 +172,7 @@ impl Display {
             let present_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("display"),
                 source: wgpu::ShaderSource::Wgsl(
-                    include_str!("../shaders/display/tonemap.wgsl").into(),
+                    uniform_source(ctx, include_str!("../shaders/display/tonemap.wgsl")).into(),
                 ),
             });
             let state = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -262,7 +267,7 @@ impl Display {
         let exposure_params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("exposure parameters"),
             contents: bytemuck::cast_slice(&exposure_words),
-            usage: wgpu::BufferUsages::UNIFORM,
+            usage: crate::passes::UNIFORM_USAGE,
         });
         let exposure_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("exposure"),
@@ -308,7 +313,7 @@ impl Display {
         let display_params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("display parameters"),
             contents: bytemuck::cast_slice(&display_words),
-            usage: wgpu::BufferUsages::UNIFORM,
+            usage: crate::passes::UNIFORM_USAGE,
         });
         let display_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("display"),

@@ -29,6 +29,25 @@ pub enum Slot {
 pub const UNIFORM_USAGE: wgpu::BufferUsages =
     wgpu::BufferUsages::UNIFORM.union(wgpu::BufferUsages::STORAGE);
 
+/// `source` with its uniform blocks declared as `ctx` reads them (read-only storage where
+/// [`GpuContext::uniforms_as_storage`]; WGSL lays both out alike).
+pub fn uniform_source(ctx: &GpuContext, source: &str) -> String {
+    if ctx.uniforms_as_storage() {
+        source.replace("var<uniform>", "var<storage, read>")
+    } else {
+        source.to_string()
+    }
+}
+
+/// The buffer binding type of a uniform block on `ctx`.
+pub fn uniform_binding(ctx: &GpuContext) -> wgpu::BufferBindingType {
+    if ctx.uniforms_as_storage() {
+        wgpu::BufferBindingType::Storage { read_only: true }
+    } else {
+        wgpu::BufferBindingType::Uniform
+    }
+}
+
 /// Binding slots every pass has.
 const COMMON: [(u32, Slot); 3] = [(0, Slot::Uniform), (1, Slot::Uniform), (2, Slot::Read)];
 
@@ -48,12 +67,7 @@ impl Pass {
     /// asks for that ([`GpuContext::uniforms_as_storage`]; WGSL lays both out alike).
     pub fn new(ctx: &GpuContext, name: &'static str, code: String, slots: &[(u32, Slot)]) -> Pass {
         let device = ctx.device();
-        let as_storage = ctx.uniforms_as_storage();
-        let code = if as_storage {
-            code.replace("var<uniform>", "var<storage, read>")
-        } else {
-            code
-        };
+        let code = uniform_source(ctx, &code);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(name),
             source: wgpu::ShaderSource::Wgsl(code.into()),
@@ -65,13 +79,8 @@ impl Pass {
                 binding,
                 visibility: wgpu::ShaderStages::COMPUTE,
                 ty: match slot {
-                    Slot::Uniform if as_storage => wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
                     Slot::Uniform => wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
+                        ty: uniform_binding(ctx),
                         has_dynamic_offset: false,
                         min_binding_size: None,
                     },

@@ -30,7 +30,11 @@ impl PointSplats {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("stars"),
                 source: wgpu::ShaderSource::Wgsl(
-                    include_str!("../../shaders/render/stars.wgsl").into(),
+                    crate::passes::uniform_source(
+                        ctx,
+                        include_str!("../../shaders/render/stars.wgsl"),
+                    )
+                    .into(),
                 ),
             });
             let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
@@ -48,7 +52,7 @@ impl PointSplats {
                 entries: &[
                     entry(0, wgpu::BufferBindingType::Storage { read_only: false }),
                     entry(1, wgpu::BufferBindingType::Storage { read_only: true }),
-                    entry(2, wgpu::BufferBindingType::Uniform),
+                    entry(2, crate::passes::uniform_binding(ctx)),
                 ],
             });
             let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -67,7 +71,7 @@ impl PointSplats {
             let params = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("stars params"),
                 size: 16,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                usage: crate::passes::UNIFORM_USAGE.union(wgpu::BufferUsages::COPY_DST),
                 mapped_at_creation: false,
             });
             Ok(PointSplats {
