@@ -411,8 +411,14 @@ mod tests {
         assert_eq!(driver_crash(&ok, naga), None);
         assert_eq!(driver_crash(&exit_1, "error: `--width` must be ≥ 1"), None);
         assert_eq!(driver_crash(&exit_101, ours), None);
-        assert_eq!(driver_crash(&exit_101, naga), Some("panicked in a dependency"));
-        assert_eq!(driver_crash(&sigabrt, "corrupted double-linked list"), Some("was killed by a signal"));
+        assert_eq!(
+            driver_crash(&exit_101, naga),
+            Some("panicked in a dependency")
+        );
+        assert_eq!(
+            driver_crash(&sigabrt, "corrupted double-linked list"),
+            Some("was killed by a signal")
+        );
     }
 
     #[test]
