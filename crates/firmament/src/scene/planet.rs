@@ -389,10 +389,11 @@ pub fn colour_basis(nm: f64) -> [f64; 3] {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn earth() -> PlanetSurface {
+    /// The procedural Earth the tests use (seed 3, 71 % sea, RGB, the glint on).
+    pub(crate) fn earth() -> PlanetSurface {
         let map = SurfaceMap::Procedural {
             seed: 3,
             ocean_fraction: 0.71,

@@ -121,22 +121,8 @@ fn read(path: &Path, w: usize, h: usize) -> Option<Vec<[f32; 4]>> {
 mod tests {
     use super::*;
     use crate::math::lattice::sphere_directions;
+    use crate::scene::planet::tests::earth;
     use crate::scene::planet::BASIS;
-
-    fn earth() -> PlanetSurface {
-        let map = SurfaceMap::Procedural {
-            seed: 3,
-            ocean_fraction: 0.71,
-        };
-        PlanetSurface::new(
-            6_360_000.0,
-            map,
-            0.0,
-            0.0,
-            &[680.0, 550.0, 440.0],
-            Some(7.0),
-        )
-    }
 
     /// The GPU's surface map: the procedural Earth's weights baked at the default texture
     /// size and interpolated bilinearly between texel centres (as render/planet.wgsl does),
