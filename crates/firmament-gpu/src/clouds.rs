@@ -109,6 +109,14 @@ impl GpuClouds {
         }
         let planet = sky.radii.bottom;
         for (i, m) in media.iter().enumerate() {
+            if m.layer.planetary.is_some() {
+                return Err(invalid(
+                    &format!("clouds[{i}].weather_wrap"),
+                    "planet".into(),
+                    "tile on the GPU (the planet's weather is marched on the CPU: --backend cpu)"
+                        .into(),
+                ));
+            }
             if (m.layer.planet_radius_m - planet).abs() > 1.0 {
                 return Err(invalid(
                     &format!("clouds[{i}]"),

@@ -50,7 +50,7 @@ fn check(
     let sky = earth_rgb();
     let radius = sky.model.bottom_radius_m;
     let (noise, _) = CloudNoise::new([32, 16], None).unwrap();
-    let media = cloud_media(std::slice::from_ref(&layer), radius, &noise).unwrap();
+    let media = cloud_media(std::slice::from_ref(&layer), radius, (0.0, 0.0), &noise).unwrap();
     let camera = camera(Projection::Perspective, altitude_m, 30.0, pitch_deg, 70.0);
     let settings = RenderSettings {
         camera: &camera,

@@ -147,7 +147,8 @@ fn main() -> firmament::Result<()> {
     println!("| case | view | class | n | median \\|e\\| | p95 \\|e\\| | bias | ref. noise |");
     println!("|---|---|---|---|---|---|---|---|");
     for (name, layer, views, sun_zenith) in &cases {
-        let media: Vec<CloudMedium> = cloud_media(std::slice::from_ref(layer), radius, &noise)?;
+        let media: Vec<CloudMedium> =
+            cloud_media(std::slice::from_ref(layer), radius, (0.0, 0.0), &noise)?;
         let sun = sun_direction(*sun_zenith, 180.0);
         let mut scene = Scene::clear_sky(&sky, sun, false);
         scene.volumes.push(Box::new(&media[0]));

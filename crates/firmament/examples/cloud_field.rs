@@ -30,7 +30,7 @@ fn main() -> firmament::Result<()> {
     };
     let cache = std::env::temp_dir().join("firmament-noise");
     let (noise, _) = CloudNoise::new([BASE_SHAPE_SIZE, EROSION_SIZE], Some(&cache))?;
-    let media = cloud_media(&[config], radius, &noise)?;
+    let media = cloud_media(&[config], radius, (0.0, 0.0), &noise)?;
     let medium = &media[0];
     let n = 400;
     let top = radius + medium.layer.params.top_m + 10.0;

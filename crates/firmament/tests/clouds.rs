@@ -35,7 +35,7 @@ fn slab(sigma: f64, albedo: f64) -> CloudLayerConfig {
 }
 
 fn media(config: CloudLayerConfig) -> Vec<CloudMedium> {
-    cloud_media(&[config], sky().model.bottom_radius_m, &noise()).unwrap()
+    cloud_media(&[config], sky().model.bottom_radius_m, (0.0, 0.0), &noise()).unwrap()
 }
 
 #[test]
@@ -218,6 +218,9 @@ fn bad_cloud_settings_are_refused_with_the_field_named() {
         ("[[clouds]]\nkind = \"cumulus\"\nphase_forward_g = 1.0", "clouds[0].phase_forward_g"),
         ("[[clouds]]\nkind = \"cumulus\"\noctaves = 0\nmultiple_scattering = \"octaves\"", "clouds[0].octaves"),
         ("[[clouds]]\nkind = \"cumulus\"\nweather = \"no-such-weather.png\"", "clouds[0].weather"),
+        ("[[clouds]]\nkind = \"cumulus\"\nweather_wrap = \"planet\"\nweather = \"no-such-map.png\"", "clouds[0].weather"),
+        ("[[clouds]]\nkind = \"uniform\"\nweather_wrap = \"planet\"", "clouds[0].weather_wrap"),
+        ("[[clouds]]\nkind = \"cumulus\"\nweather_wrap = \"globe\"", "globe"),
         ("[[clouds]]\nkind = \"cumulus\"\n[[clouds]]\nkind = \"cumulus\"\nbottom_m = 2000\ntop_m = 3000", "clouds[1].bottom_m"),
     ] {
         let err = match scene_with(clouds) {
@@ -238,6 +241,11 @@ fn bad_cloud_settings_are_refused_with_the_field_named() {
     // A good one passes.
     let scene = scene_with("[[clouds]]\nkind = \"cumulus\"\ncoverage = 0.3").unwrap();
     assert_eq!(scene.clouds.len(), 1);
+    let planet = scene_with("[[clouds]]\nkind = \"cumulus\"\nweather_wrap = \"planet\"").unwrap();
+    assert!(planet.build_clouds(6_360_000.0, None).unwrap()[0]
+        .layer
+        .planetary
+        .is_some());
 }
 
 /// The fast path (single scattering, the two-stream's diffuse light, the shadowed air)

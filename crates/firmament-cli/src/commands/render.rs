@@ -7,6 +7,7 @@ use anyhow::{Context, Result};
 use firmament::atmosphere::Model;
 use firmament::io::OutputFormat;
 use firmament::render::{self, tonemap, RenderSettings};
+use firmament::scene::clouds::ViewFootprint;
 use firmament::scene::sky_lights::{sources_of, SkySources};
 use firmament::scene::terrain::Heightfield;
 use firmament::scene::{sun_direction, Projection, SceneFile as Scene};
@@ -170,11 +171,22 @@ pub fn render_scene(
     let camera = scene.camera_over(terrain, sky.model().bottom_radius_m);
     let radius = terrain.map_or(sky.model().bottom_radius_m, |t| t.radius_m);
     let planet = scene.build_surface(radius, sky.model().wavelengths.nm())?;
-    let clouds = crate::common::scene_clouds(scene, radius, quiet)?;
+    let mut clouds = crate::common::scene_clouds(scene, radius, quiet)?;
     let settings = RenderSettings {
         camera: &camera,
         ..render_settings(scene)
     };
+    // The clouds' density is filtered over the pixels' footprint (far clouds).
+    let prepared = camera.prepare(sky.model().bottom_radius_m, settings.width, settings.height);
+    if let Some((eye, pixel_angle_rad)) = prepared.pixel_footprint() {
+        let view = ViewFootprint {
+            eye,
+            pixel_angle_rad,
+        };
+        for c in &mut clouds {
+            c.layer.set_view(view, None);
+        }
+    }
     let frame = sky
         .render(
             &settings,

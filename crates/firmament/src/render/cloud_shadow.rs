@@ -50,6 +50,8 @@ pub struct CloudShadow {
     tau: Vec<f32>,
     /// The mean transmittance e^{−τ} per block of the coarse map, row-major.
     coarse: Vec<f32>,
+    /// Whether the map's edge stands for the volumes beyond it ([`Volume::alike_everywhere`]).
+    extends: bool,
 }
 
 impl CloudShadow {
@@ -103,6 +105,7 @@ impl CloudShadow {
             planet_radius_m: planet,
             tau,
             coarse,
+            extends: scene.volumes.iter().all(|v| v.alike_everywhere()),
         })
     }
 
@@ -141,10 +144,15 @@ impl CloudShadow {
     }
 
     /// The mean transmittance towards the light of the block `x`'s ray enters (bilinear
-    /// between blocks; beyond the map, its edge), when `x` lies below the base sphere.
+    /// between blocks; beyond the map, its edge, unless the volumes differ there: None),
+    /// when `x` lies below the base sphere.
     pub fn mean_transmittance(&self, x: Vec3) -> Option<f64> {
         let (fx, fy) = self.entry_texel(x, COARSE_TEXELS)?;
         let max = (COARSE_TEXELS - 1) as f64;
+        let inside = (0.0..=max).contains(&fx) && (0.0..=max).contains(&fy);
+        if !(self.extends || inside) {
+            return None;
+        }
         let (fx, fy) = (fx.clamp(0.0, max), fy.clamp(0.0, max));
         let last = COARSE_TEXELS - 2;
         let (i, j) = ((fx as usize).min(last), (fy as usize).min(last));

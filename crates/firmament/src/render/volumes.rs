@@ -18,7 +18,8 @@
 //! clouds' ambient light, bright tops and darker bases.
 //!
 //! Steps: by optical depth (0.1 of the majorant per step, 32 to 1024 steps), or, for volumes
-//! that name a feature size (clouds), at that size growing with distance, skipping empty
+//! that name a feature size (clouds), at that size growing with distance (but crossing the
+//! thinnest shell in at least [`VERTICAL_STEPS`] steps), skipping empty
 //! stretches in leaps of six steps, and stopping once the volumes are opaque. The steps
 //! are jittered per ray (a hash of its direction).
 //!
@@ -45,6 +46,9 @@ const MAX_STEPS: usize = 1024;
 /// Adaptive steps grow with the distance t as max(feature, STEP_DISTANCE_FRACTION·t): 250 m
 /// at 50 km, a quarter of a cumulus there.
 pub const STEP_DISTANCE_FRACTION: f64 = 0.005;
+/// The fewest steps a far ray takes across the thinnest shell, however far it is (seen
+/// from orbit, a step of 0.5 % of the distance would cross a cloud layer in one).
+pub const VERTICAL_STEPS: f64 = 32.0;
 /// Steps in a volume's feature size (its finest texel): a step per texel at the closest,
 /// jittered (1.5 texels shows as grain in thin cloud).
 pub const FEATURE_STEPS: f64 = 1.0;
@@ -158,8 +162,24 @@ pub(super) fn composite(
             (b - a) / steps as f64
         }
     };
+    // The thinnest shell: far steps cross it in at least VERTICAL_STEPS.
+    let thinnest = scene
+        .volumes
+        .iter()
+        .filter_map(|v| v.radii_m())
+        .map(|[lo, hi]| hi - lo)
+        .reduce(f64::min);
     let step_at = |t: f64| match feature {
-        Some(f) => (FEATURE_STEPS * f).max(STEP_DISTANCE_FRACTION * t),
+        Some(f) => {
+            let dt = (FEATURE_STEPS * f).max(STEP_DISTANCE_FRACTION * t);
+            match thinnest {
+                Some(h) => {
+                    let mu = ray.dir.dot((ray.origin + t * ray.dir).normalize_or_zero());
+                    dt.min((h / (VERTICAL_STEPS * mu.abs().max(1e-3))).max(f))
+                }
+                None => dt,
+            }
+        }
         None => uniform_dt,
     };
     let jitter = ray_jitter(ray);

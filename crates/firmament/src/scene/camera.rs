@@ -281,6 +281,16 @@ impl PreparedCamera {
 }
 
 impl PreparedCamera {
+    /// The camera's position and the angle (rad) between the rays of two neighbouring
+    /// pixels at the image's centre: a pixel's angular width, for what is filtered over a
+    /// pixel's footprint (the clouds' density seen from far away).
+    pub fn pixel_footprint(&self) -> Option<(Vec3, f64)> {
+        let (cx, cy) = (0.5 * self.width as f64, 0.5 * self.height as f64);
+        let a = self.ray(cx, cy)?;
+        let b = self.ray(cx + 1.0, cy)?;
+        Some((a.origin, a.dir.dot(b.dir).clamp(-1.0, 1.0).acos()))
+    }
+
     /// The continuous pixel position (pixel centres at +0.5) that sees direction `dir`
     /// (unit, local frame): the inverse of [`PreparedCamera::ray`]. None outside the image.
     pub fn pixel_of(&self, dir: Vec3) -> Option<(f64, f64)> {

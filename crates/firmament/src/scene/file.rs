@@ -340,7 +340,11 @@ impl SceneFile {
         }
         let sizes = [super::clouds::BASE_SHAPE_SIZE, super::clouds::EROSION_SIZE];
         let (noise, _) = super::clouds::CloudNoise::new(sizes, cache)?;
-        super::clouds::cloud_media(&self.clouds, planet_radius_m, &noise)
+        let location = self
+            .location
+            .as_ref()
+            .map_or((0.0, 0.0), |l| (l.lat_deg, l.lon_deg));
+        super::clouds::cloud_media(&self.clouds, planet_radius_m, location, &noise)
     }
 
     /// Check every value; messages name the field.

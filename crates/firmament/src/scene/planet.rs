@@ -103,14 +103,7 @@ impl PlanetSurface {
         wavelengths_nm: &[f64],
         wind_m_s: Option<f64>,
     ) -> PlanetSurface {
-        let (phi, lambda) = (lat_deg.to_radians(), lon_deg.to_radians());
-        let up = Vec3::new(
-            phi.cos() * lambda.cos(),
-            phi.cos() * lambda.sin(),
-            phi.sin(),
-        );
-        let east = Vec3::new(-lambda.sin(), lambda.cos(), 0.0);
-        let north = up.cross(east);
+        let frame = observer_frame(lat_deg, lon_deg);
         let [ice, rock, grass, forest] = material_spectra(wavelengths_nm);
         let mut planet = PlanetSurface {
             sphere: Sphere {
@@ -120,7 +113,7 @@ impl PlanetSurface {
                 casts_shadows: false,
             },
             map,
-            frame: [east, north, up],
+            frame,
             ocean: ocean_spectrum(wavelengths_nm),
             ice,
             rock,
@@ -293,6 +286,19 @@ impl Surface for PlanetSurface {
     }
 }
 
+/// The observer's east, north and up at (`lat_deg`, `lon_deg`) in a planet-fixed frame (z to
+/// 90° N, x to 0° E): the renderer's x, y and z there.
+pub(crate) fn observer_frame(lat_deg: f64, lon_deg: f64) -> [Vec3; 3] {
+    let (phi, lambda) = (lat_deg.to_radians(), lon_deg.to_radians());
+    let up = Vec3::new(
+        phi.cos() * lambda.cos(),
+        phi.cos() * lambda.sin(),
+        phi.sin(),
+    );
+    let east = Vec3::new(-lambda.sin(), lambda.cos(), 0.0);
+    [east, up.cross(east), up]
+}
+
 /// The continents' noise at a planet-fixed unit direction: eight octaves of gradient noise
 /// (coasts down to about 30 km), the finer ones a little stronger than fBm's halving so
 /// that coasts are ragged.
@@ -309,7 +315,7 @@ fn continents(seed: u64, d: Vec3) -> f64 {
 
 /// 3D gradient noise in about [−1, 1] (Perlin 2002, "Improving noise", SIGGRAPH: quintic
 /// fade, gradients from a hash of the lattice point).
-fn noise3(seed: u64, p: Vec3) -> f64 {
+pub(crate) fn noise3(seed: u64, p: Vec3) -> f64 {
     let (xi, yi, zi) = (p.x.floor(), p.y.floor(), p.z.floor());
     let (fx, fy, fz) = (p.x - xi, p.y - yi, p.z - zi);
     let fade = |t: f64| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
@@ -351,7 +357,7 @@ pub fn fresnel(cos_i: f64, n: f64) -> f64 {
 }
 
 /// The map's colour at pixel coordinates (x, y), bilinear, wrapping in x, clamped in y.
-fn bilinear_wrap(rgb: &[[f32; 3]], w: usize, h: usize, x: f64, y: f64) -> [f64; 3] {
+pub(crate) fn bilinear_wrap(rgb: &[[f32; 3]], w: usize, h: usize, x: f64, y: f64) -> [f64; 3] {
     let y = y.clamp(0.0, (h - 1) as f64);
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = (x - x0, y - y0);

@@ -84,6 +84,13 @@ pub trait Volume: Send + Sync {
         None
     }
 
+    /// Whether the volume is alike everywhere around the planet (a tiled weather), so that
+    /// its shadow mapped around the observer stands for it beyond the map; false for a
+    /// planet's weather, whose shadow beyond the map the renderer leaves out of the air.
+    fn alike_everywhere(&self) -> bool {
+        true
+    }
+
     /// The scale (m) of the volume's smallest features: the renderer's march steps at about
     /// this length (growing with distance) instead of by optical depth; None: by optical
     /// depth.
@@ -127,6 +134,9 @@ impl<V: Volume + ?Sized> Volume for &V {
     }
     fn radii_m(&self) -> Option<[f64; 2]> {
         (**self).radii_m()
+    }
+    fn alike_everywhere(&self) -> bool {
+        (**self).alike_everywhere()
     }
     fn surely_empty(&self, point: Vec3) -> bool {
         (**self).surely_empty(point)

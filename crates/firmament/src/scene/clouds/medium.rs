@@ -4,7 +4,8 @@
 //! marcher lights it with (the progressive march towards the light of Hillaire 2016, seed
 //! "Sun shadow sampling", and the vertical depths of the ambient light).
 
-use super::layer::{CloudLayer, MultipleScattering};
+use super::config::MultipleScattering;
+use super::layer::CloudLayer;
 use super::two_stream::TwoStream;
 use crate::math::sphere::ray_sphere;
 use crate::math::Vec3;
@@ -155,6 +156,10 @@ impl Volume for CloudMedium {
 
     fn radii_m(&self) -> Option<[f64; 2]> {
         Some(self.layer.radii_m)
+    }
+
+    fn alike_everywhere(&self) -> bool {
+        self.layer.planetary.is_none()
     }
 
     /// Outside the shell, or where the weather's coverage and the type's profile leave no

@@ -6,13 +6,19 @@
 //!
 //! - [`noise`]: tileable Perlin and Worley noise; [`noise_volume`]: the two 3D textures
 //!   made from them, cached on disk.
-//! - [`weather`]: the weather map (procedural or a PNG); [`profile`]: the cloud types.
-//! - [`layer`]: a `[[clouds]]` section and the density it gives; [`medium`]: the volume.
+//! - [`weather`]: the weather map (procedural or a PNG); [`planetary`]: one over the whole
+//!   planet; [`profile`]: the cloud types.
+//! - [`lod`]: the density filtered over a pixel's footprint (clouds seen from far away).
+//! - [`config`]: a `[[clouds]]` section; [`layer`]: the density it gives; [`medium`]: the
+//!   volume.
 
+pub mod config;
 pub mod layer;
+pub mod lod;
 pub mod medium;
 pub mod noise;
 pub mod noise_volume;
+pub mod planetary;
 pub mod profile;
 pub mod two_stream;
 pub mod weather;
@@ -20,7 +26,8 @@ pub mod weather;
 use std::path::Path;
 use std::sync::Arc;
 
-pub use layer::{CloudLayer, CloudLayerConfig, MultipleScattering};
+pub use config::{CloudLayerConfig, LayerParams, MultipleScattering, WeatherWrap};
+pub use layer::{CloudLayer, ViewFootprint};
 pub use medium::CloudMedium;
 pub use noise_volume::{NoiseKind, NoiseVolume};
 pub use profile::CloudKind;
@@ -57,11 +64,13 @@ impl CloudNoise {
     }
 }
 
-/// The volumes of the layers `configs` over a planet of `planet_radius_m` (errors name
-/// `clouds[i]`). Layers may not overlap: each point has one phase function.
+/// The volumes of the layers `configs` over a planet of `planet_radius_m`, the observer at
+/// (`lat_deg`, `lon_deg`) of a planetary weather map (errors name `clouds[i]`). Layers may
+/// not overlap: each point has one phase function.
 pub fn cloud_media(
     configs: &[CloudLayerConfig],
     planet_radius_m: f64,
+    location: (f64, f64),
     noise: &CloudNoise,
 ) -> Result<Vec<CloudMedium>> {
     validate_layers(configs)?;
@@ -73,6 +82,7 @@ pub fn cloud_media(
                 c,
                 planet_radius_m,
                 noise.textures.clone(),
+                location,
                 &format!("clouds[{i}]"),
             )
             .map(CloudMedium::new)
