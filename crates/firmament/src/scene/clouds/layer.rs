@@ -293,14 +293,16 @@ impl CloudLayer {
             ),
             None => return gain * self.noise_density(&local, profile, base, detail, eroded),
         };
-        let mean = || mean.effective(local.h, local.c, local.t);
+        if weight <= 0.0 {
+            return gain * self.noise_density(&local, profile, base, detail, eroded);
+        }
+        // The noise's density blended towards the mean scaled by χ (lod::MeanDensity).
+        let mean = mean.effective(local.h, local.c, local.t);
         gain * if weight >= 1.0 {
-            mean()
-        } else if weight <= 0.0 {
-            self.noise_density(&local, profile, base, detail, eroded)
+            mean
         } else {
             let noise = self.noise_density(&local, profile, base, detail, eroded);
-            noise + weight * (mean() - noise)
+            noise + weight * (mean - noise)
         }
     }
 

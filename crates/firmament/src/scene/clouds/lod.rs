@@ -125,26 +125,21 @@ impl MeanDensity {
     /// of a clumpy cloud, Cahalan et al. 1994: a homogeneous cloud of the mean optical
     /// depth reflects far too much, the reflectance being concave in τ).
     pub fn effective(&self, h: f64, c: f64, t: f64) -> f64 {
-        let axis = |v: f64, n: usize| {
-            let f = v.clamp(0.0, 1.0) * (n - 1) as f64;
-            let i = (f as usize).min(n - 2);
-            (i, f - i as f64)
-        };
+        self.sample(h, c, t) * self.chi(c, t)
+    }
+
+    /// χ(c, t), bilinear.
+    pub fn chi(&self, c: f64, t: f64) -> f64 {
         let (ic, fc) = axis(c, COVERAGES);
         let (it, ft) = axis(t, TYPES);
         let at = |t: usize, c: usize| self.chi[t * COVERAGES + c] as f64;
         let lo = at(it, ic) + (at(it, ic + 1) - at(it, ic)) * fc;
         let hi = at(it + 1, ic) + (at(it + 1, ic + 1) - at(it + 1, ic)) * fc;
-        self.sample(h, c, t) * (lo + (hi - lo) * ft)
+        lo + (hi - lo) * ft
     }
 
     /// The mean density at (h, c, t), trilinear.
     pub fn sample(&self, h: f64, c: f64, t: f64) -> f64 {
-        let axis = |v: f64, n: usize| {
-            let f = v.clamp(0.0, 1.0) * (n - 1) as f64;
-            let i = (f as usize).min(n - 2);
-            (i, f - i as f64)
-        };
         let (ih, fh) = axis(h, HEIGHTS);
         let (ic, fc) = axis(c, COVERAGES);
         let (it, ft) = axis(t, TYPES);
@@ -160,6 +155,14 @@ impl MeanDensity {
         }
         sum
     }
+}
+
+/// The cell below `v` ∈ [0, 1] on an axis of `n` nodes and the fraction past it.
+#[inline]
+fn axis(v: f64, n: usize) -> (usize, f64) {
+    let f = v.clamp(0.0, 1.0) * (n - 1) as f64;
+    let i = (f as usize).min(n - 2);
+    (i, f - i as f64)
 }
 
 /// The mean over the quantiles of the base `b` and the erosion `d` of the layer's density
