@@ -119,12 +119,15 @@ pub const RENDER: [Module; 8] = [
     module!("render/render.wgsl"),
 ];
 
-/// The clouds' modules (after [`RENDER`]): their types, noise, weather, layers, two-stream
-/// tables and medium, the shadow map, the march and the frame under them.
-pub const CLOUDS: [Module; 10] = [
+/// The clouds' modules (after [`RENDER`]): their types, noise, weather (tiled and the
+/// planet's), the filtered density, layers, two-stream tables and medium, the shadow map, the
+/// march and the frame under them.
+pub const CLOUDS: [Module; 12] = [
     module!("clouds/profile.wgsl"),
     module!("clouds/noise_volume.wgsl"),
     module!("clouds/weather.wgsl"),
+    module!("clouds/planetary.wgsl"),
+    module!("clouds/lod.wgsl"),
     module!("clouds/layer.wgsl"),
     module!("clouds/two_stream.wgsl"),
     module!("clouds/medium.wgsl"),

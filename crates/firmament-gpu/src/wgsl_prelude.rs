@@ -117,7 +117,7 @@ pub fn prelude() -> String {
 fn clouds_prelude() -> String {
     use crate::clouds as gc;
     use firmament::render::{cloud_shadow as cs, shadowed_air as sa, volumes as rv};
-    use firmament::scene::clouds::{layer, medium, two_stream as ts};
+    use firmament::scene::clouds::{layer, lod, medium, two_stream as ts};
     let mut s = String::from("// Clouds (firmament_gpu::clouds).\n");
     for (name, v) in [
         ("MAX_CLOUD_LAYERS", gc::MAX_CLOUD_LAYERS),
@@ -126,6 +126,10 @@ fn clouds_prelude() -> String {
         ("CLOUD_CIRRUS", gc::CLOUD_CIRRUS as usize),
         ("CLOUD_UNIFORM", gc::CLOUD_UNIFORM as usize),
         ("WEATHER_CHANNELS", gc::WEATHER_CHANNELS),
+        ("PLANET_CHANNELS", gc::PLANET_CHANNELS),
+        ("MEAN_HEIGHTS", lod::HEIGHTS),
+        ("MEAN_COVERAGES", lod::COVERAGES),
+        ("MEAN_TYPES", lod::TYPES),
         ("TS_DEPTHS", ts::DEPTHS),
         ("TS_THICKNESSES", ts::THICKNESSES),
         ("TS_COSINES", ts::COSINES),
@@ -144,6 +148,12 @@ fn clouds_prelude() -> String {
     for (name, v) in [
         ("WEATHER_CONTRAST", layer::WEATHER_CONTRAST),
         ("PRECIPITATION_GAIN", layer::PRECIPITATION_GAIN),
+        ("PLANET_CONTRAST", layer::PLANET_CONTRAST),
+        ("PLANET_DETAIL", layer::PLANET_DETAIL),
+        ("PLANET_DETAIL_GAIN", gc::PLANET_DETAIL_GAIN),
+        ("FILTER_START_CELLS", lod::FILTER_START_CELLS),
+        ("FILTER_END_CELLS", lod::FILTER_END_CELLS),
+        ("VERTICAL_STEPS", rv::VERTICAL_STEPS),
         ("TS_MAX_THICKNESS", ts::MAX_THICKNESS),
         ("LIGHT_STEP_GROWTH", medium::LIGHT_STEP_GROWTH),
         ("LIGHT_MARCH_MAX_M", medium::LIGHT_MARCH_MAX_M),

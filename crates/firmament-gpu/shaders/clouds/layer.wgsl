@@ -1,6 +1,8 @@
 // The cloud layers (firmament::scene::clouds::layer::CloudLayer): shells between two
-// altitudes following the planet, their density from the weather map's coverage and type,
-// the type's height profile and the two noise volumes (Hillaire 2016 §5.2, Schneider 2015).
+// altitudes following the planet, their density from the weather map's coverage and type
+// (or the planet's weather map's, planetary.wgsl), the type's height profile and the two
+// noise volumes (Hillaire 2016 §5.2, Schneider 2015), filtered over a pixel's footprint
+// when the layer has a view (lod.wgsl).
 // Positions are local (m): the observer's foot at the origin, x east, y north, z up, the
 // planet's centre at (0, 0, −clouds.planet_radius_m); altitudes are taken without
 // cancellation so that f32 keeps the layer's structure anywhere in view.
@@ -38,6 +40,30 @@ struct CloudLayerParams {
     octave_extinction: f32,
     octave_eccentricity: f32,
     pad0: u32,
+    // The planet's weather (weather_wrap = "planet"; planetary.wgsl): the observer's east,
+    // north and up in the planet-fixed frame, the map's offset (NONE: the tiled map's weather)
+    // and size.
+    planet_east: vec3<f32>,
+    planet_at: u32,
+    planet_north: vec3<f32>,
+    planet_width: u32,
+    planet_up: vec3<f32>,
+    planet_height: u32,
+    // The view whose pixels' footprint the density is filtered over (CloudLayer::filter):
+    // the camera (planet-centred, m) and a pixel's angle (rad).
+    eye: vec3<f32>,
+    pixel_angle_rad: f32,
+    // The planet's fine detail: two tiled maps of w alone (PlanetaryWeather::detail).
+    planet_detail_at: vec2<u32>,
+    planet_detail_width: vec2<u32>,
+    planet_detail_height: vec2<u32>,
+    planet_detail_tile_m: vec2<f32>,
+    // The filter's mean density (lod.wgsl; NONE: no filter, the noise's density everywhere)
+    // and the noise's cell (CloudLayer::cell_m).
+    mean_at: u32,
+    cell_m: f32,
+    pad2: u32,
+    pad3: u32,
 }
 
 struct Clouds {
@@ -58,6 +84,13 @@ struct Clouds {
     observer_alt_m: f32,
     pad1: u32,
     shadow_at: vec4<u32>,
+    // The thinnest layer's thickness (m): far steps cross it in at least VERTICAL_STEPS.
+    thinnest_m: f32,
+    // Whether the coarse shadow map's edge stands for the clouds beyond it (1; 0 over a
+    // planet's weather: CloudShadow's `extends`).
+    shadow_extends: u32,
+    pad4: u32,
+    pad5: u32,
     layer: array<CloudLayerParams, MAX_CLOUD_LAYERS>,
 }
 
@@ -100,44 +133,91 @@ fn remap(v: f32, lo: f32, hi: f32, new_lo: f32, new_hi: f32) -> f32 {
     return new_lo + (v - lo) / (hi - lo) * (new_hi - new_lo);
 }
 
-// The weather's local coverage c_loc = clamp(c + WEATHER_CONTRAST·(w − ½), 0, 1).
-fn local_coverage(l: CloudLayerParams, w: f32) -> f32 {
-    return clamp(l.coverage + WEATHER_CONTRAST * (w - 0.5), 0.0, 1.0);
+// The weather at a point of a layer (CloudLayer::local's Local): normalised height, local
+// coverage c_loc, type, precipitation, the planar coordinates with the wind (m) and the
+// noise's warp (tiles).
+struct CloudLocal {
+    h: f32,
+    c: f32,
+    t: f32,
+    precipitation: f32,
+    xy: vec2<f32>,
+    warp: vec2<f32>,
 }
 
-// CloudLayer::density_with (dimensionless: the extinction over extinction_per_m).
+// CloudLayer::local at `p` inside the shell of layer `l`, which has weather (not uniform):
+// c_loc = clamp(c + k·(w − ½), 0, 1) with the tiled map's w and k = WEATHER_CONTRAST, or the
+// planet's w plus PLANET_DETAIL times its fine detail and k = PLANET_CONTRAST (t and p from
+// the planet's map too; the tiled map still warps the noise).
+fn cloud_local(l: CloudLayerParams, p: CloudPoint) -> CloudLocal {
+    var out: CloudLocal;
+    out.h = (p.alt_m - l.bottom_m) / (l.top_m - l.bottom_m);
+    out.xy = cloud_planar(p.up) + vec2<f32>(l.wind_x_m, l.wind_y_m);
+    let weather = weather_sample(l, out.xy);
+    out.warp = weather.warp;
+    var w = weather.w;
+    var contrast = WEATHER_CONTRAST;
+    out.t = weather.t;
+    out.precipitation = weather.precipitation;
+    if (l.planet_at != NONE) {
+        let planet = planet_sample(l, p.up);
+        w = clamp(planet.x + PLANET_DETAIL * planet_detail(l, out.xy), 0.0, 1.0);
+        out.t = planet.y;
+        out.precipitation = planet.z;
+        contrast = PLANET_CONTRAST;
+    }
+    out.c = clamp(l.coverage + contrast * (w - 0.5), 0.0, 1.0);
+    return out;
+}
+
+// CloudLayer::noise_density: the noise's density (before precipitation's gain) at the
+// weather `local` of layer `l` with the type's `profile` there.
+fn noise_density(l: CloudLayerParams, local: CloudLocal, profile: f32, eroded: bool) -> f32 {
+    let z = local.h * (l.top_m - l.bottom_m);
+    let uv = local.xy / l.shape_tile_m + local.warp;
+    let b = noise_sample(clouds.base_at, clouds.base_size, vec3<f32>(uv, z * l.horizontal_stretch / l.shape_tile_m));
+    let shape = max(remap(b * profile, 1.0 - local.c, 1.0, 0.0, 1.0), 0.0);
+    if (shape <= 0.0 || !eroded) {
+        return shape;
+    }
+    let e = profile_erosion(l.kind, local.h);
+    let k = l.shape_tile_m / l.detail_tile_m;
+    let d = noise_sample(clouds.detail_at, clouds.detail_size, vec3<f32>(uv * k, z * l.horizontal_stretch / l.detail_tile_m));
+    return max(remap(shape, e * d, 1.0, 0.0, 1.0), 0.0);
+}
+
+// CloudLayer::density_with (dimensionless: the extinction over extinction_per_m); with a
+// view, the noise's density blended towards the mean given the weather as the pixel's
+// footprint there grows past the noise's cells (lod.wgsl).
 fn cloud_layer_density(i: u32, p: CloudPoint, eroded: bool) -> f32 {
     let l = clouds.layer[i];
     if (p.alt_m < l.bottom_m || p.alt_m > l.top_m) {
         return 0.0;
     }
-    let h = (p.alt_m - l.bottom_m) / (l.top_m - l.bottom_m);
     if (l.kind == CLOUD_UNIFORM) {
         return 1.0;
     }
-    let xy = cloud_planar(p.up) + vec2<f32>(l.wind_x_m, l.wind_y_m);
-    let weather = weather_sample(l, xy);
-    let c = local_coverage(l, weather.w);
-    let profile = profile_density(l.kind, h, weather.t);
+    let local = cloud_local(l, p);
+    let profile = profile_density(l.kind, local.h, local.t);
     // The shape is 0 unless base·profile > 1 − c, and base ≤ 1.
-    if (profile <= 1.0 - c) {
+    if (profile <= 1.0 - local.c) {
         return 0.0;
     }
-    let z = p.alt_m - l.bottom_m;
-    let uv = xy / l.shape_tile_m + weather.warp;
-    let b = noise_sample(clouds.base_at, clouds.base_size, vec3<f32>(uv, z * l.horizontal_stretch / l.shape_tile_m));
-    let shape = max(remap(b * profile, 1.0 - c, 1.0, 0.0, 1.0), 0.0);
-    if (shape <= 0.0) {
-        return 0.0;
+    let gain = 1.0 + PRECIPITATION_GAIN * local.precipitation;
+    // The pixel's footprint at the point (the point planet-centred, as the eye).
+    var weight = 0.0;
+    if (l.mean_at != NONE) {
+        let centred = p.up * (clouds.planet_radius_m + p.alt_m);
+        weight = filter_weight(length(centred - l.eye) * l.pixel_angle_rad, l.cell_m);
     }
-    let rain = 1.0 + PRECIPITATION_GAIN * weather.precipitation;
-    if (!eroded) {
-        return shape * rain;
+    var density = 0.0;
+    if (weight < 1.0) {
+        density = noise_density(l, local, profile, eroded);
     }
-    let e = profile_erosion(l.kind, h);
-    let k = l.shape_tile_m / l.detail_tile_m;
-    let d = noise_sample(clouds.detail_at, clouds.detail_size, vec3<f32>(uv * k, z * l.horizontal_stretch / l.detail_tile_m));
-    return max(remap(shape, e * d, 1.0, 0.0, 1.0), 0.0) * rain;
+    if (weight > 0.0) {
+        density += weight * (mean_effective(l.mean_at, local.h, local.c, local.t) - density);
+    }
+    return gain * density;
 }
 
 // CloudLayer::surely_empty: outside the shell, or where the profile is at most 1 − c_loc.
@@ -149,8 +229,6 @@ fn layer_surely_empty(i: u32, p: CloudPoint) -> bool {
     if (l.kind == CLOUD_UNIFORM) {
         return false;
     }
-    let xy = cloud_planar(p.up) + vec2<f32>(l.wind_x_m, l.wind_y_m);
-    let weather = weather_sample(l, xy);
-    let h = (p.alt_m - l.bottom_m) / (l.top_m - l.bottom_m);
-    return profile_density(l.kind, h, weather.t) <= 1.0 - local_coverage(l, weather.w);
+    let local = cloud_local(l, p);
+    return profile_density(l.kind, local.h, local.t) <= 1.0 - local.c;
 }

@@ -144,24 +144,28 @@ struct DiffuseLight {
     scattering_scale: f32,
 }
 
-// CloudMedium::diffuse_radiance of layer i (which has two-stream tables) at local `q`, a
-// light at cosine `mu_light` from the local vertical seen through optical depth `tau_light`.
-fn diffuse_radiance(i: u32, q: vec3<f32>, p: CloudPoint, mu_light: f32, tau_light: f32) -> DiffuseLight {
+// CloudMedium::diffuse_radiance of layer i (which has two-stream tables) above its top: the
+// light comes down unscattered.
+fn diffuse_above(i: u32) -> DiffuseLight {
+    let l = clouds.layer[i];
+    var f: DiffuseLight;
+    f.asymmetry = l.ts_asymmetry;
+    f.scattering_scale = l.ts_scattering_scale;
+    f.base_direct = 1.0;
+    return f;
+}
+
+// CloudMedium::diffuse_radiance of layer i (which has two-stream tables) at a point in or
+// under it whose vertical optical depths (above, below) in the layer are `depths` (inside:
+// vertical_optical_depths; under it: the march up its whole column and 0; the callers
+// march them, each call site of a march inlining the layer's density), a light at cosine
+// `mu_light` from the local vertical seen through optical depth `tau_light`.
+fn diffuse_radiance(i: u32, depths: vec2<f32>, mu_light: f32, tau_light: f32) -> DiffuseLight {
     let l = clouds.layer[i];
     let at = l.two_stream_at;
     var f: DiffuseLight;
     f.asymmetry = l.ts_asymmetry;
     f.scattering_scale = l.ts_scattering_scale;
-    var depths = vec2<f32>(0.0);
-    if (p.alt_m < l.bottom_m) {
-        // Under the layer: its whole column above.
-        depths = vec2<f32>(layer_light_optical_depth(i, q, p.up), 0.0);
-    } else if (p.alt_m > l.top_m) {
-        f.base_direct = 1.0;
-        return f;
-    } else {
-        depths = vertical_optical_depths(i, p);
-    }
     let above = depths.x;
     let thickness = depths.x + depths.y;
     // A cloud's sides face a low light: the equivalent slab is never lit more grazingly than

@@ -43,3 +43,21 @@ fn weather_sample(l: CloudLayerParams, xy: vec2<f32>) -> Weather {
     let d = weather_texel(l.weather_at, i1.y * size.x + i1.x);
     return weather_mix(weather_mix(a, b, t.x), weather_mix(c0, d, t.x), t.y);
 }
+
+// WeatherMap::sample's first value (w) of a map of one value per texel (width × height in
+// cloud_data from `at`, row-major from the tile's south-west corner) tiling every `tile_m`,
+// bilinear with wrap-around at (x, y) m: the planet's detail maps (planetary.wgsl).
+fn weather_value(at: u32, width: u32, height: u32, tile_m: f32, xy: vec2<f32>) -> f32 {
+    let size = vec2<u32>(width, height);
+    let uv = xy / tile_m;
+    let fxy = (uv - floor(uv)) * vec2<f32>(size) - 0.5;
+    let c = floor(fxy);
+    let t = fxy - c;
+    let i0 = vec2<u32>(select(vec2<i32>(c), vec2<i32>(size) - 1, c < vec2<f32>(0.0)));
+    let i1 = select(i0 + 1u, vec2<u32>(0u), i0 + 1u >= size);
+    let row0 = at + i0.y * size.x;
+    let row1 = at + i1.y * size.x;
+    let lo = mix(cloud_data[row0 + i0.x], cloud_data[row0 + i1.x], t.x);
+    let hi = mix(cloud_data[row1 + i0.x], cloud_data[row1 + i1.x], t.x);
+    return mix(lo, hi, t.y);
+}

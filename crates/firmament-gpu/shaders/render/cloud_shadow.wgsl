@@ -55,14 +55,20 @@ fn map_optical_depth(l: u32, x: vec3<f32>, dir: vec3<f32>) -> f32 {
 }
 
 // CloudShadow::mean_transmittance: the coarse map's mean transmittance towards light `l` of
-// the block local `x`'s ray enters (beyond the map, its edge; < 0: x lies at or above the
-// base).
+// the block local `x`'s ray enters (beyond the map, its edge, unless the clouds differ there,
+// clouds.shadow_extends = 0: the air there is lit; < 0: x lies at or above the base, or
+// beyond a map that does not extend).
 fn map_mean_transmittance(l: u32, x: vec3<f32>, dir: vec3<f32>) -> f32 {
     let e = map_entry(x, dir, COARSE_TEXELS);
     if (e.z < 0.0) {
         return -1.0;
     }
-    let f = clamp(e.xy, vec2<f32>(0.0), vec2<f32>(f32(COARSE_TEXELS - 1u)));
+    let max_f = f32(COARSE_TEXELS - 1u);
+    let inside = all(e.xy >= vec2<f32>(0.0)) && all(e.xy <= vec2<f32>(max_f));
+    if (clouds.shadow_extends == 0u && !inside) {
+        return -1.0;
+    }
+    let f = clamp(e.xy, vec2<f32>(0.0), vec2<f32>(max_f));
     let i = min(vec2<u32>(f), vec2<u32>(COARSE_TEXELS - 2u));
     let t = f - vec2<f32>(i);
     let row0 = clouds.shadow_at[l] + SHADOW_TEXELS * SHADOW_TEXELS + i.y * COARSE_TEXELS + i.x;

@@ -3,7 +3,8 @@
 // every sample lit by each light through the air (the sky method's transmittance) and the
 // layers (the march towards the light), multiple scattering by the layer's two-stream (the
 // δ-scaled diffuse light in octave slot 1) or by Wrenninge's octaves with the ambient light
-// from above and below; steps at the layers' feature size growing with distance, leaps
+// from above and below; steps at the layers' feature size growing with distance (crossing
+// the thinnest layer in at least VERTICAL_STEPS), leaps
 // where the weather leaves no room for cloud, and the composition at the transmittance-
 // weighted mean depth d̄: L = S_air(0 → d̄) + T_air(d̄)·L_vol + T_vol·(L_behind − S_air(0 → d̄)).
 // The layers are grey, so the composition holds in linear sRGB. Unlike the CPU, the air's
@@ -80,8 +81,8 @@ struct SampleLight {
 
 // The in-scattered source of octave m at a sample of layer i for channel group k
 // (volumes::light_sources), summed over the lights; octave slot 1 of a two-stream layer is
-// its diffuse light.
-fn light_sources(i: u32, sigma_t: f32, dir: vec3<f32>, p: CloudPoint, sl: ptr<function, array<SampleLight, MAX_LIGHTS>>, k: u32, src: ptr<function, array<vec4<f32>, MAX_OCTAVES>>) {
+// its diffuse light. `depths`: the sample's vertical optical depths in the layer.
+fn light_sources(i: u32, sigma_t: f32, dir: vec3<f32>, p: CloudPoint, depths: vec2<f32>, sl: ptr<function, array<SampleLight, MAX_LIGHTS>>, k: u32, src: ptr<function, array<vec4<f32>, MAX_OCTAVES>>) {
     let l = clouds.layer[i];
     for (var m = 0u; m < MAX_OCTAVES; m++) {
         (*src)[m] = vec4<f32>(0.0);
@@ -120,7 +121,6 @@ fn light_sources(i: u32, sigma_t: f32, dir: vec3<f32>, p: CloudPoint, sl: ptr<fu
             let radiance = max(i0 + f.asymmetry * i1 * towards_eye, vec4<f32>(0.0));
             (*src)[1] += ss * f.scattering_scale * radiance;
         } else {
-            let depths = vertical_optical_depths(i, p);
             let one_minus_g = 1.0 - l.mean_cosine;
             let w_sky = 1.0 / (1.0 + one_minus_g * depths.x);
             let w_ground = 1.0 / (1.0 + one_minus_g * depths.y);
@@ -170,7 +170,12 @@ fn march_clouds(q: vec3<f32>, dir: vec3<f32>, end_m: f32, l_vol: ptr<function, a
     var air_at: array<vec3<f32>, MAX_LIGHTS>;
     var air_kept = 0u;
     for (var guard = 0u; guard < MAX_MARCH_STEPS && t < b; guard++) {
-        let dt = min(max(FEATURE_STEPS * clouds.feature_m, STEP_DISTANCE_FRACTION * t), b - t);
+        // The feature's step growing with distance, but crossing the thinnest layer in at
+        // least VERTICAL_STEPS however far (volumes::composite's step_at, at t).
+        let at_t = q + t * dir;
+        let mu = dot(dir, normalize(vec3<f32>(at_t.xy, clouds.planet_radius_m + at_t.z)));
+        let vertical = max(clouds.thinnest_m / (VERTICAL_STEPS * max(abs(mu), 1e-3)), clouds.feature_m);
+        let dt = min(min(max(FEATURE_STEPS * clouds.feature_m, STEP_DISTANCE_FRACTION * t), vertical), b - t);
         let x = q + (t + jitter * dt) * dir;
         let p = cloud_point(x);
         let c = cloud_sample(p);
@@ -180,8 +185,17 @@ fn march_clouds(q: vec3<f32>, dir: vec3<f32>, end_m: f32, l_vol: ptr<function, a
                 // Leap where no layer can have cloud at either end (a bound that ignores the
                 // fine noise, so the leaps do not depend on the jitter).
                 let leap = LEAP_STEPS * dt;
+                // (Both ends through one call site: each site inlines the layers' weather.)
                 let probe = cloud_point(q + (t + leap + jitter * dt) * dir);
-                if (t + leap < b && clouds_surely_empty(p) && clouds_surely_empty(probe)) {
+                var empty = t + leap < b;
+                for (var end = 0u; end < 2u && empty; end++) {
+                    var at = p;
+                    if (end == 1u) {
+                        at = probe;
+                    }
+                    empty = clouds_surely_empty(at);
+                }
+                if (empty) {
                     t += leap;
                     continue;
                 }
@@ -192,6 +206,9 @@ fn march_clouds(q: vec3<f32>, dir: vec3<f32>, end_m: f32, l_vol: ptr<function, a
         empty_run = 0u;
         let i = c.layer;
         let alt_km = p.alt_m * 1e-3;
+        // The sample's vertical optical depths in its layer (the ambient light's and the
+        // two-stream's slab), once for every light and channel group.
+        let depths = vertical_optical_depths(i, p);
         for (var j = 0u; j < frame.lights; j++) {
             let vl = view_light(j);
             sl[j].tau = light_optical_depth(x, vl.direction);
@@ -205,7 +222,7 @@ fn march_clouds(q: vec3<f32>, dir: vec3<f32>, end_m: f32, l_vol: ptr<function, a
                 air_kept |= 1u << min(j, 31u);
             }
             if (clouds.layer[i].two_stream_at != NONE) {
-                sl[j].diffuse = diffuse_radiance(i, x, p, sl[j].mu, sl[j].tau);
+                sl[j].diffuse = diffuse_radiance(i, depths, sl[j].mu, sl[j].tau);
             }
         }
         // Each octave's step transmittance (grey).
@@ -218,7 +235,7 @@ fn march_clouds(q: vec3<f32>, dir: vec3<f32>, end_m: f32, l_vol: ptr<function, a
             gain_t *= clouds.octave_extinction;
         }
         for (var k = 0u; k < atm.groups; k++) {
-            light_sources(i, c.sigma_t, dir, p, &sl, k, &src);
+            light_sources(i, c.sigma_t, dir, p, depths, &sl, k, &src);
             for (var m = 0u; m < count; m++) {
                 (*l_vol)[k] += t_m[m] * step_integral(src[m], sigma[m], dt, step_t[m]);
             }
@@ -269,26 +286,42 @@ fn dim_surface_light(j: u32, x: vec3<f32>, up: vec3<f32>, light_dir: vec3<f32>, 
             continue;
         }
         let l = clouds.layer[i];
-        var tau_l = 0.0;
+        let two_stream = l.two_stream_at != NONE;
+        let under = p.alt_m < l.bottom_m;
+        // The layer's depth towards the light (unless the map covers the point) and up its
+        // column (for octaves; for the two-stream under the layer, up the radial vertical):
+        // both marches through one call site (each site inlines the layer's density).
+        var taus = vec2<f32>(0.0);
+        for (var s = 0u; s < 2u; s++) {
+            let needed = select(crosses && mapped < 0.0, select(over, under, two_stream), s == 1u);
+            if (needed) {
+                let vertical = select(up, p.up, two_stream);
+                taus[s] = layer_light_optical_depth(i, x, select(light_dir, vertical, s == 1u));
+            }
+        }
+        var tau_l = taus.x;
         if (mapped >= 0.0) {
             tau_l = mapped / f32(clouds.layers);
-        } else if (crosses) {
-            tau_l = layer_light_optical_depth(i, x, light_dir);
         }
         let unscattered = exp(-tau_l);
         var through: f32;
         var from_beam: f32;
-        if (l.two_stream_at != NONE) {
-            let f = diffuse_radiance(i, x, p, mu, tau_l);
+        if (two_stream) {
+            // The point's vertical depths in the layer: under it, its whole column above.
+            let above = p.alt_m > l.top_m;
+            var depths = vec2<f32>(taus.y, 0.0);
+            if (!under && !above) {
+                depths = vertical_optical_depths(i, p);
+            }
+            var f = diffuse_above(i);
+            if (!above) {
+                f = diffuse_radiance(i, depths, mu, tau_l);
+            }
             bounce /= 1.0 - albedo * f.base_reflectance;
             through = f.base_from_above;
             from_beam = f.base_from_light;
         } else {
-            var tau_up = 0.0;
-            if (over) {
-                tau_up = layer_light_optical_depth(i, x, up);
-            }
-            let total = 1.0 / (1.0 + (1.0 - l.mean_cosine) * tau_up);
+            let total = 1.0 / (1.0 + (1.0 - l.mean_cosine) * taus.y);
             through = total;
             from_beam = max(mu, 0.0) * max(total - unscattered, 0.0);
         }

@@ -7,7 +7,8 @@
 use anyhow::{Context, Result};
 use firmament::render::stars::point_splats;
 use firmament::render::{Frame, RenderSettings};
-use firmament::scene::clouds::CloudMedium;
+use firmament::scene::clouds::lod::MeanDensity;
+use firmament::scene::clouds::{CloudMedium, ViewFootprint};
 use firmament::scene::planet::PlanetSurface;
 use firmament::scene::sky_lights::SkySources;
 use firmament::scene::terrain::Heightfield;
@@ -76,8 +77,12 @@ pub struct FramePath {
     gpu_terrain: Option<(TerrainKey, GpuTerrain)>,
     /// Seconds the last terrain upload took (its CPU parts).
     pub last_terrain_s: f64,
-    /// The scene's cloud layers as media (their TOML and planet radius as the key).
+    /// The scene's cloud layers as media (their TOML and planet radius as the key), their
+    /// density unfiltered (as the reference traces it).
     clouds: Option<(String, f64, Arc<Vec<CloudMedium>>)>,
+    /// Each layer's mean density for the filter over the pixels' footprint (made with the
+    /// first upload of the layers, kept while they stay).
+    cloud_means: Vec<Option<Arc<MeanDensity>>>,
     /// Their shadow maps on the device for the current lights and observer.
     gpu_clouds: Option<(TerrainKey, GpuClouds)>,
     /// The pass adding the stars and small disks into the frame (made when first needed).
@@ -132,6 +137,7 @@ impl FramePath {
             reference: Overlay::default(),
             ref_model: None,
             clouds: None,
+            cloud_means: Vec::new(),
             gpu_clouds: None,
             points: None,
             planet: None,
@@ -158,8 +164,30 @@ impl FramePath {
         }
         let media = crate::common::scene_clouds(&state.scene, radius_m, true)?;
         self.clouds = Some((key, radius_m, Arc::new(media)));
+        self.cloud_means = Vec::new();
         self.gpu_clouds = None;
         Ok(())
+    }
+
+    /// The layers with their density filtered over the footprint of `view`'s pixels, as
+    /// `render` sets them (`CloudLayer::set_view`), for the device: copies of `media`, each
+    /// layer's mean density made once and kept in `means`.
+    fn viewed_clouds(
+        media: &[CloudMedium],
+        means: &mut Vec<Option<Arc<MeanDensity>>>,
+        view: ViewFootprint,
+    ) -> Vec<CloudMedium> {
+        means.resize(media.len(), None);
+        media
+            .iter()
+            .zip(means.iter_mut())
+            .map(|(m, mean)| {
+                let mut layer = m.layer.clone();
+                layer.set_view(view, mean.clone());
+                *mean = layer.filter.as_ref().map(|(_, a)| a.clone());
+                CloudMedium::new(layer)
+            })
+            .collect()
     }
 
     /// The scene's surface map (`[surface]`) on the device for a planet of `radius_m` (None
@@ -361,7 +389,15 @@ impl FramePath {
             _ => None,
         };
         // The clouds with the 4D tables over the planet's sphere (the GPU draws clouds over a
-        // terrain not yet).
+        // terrain not yet), their density filtered over the pixels' footprint as `render`
+        // sets it: the upload's with its shadow maps, each frame's from then on.
+        let view = camera
+            .prepare(radius, settings.width, settings.height)
+            .pixel_footprint()
+            .map(|(eye, pixel_angle_rad)| ViewFootprint {
+                eye,
+                pixel_angle_rad,
+            });
         let clouds = match (&self.clouds, state.method, &self.terrain) {
             (Some((_, _, media)), Method::Bruneton4d, None) if !media.is_empty() => {
                 if self
@@ -369,8 +405,17 @@ impl FramePath {
                     .as_ref()
                     .is_none_or(|(k, _)| *k != light_key)
                 {
-                    let uploaded = sky.gpu_clouds(media, &settings, sources, true)?;
+                    let uploaded = match view {
+                        Some(v) => {
+                            let viewed = Self::viewed_clouds(media, &mut self.cloud_means, v);
+                            sky.gpu_clouds(&viewed, &settings, sources, true)?
+                        }
+                        None => sky.gpu_clouds(media, &settings, sources, true)?,
+                    };
                     self.gpu_clouds = Some((light_key, uploaded));
+                }
+                if let (Some((_, c)), Some(v)) = (self.gpu_clouds.as_mut(), view) {
+                    c.set_view(v);
                 }
                 self.gpu_clouds.as_ref().map(|(_, c)| c)
             }
