@@ -11,16 +11,14 @@
 //! `cargo run --release -p firmament --example cloud_accuracy [SAMPLES] [slab|cumulus|all]`
 //! (default 1024 paths per wavelength, all; the tables come from the user's cache).
 
-use firmament::atmosphere::Atmosphere;
+#[path = "common/cloud_sky.rs"]
+mod cloud_sky;
+
 use firmament::math::Vec3;
 use firmament::reference::{self, ReferenceSettings};
 use firmament::render::{ShadeScratch, Shader};
-use firmament::scene::clouds::{cloud_media, CloudKind, CloudLayerConfig, CloudMedium, CloudNoise};
-use firmament::scene::clouds::{BASE_SHAPE_SIZE, EROSION_SIZE};
+use firmament::scene::clouds::{cloud_media, CloudKind, CloudLayerConfig, CloudMedium};
 use firmament::scene::{sun_direction, Ray, Scene, Volume};
-use firmament::sky::bruneton4d::cache::{Loaded, TableCache};
-use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, Tables};
-use firmament::spectrum::Wavelengths;
 
 /// A view: where from, which directions, how to class each.
 struct View {
@@ -55,23 +53,8 @@ fn main() -> firmament::Result<()> {
     let args: Vec<String> = std::env::args().collect();
     let samples: usize = args.get(1).map_or(1024, |s| s.parse().expect("samples"));
     let which = args.get(2).map_or("all", |s| s.as_str()).to_string();
-    let model = Atmosphere::earth().resolve(&Wavelengths::rgb())?;
-    let config = TableConfig::default();
-    let tables = match TableCache::from_env()? {
-        Some(cache) => match cache.load(&model, &config) {
-            Loaded::Hit { tables, .. } => *tables,
-            _ => {
-                *cache
-                    .store(&Tables::compute(&model, &config)?, &model, &config)?
-                    .tables
-            }
-        },
-        None => Tables::compute(&model, &config)?,
-    };
-    let sky = Bruneton4d::new(model.clone(), tables)?;
+    let (model, sky, noise) = cloud_sky::earth_rgb_with_noise()?;
     let radius = model.bottom_radius_m;
-    let cache = TableCache::from_env()?.map(|c| c.dir);
-    let (noise, _) = CloudNoise::new([BASE_SHAPE_SIZE, EROSION_SIZE], cache.as_deref())?;
     let colour = model.colour_matrix();
     let reference_settings = ReferenceSettings {
         samples,

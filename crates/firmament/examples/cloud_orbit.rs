@@ -18,16 +18,15 @@
 //! (default 64 paths per ray and wavelength, 8×8 rays per pixel; `slab`: a uniform slab of
 //! optical thickness 10 instead; the tables from the user's cache).
 
-use firmament::atmosphere::Atmosphere;
+#[path = "common/cloud_sky.rs"]
+mod cloud_sky;
+
 use firmament::math::Vec3;
 use firmament::reference::{self, ReferenceSettings};
 use firmament::render::{ShadeScratch, Shader};
-use firmament::scene::clouds::{cloud_media, CloudKind, CloudLayerConfig, CloudNoise};
-use firmament::scene::clouds::{ViewFootprint, WeatherWrap, BASE_SHAPE_SIZE, EROSION_SIZE};
+use firmament::scene::clouds::{cloud_media, CloudKind, CloudLayerConfig};
+use firmament::scene::clouds::{ViewFootprint, WeatherWrap};
 use firmament::scene::{sun_direction, Ray, Scene, Volume};
-use firmament::sky::bruneton4d::cache::{Loaded, TableCache};
-use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, Tables};
-use firmament::spectrum::Wavelengths;
 
 const ALTITUDE_M: f64 = 700e3;
 
@@ -73,23 +72,8 @@ fn main() -> firmament::Result<()> {
         .get(1)
         .map_or(64, |s| s.parse().expect("paths per ray"));
     let n: usize = args.get(2).map_or(8, |s| s.parse().expect("rays per side"));
-    let model = Atmosphere::earth().resolve(&Wavelengths::rgb())?;
-    let config = TableConfig::default();
-    let tables = match TableCache::from_env()? {
-        Some(cache) => match cache.load(&model, &config) {
-            Loaded::Hit { tables, .. } => *tables,
-            _ => {
-                *cache
-                    .store(&Tables::compute(&model, &config)?, &model, &config)?
-                    .tables
-            }
-        },
-        None => Tables::compute(&model, &config)?,
-    };
-    let sky = Bruneton4d::new(model.clone(), tables)?;
+    let (model, sky, noise) = cloud_sky::earth_rgb_with_noise()?;
     let radius = model.bottom_radius_m;
-    let cache = TableCache::from_env()?.map(|c| c.dir);
-    let (noise, _) = CloudNoise::new([BASE_SHAPE_SIZE, EROSION_SIZE], cache.as_deref())?;
     let colour = model.colour_matrix();
     let settings = ReferenceSettings {
         samples,
