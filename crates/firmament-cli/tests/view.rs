@@ -340,6 +340,30 @@ fn the_viewer_draws_the_clouds_as_render_does() {
 }
 
 #[test]
+fn the_viewer_draws_the_clouds_over_the_terrain_as_render_does() {
+    let Some(_gpu) = gpu() else { return };
+    let dir = tmp_subdir("view-valley-clouds");
+    let scene =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/clouds-over-the-valley.toml");
+    let out = offscreen(&dir, &scene, (64, 36), "bruneton4d");
+    succeeds(&out);
+    // Nothing of the scene is left out of the view.
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(!said.contains("over a terrain"), "{said}");
+    let text = std::fs::read_to_string(dir.join("scene.toml")).unwrap();
+    assert!(
+        text.contains("[[clouds]]") && text.contains("[terrain]"),
+        "{text}"
+    );
+    render_saved_scene(&dir);
+    let (rel, mean, _) = exr_difference(&dir.join("view.exr"), &dir.join("render.exr"));
+    eprintln!(
+        "clouds over the terrain: view vs render: mean |ΔL|/L {rel:.2e}, mean luminance {mean:+.2e}"
+    );
+    assert!(rel <= 0.01 && mean.abs() <= 0.01, "{rel} {mean}");
+}
+
+#[test]
 fn the_viewer_draws_the_moon_and_the_stars_as_render_does() {
     let Some(_gpu) = gpu() else { return };
     let dir = tmp_subdir("view-night");

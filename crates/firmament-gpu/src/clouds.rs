@@ -56,8 +56,12 @@ const LAYER_WORDS: usize = 56;
 pub(crate) const UNIFORM_WORDS: usize = HEADER_WORDS + MAX_CLOUD_LAYERS * LAYER_WORDS;
 /// Words of the `Clouds` uniform before its layers.
 const HEADER_WORDS: usize = 20;
-/// Word index of the observer's altitude in the uniform (`Clouds.observer_alt_m`).
+/// Word index of the observer's altitude in the uniform (`Clouds.observer_alt_m`), then
+/// the tables' ground above the clouds' planet (`lift_m`).
 const OBSERVER_WORD: usize = 10;
+/// The most the tables' ground may be lifted above the clouds' planet (m): a terrain's
+/// floor (the Dead Sea's shore to the Tibetan plateau's).
+const MAX_LIFT_M: f64 = 10_000.0;
 /// Word index of a layer's view (`CloudLayerParams.eye`, then `pixel_angle_rad`) in its
 /// words.
 const EYE_WORD: usize = 40;
@@ -71,6 +75,8 @@ pub struct GpuClouds {
     words: Vec<u32>,
     /// The light directions the shadow maps were computed for.
     lights: Vec<Vec3>,
+    /// The layers' planet (m from its centre).
+    planet_radius_m: f64,
 }
 
 impl std::fmt::Debug for GpuClouds {
@@ -123,19 +129,24 @@ impl GpuClouds {
                 format!("1 to {MAX_CLOUD_LAYERS} layers on the GPU"),
             ));
         }
-        let planet = sky.radii.bottom;
+        // The layers' planet: the tables' ground, or a terrain's sphere under a ground
+        // lifted to the terrain's floor (render's `terrain_and_atmosphere`).
+        let bottom = sky.radii.bottom;
+        let planet = media[0].layer.planet_radius_m;
         for (i, m) in media.iter().enumerate() {
-            if (m.layer.planet_radius_m - planet).abs() > 1.0 {
+            let r = m.layer.planet_radius_m;
+            if (r - planet).abs() > 1.0 || !(bottom - MAX_LIFT_M - 1.0..=bottom + 1.0).contains(&r)
+            {
                 return Err(invalid(
                     &format!("clouds[{i}]"),
+                    format!("a layer over a planet of radius {r} m"),
                     format!(
-                        "a layer over a planet of radius {} m",
-                        m.layer.planet_radius_m
+                        "every layer over one planet, from the tables' ground ({bottom} m) to {MAX_LIFT_M} m below it"
                     ),
-                    format!("the tables' ground, {planet} m"),
                 ));
             }
         }
+        let lift = (bottom - planet).max(0.0);
         let mut data: Vec<f32> = Vec::new();
         // The noise volumes (every layer with noise shares one pair).
         let noise = media.iter().find_map(|m| m.layer.noise.clone());
@@ -360,7 +371,7 @@ impl GpuClouds {
             bits(planet),
             bits(shadow_base_m),
             0, // the observer's altitude, per frame
-            0,
+            bits(lift),
         ];
         words.extend(shadow_at);
         words.extend([bits(thinnest), extends as u32, 0, 0]);
@@ -378,6 +389,7 @@ impl GpuClouds {
         Ok(GpuClouds {
             data,
             words,
+            planet_radius_m: planet,
             lights: lights.iter().map(|l| l.direction).collect(),
         })
     }
@@ -405,15 +417,21 @@ impl GpuClouds {
         any
     }
 
+    /// The layers' planet (m from its centre): a terrain under them must lie on it.
+    pub fn planet_radius_m(&self) -> f64 {
+        self.planet_radius_m
+    }
+
     /// The storage buffer (binding 19).
     pub(crate) fn data(&self) -> &wgpu::Buffer {
         &self.data
     }
 
-    /// The uniform (binding 20) for a frame of `settings` lit by `lights`, which must be
-    /// the lights the clouds were uploaded for.
+    /// The uniform (binding 20) for a frame of `settings` over `sky`'s tables lit by
+    /// `lights`, which must be the lights the clouds were uploaded for.
     pub(crate) fn uniform_words(
         &self,
+        sky: &GpuSky,
         lights: &[Light],
         settings: &RenderSettings,
     ) -> Result<Vec<u32>, GpuError> {
@@ -431,7 +449,10 @@ impl GpuClouds {
             .into());
         }
         let mut words = self.words.clone();
-        words[OBSERVER_WORD] = bits(settings.camera.altitude_m);
+        // The camera stands above the tables' ground, which may be lifted above the
+        // clouds' planet (a terrain's floor): its altitude above that planet.
+        words[OBSERVER_WORD] =
+            bits(sky.radii.bottom + settings.camera.altitude_m - self.planet_radius_m);
         Ok(words)
     }
 }
@@ -513,6 +534,7 @@ mod tests {
         let (size, members) = wgsl_struct("Clouds");
         assert_eq!(size as usize, 4 * UNIFORM_WORDS);
         assert_eq!(offset(&members, "observer_alt_m"), OBSERVER_WORD);
+        assert_eq!(offset(&members, "lift_m"), OBSERVER_WORD + 1);
         assert_eq!(offset(&members, "thinnest_m"), 16);
         assert_eq!(offset(&members, "layer"), HEADER_WORDS);
     }

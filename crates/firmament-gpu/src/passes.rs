@@ -138,12 +138,26 @@ impl Pass {
 
     /// Another entry point of the same source, with the same bind group layout.
     pub fn entry_point(&self, device: &wgpu::Device, entry: &str) -> wgpu::ComputePipeline {
+        self.entry_point_with(device, entry, &[])
+    }
+
+    /// Another entry point of the same source, with the same bind group layout and the
+    /// pipeline-overridable constants `constants` (WGSL `override`s) set.
+    pub fn entry_point_with(
+        &self,
+        device: &wgpu::Device,
+        entry: &str,
+        constants: &[(&str, f64)],
+    ) -> wgpu::ComputePipeline {
         device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(entry),
             layout: Some(&self.pipeline_layout),
             module: &self.module,
             entry_point: Some(entry),
-            compilation_options: wgpu::PipelineCompilationOptions::default(),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants,
+                ..Default::default()
+            },
             cache: None,
         })
     }

@@ -93,6 +93,11 @@ fn bits(x: f64) -> u32 {
 }
 
 impl GpuTerrain {
+    /// The terrain's sphere (m from the planet's centre): heights are above it.
+    pub fn radius_m(&self) -> f64 {
+        self.radius_m
+    }
+
     /// Upload `terrain` for frames prepared by `shader` (the CPU's [`Shader`] of the same
     /// scene from the frame's observer, over the tables of `sky`): its lights' shadow
     /// fields (computed here on the CPU when the terrain casts light shafts), its air volume

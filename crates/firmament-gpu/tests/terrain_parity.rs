@@ -9,33 +9,14 @@
 
 mod common;
 
-use firmament::atmosphere::Atmosphere;
 use firmament::math::Vec3;
 use firmament::render::{render, Frame, RenderSettings, Shader};
 use firmament::scene::terrain::{Heightfield, TerrainConfig};
 use firmament::scene::{sun_direction, Projection, Scene};
-use firmament::sky::bruneton4d::{Bruneton4d, TableConfig, TableSizes, Tables};
-use firmament::spectrum::Wavelengths;
+use firmament::sky::bruneton4d::Bruneton4d;
 use firmament_gpu::{GpuSky, GpuTerrain, RenderInputs};
 
 use common::*;
-
-/// The default valley at a coarser resolution, and the earth's air with its ground lifted to
-/// the valley's floor (small tables).
-fn valley(config: TerrainConfig) -> (Heightfield, Bruneton4d) {
-    let wavelengths = Wavelengths::rgb();
-    let earth = Atmosphere::earth();
-    let radius = earth.resolve(&wavelengths).unwrap().bottom_radius_m;
-    let terrain = config.build(radius, wavelengths.nm()).unwrap();
-    let lifted = earth.lifted(terrain.floor_m(), &wavelengths).unwrap();
-    let model = lifted.resolve(&wavelengths).unwrap();
-    let config = TableConfig {
-        sizes: TableSizes::small(),
-        ..TableConfig::default()
-    };
-    let tables = Tables::compute(&model, &config).unwrap();
-    (terrain, Bruneton4d::new(model, tables).unwrap())
-}
 
 struct Shot {
     altitude_m: f64,

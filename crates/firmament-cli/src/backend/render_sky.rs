@@ -216,11 +216,6 @@ impl<'a> RenderSky<'a> {
                 "clouds ([[clouds]]) render on the CPU or with `--method bruneton4d` on the GPU so far: use `--backend cpu` (or `auto`)"
             );
         }
-        if !clouds.is_empty() && terrain.is_some() && matches!(self, RenderSky::Gpu { .. }) {
-            anyhow::bail!(
-                "clouds ([[clouds]]) over a terrain render on the CPU only so far: use `--backend cpu` (or `auto`)"
-            );
-        }
         if terrain.is_some() && matches!(self, RenderSky::GpuHillaire { .. }) {
             anyhow::bail!(
                 "`--method hillaire2020` draws terrain on the CPU only so far: use `--backend cpu` (or `auto`)"
@@ -314,8 +309,9 @@ impl<'a> RenderSky<'a> {
 
     /// Record a frame lit by `sources` into `target` on the GPU (nothing submitted), over
     /// `terrain` when given (uploaded by [`RenderSky::gpu_terrain`] for these lights and
-    /// this camera; the 4D tables only), or under `clouds` (uploaded by
-    /// [`RenderSky::gpu_clouds`]; the 4D tables without a terrain only); no stars (those
+    /// this camera; the 4D tables only), under `clouds` (uploaded by
+    /// [`RenderSky::gpu_clouds`] on the terrain's sphere when there is one; the 4D tables
+    /// only); no stars (those
     /// need the CPU's parts of [`RenderSky::render`]); `timestamps` as
     /// `RenderInputs::timestamps`, over the planet's map `planet` ([`RenderSky::gpu_planet`];
     /// every method). The viewer's frame path.

@@ -288,10 +288,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             anyhow::bail!("`--tables` holds 4D tables: `--method hillaire2020` builds its own (in milliseconds)");
         }
     }
-    // The GPU marches clouds through the 4D tables' sky, without a terrain (render::volumes'
-    // twin in firmament-gpu's shaders/render/volumes.wgsl).
-    let clouds_cpu_only = !scene.clouds.is_empty()
-        && (args.method != Method::Bruneton4d || terrain_wanted || args.aerial_volume);
+    // The GPU marches clouds through the 4D tables' sky, over the planet's sphere or a
+    // terrain (render::volumes' twin in firmament-gpu's shaders/render/volumes.wgsl).
+    let clouds_cpu_only =
+        !scene.clouds.is_empty() && (args.method != Method::Bruneton4d || args.aerial_volume);
     let backend = match Backend::open(args.backend, args.quiet)? {
         Backend::Gpu(_)
             if args.backend == BackendChoice::Auto
@@ -306,12 +306,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
         Backend::Gpu(_) if clouds_cpu_only && args.backend == BackendChoice::Gpu => {
             anyhow::bail!(
-                "clouds ([[clouds]]) render on the GPU with `--method bruneton4d` and no terrain so far: `--backend cpu` or `auto` render them here (or `--no-terrain`)"
+                "clouds ([[clouds]]) render on the GPU with `--method bruneton4d` and without `--aerial-volume` so far: `--backend cpu` or `auto` render them here"
             )
         }
         Backend::Gpu(_) if clouds_cpu_only => {
             if !args.quiet {
-                eprintln!("note: clouds with hillaire2020, elek3d or a terrain render on the CPU only so far: using the CPU");
+                eprintln!("note: clouds with hillaire2020, elek3d or `--aerial-volume` render on the CPU only so far: using the CPU");
             }
             Backend::Cpu
         }

@@ -82,7 +82,9 @@ struct Clouds {
     shadow_base_m: f32,
     // The observer's altitude above the clouds' planet (m).
     observer_alt_m: f32,
-    pad1: u32,
+    // The tables' ground above the clouds' planet (m: the ground lifted to a terrain's
+    // floor; 0 without a terrain).
+    lift_m: f32,
     shadow_at: vec4<u32>,
     // The thinnest layer's thickness (m): far steps cross it in at least VERTICAL_STEPS.
     thinnest_m: f32,

@@ -205,7 +205,8 @@ fn march_clouds(q: vec3<f32>, dir: vec3<f32>, end_m: f32, l_vol: ptr<function, a
         }
         empty_run = 0u;
         let i = c.layer;
-        let alt_km = p.alt_m * 1e-3;
+        // The sample's altitude above the tables' ground.
+        let alt_km = (p.alt_m - clouds.lift_m) * 1e-3;
         // The sample's vertical optical depths in its layer (the ambient light's and the
         // two-stream's slab), once for every light and channel group.
         let depths = vertical_optical_depths(i, p);
@@ -260,17 +261,18 @@ fn march_clouds(q: vec3<f32>, dir: vec3<f32>, end_m: f32, l_vol: ptr<function, a
     return out;
 }
 
-// volumes::dim_surface_light for a ground point at local `x` with vertical `up` (the
-// normal) under light j: the direct beam dimmed by the layers' transmittance towards the
+// volumes::dim_surface_light for a ground point at local `x` with vertical `up` and unit
+// `normal` under light j: the direct beam dimmed by the layers' transmittance towards the
 // light (from the shadow map where it covers the point, else the march), the beam they
-// scatter forward added to the sky's light as diffuse, the sky's light dimmed by them, and
-// the ground–cloud interreflection. `t_air` is the air's transmittance to the light.
+// scatter forward added to the sky's light as diffuse (on a tilted surface by
+// (1 + n·up)/2, like the sky's), the sky's light dimmed by them, and the ground–cloud
+// interreflection. `t_air` is the air's transmittance to the light.
 struct SurfaceLight {
     direct: vec4<f32>,
     sky: vec4<f32>,
 }
 
-fn dim_surface_light(j: u32, x: vec3<f32>, up: vec3<f32>, light_dir: vec3<f32>, k: u32, t_air: vec4<f32>, e_in: SurfaceLight) -> SurfaceLight {
+fn dim_surface_light(j: u32, x: vec3<f32>, up: vec3<f32>, normal: vec3<f32>, light_dir: vec3<f32>, k: u32, t_air: vec4<f32>, e_in: SurfaceLight) -> SurfaceLight {
     let mu = dot(light_dir, up);
     let mapped = map_optical_depth(j, x, light_dir);
     let p = cloud_point(x);
@@ -331,7 +333,8 @@ fn dim_surface_light(j: u32, x: vec3<f32>, up: vec3<f32>, light_dir: vec3<f32>, 
     }
     var out: SurfaceLight;
     out.direct = e_in.direct * beam;
-    out.sky = e_in.sky * sky_factor + light_irradiance(j, k) * t_air * diffuse;
+    let open = 0.5 * (1.0 + dot(normal, up));
+    out.sky = e_in.sky * sky_factor + light_irradiance(j, k) * t_air * (diffuse * open);
     out.sky += (bounce - 1.0) * (out.direct + out.sky);
     return out;
 }

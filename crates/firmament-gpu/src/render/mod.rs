@@ -123,6 +123,8 @@ struct Pipelines {
     slice: wgpu::ComputePipeline,
     terrain: OnceLock<wgpu::ComputePipeline>,
     clouds: OnceLock<wgpu::ComputePipeline>,
+    /// `main_clouds` with `WITH_TERRAIN` set: clouds over a terrain.
+    terrain_clouds: OnceLock<wgpu::ComputePipeline>,
 }
 
 /// The render pipelines, compiled once per context (the texture outputs on first use).
@@ -189,6 +191,7 @@ fn compile(ctx: &GpuContext, output: Slot, format: Option<&str>) -> Pipelines {
         pass,
         terrain: OnceLock::new(),
         clouds: OnceLock::new(),
+        terrain_clouds: OnceLock::new(),
     }
 }
 
@@ -490,30 +493,50 @@ impl GpuRenderer {
             ));
         }
         let pipelines = self.pipelines(ctx, &target)?;
-        let entry = |cell: &'p OnceLock<wgpu::ComputePipeline>, name: &str| match cell.get() {
+        let entry = |cell: &'p OnceLock<wgpu::ComputePipeline>,
+                     name: &str,
+                     constants: &[(&str, f64)]| match cell.get() {
             Some(p) => Ok(p),
             None => {
-                let p = scoped(ctx, &format!("render shader compilation ({name})"), || {
-                    Ok(pipelines.pass.entry_point(ctx.device(), name))
+                let what = match constants {
+                    [] => name.to_string(),
+                    _ => format!("{name} with {constants:?}"),
+                };
+                let p = scoped(ctx, &format!("render shader compilation ({what})"), || {
+                    Ok(pipelines
+                        .pass
+                        .entry_point_with(ctx.device(), name, constants))
                 })?;
                 Ok::<_, GpuError>(cell.get_or_init(|| p))
             }
         };
         let main = match (inputs.terrain, inputs.clouds) {
             (None, None) => &pipelines.pass.pipeline,
-            (Some(_), None) => entry(&pipelines.terrain, "main_terrain")?,
-            (None, Some(_)) => entry(&pipelines.clouds, "main_clouds")?,
-            (Some(_), Some(_)) => {
-                return Err(firmament::Error::invalid(
-                    "RenderInputs",
-                    "a terrain and clouds",
-                    "a terrain or clouds on the GPU (both: the CPU renderer)",
-                )
-                .into())
+            (Some(_), None) => entry(&pipelines.terrain, "main_terrain", &[])?,
+            (None, Some(_)) => entry(&pipelines.clouds, "main_clouds", &[])?,
+            (Some(t), Some(c)) => {
+                // The two share the observer's foot and the planet's sphere.
+                if (t.radius_m() - c.planet_radius_m()).abs() > 1.0 {
+                    return Err(firmament::Error::invalid(
+                        "RenderInputs",
+                        format!(
+                            "clouds over a planet of radius {} m above a terrain on one of {} m",
+                            c.planet_radius_m(),
+                            t.radius_m()
+                        ),
+                        "clouds on the terrain's sphere",
+                    )
+                    .into());
+                }
+                entry(
+                    &pipelines.terrain_clouds,
+                    "main_clouds",
+                    &[("WITH_TERRAIN", 1.0)],
+                )?
             }
         };
         let cloud_words = match inputs.clouds {
-            Some(c) => c.uniform_words(lights, settings)?,
+            Some(c) => c.uniform_words(sky, lights, settings)?,
             None => no_clouds_words(),
         };
         let terrain_words = match inputs.terrain {

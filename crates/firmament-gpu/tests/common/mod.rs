@@ -11,6 +11,7 @@ use std::sync::{Mutex, OnceLock};
 use firmament::atmosphere::Atmosphere;
 use firmament::math::Vec3;
 use firmament::render::{Frame, RenderSettings};
+use firmament::scene::terrain::{Heightfield, TerrainConfig};
 use firmament::scene::{Camera, Light, Projection};
 use firmament::sky::bruneton4d::{Bruneton4d, MieStorage, TableConfig, TableSizes, Tables};
 use firmament::spectrum::Wavelengths;
@@ -68,6 +69,23 @@ pub fn sky(preset: &str, wavelengths: Wavelengths, orders: usize, mie: MieStorag
     };
     let tables = Tables::compute(&model, &config).unwrap();
     Bruneton4d::new(model, tables).unwrap()
+}
+
+/// The default valley at a coarser resolution, and the earth's air with its ground lifted to
+/// the valley's floor (small tables).
+pub fn valley(config: TerrainConfig) -> (Heightfield, Bruneton4d) {
+    let wavelengths = Wavelengths::rgb();
+    let earth = Atmosphere::earth();
+    let radius = earth.resolve(&wavelengths).unwrap().bottom_radius_m;
+    let terrain = config.build(radius, wavelengths.nm()).unwrap();
+    let lifted = earth.lifted(terrain.floor_m(), &wavelengths).unwrap();
+    let model = lifted.resolve(&wavelengths).unwrap();
+    let config = TableConfig {
+        sizes: TableSizes::small(),
+        ..TableConfig::default()
+    };
+    let tables = Tables::compute(&model, &config).unwrap();
+    (terrain, Bruneton4d::new(model, tables).unwrap())
 }
 
 /// The earth preset in RGB with 4 orders, computed once for the RGB scenes.

@@ -231,11 +231,10 @@ impl FramePath {
         Ok(self.planet.as_ref().map(|m| &m.gpu))
     }
 
-    /// Whether the scene's clouds are drawn with this method (the 4D tables over the
-    /// planet's sphere), for the panel.
+    /// Whether the scene's clouds are drawn with this method (the 4D tables), for the
+    /// panel.
     pub fn clouds_drawn(&self, state: &ViewState) -> bool {
         state.method == Method::Bruneton4d
-            && self.terrain.is_none()
             && self.clouds.as_ref().is_some_and(|(_, _, m)| !m.is_empty())
     }
 
@@ -350,9 +349,10 @@ impl FramePath {
             self.hdr = Some((hdr_buffer(self.ctx(), size.0, size.1), size));
         }
         let radius = self.sky().context("no sky yet")?.model().bottom_radius_m;
-        self.ensure_clouds(state, radius)?;
-        // The map lies on the terrain's planet when there is one, as in `render`.
+        // The clouds and the map lie on the terrain's planet when there is one, as in
+        // `render`.
         let planet_radius = self.terrain.as_ref().map_or(radius, |t| t.radius_m);
+        self.ensure_clouds(state, planet_radius)?;
         self.ensure_planet(state, planet_radius)?;
         // The camera's altitude is above the terrain under it, as in `render`.
         let camera = state.scene.camera_over(self.terrain.as_deref(), radius);
@@ -388,9 +388,9 @@ impl FramePath {
             }
             _ => None,
         };
-        // The clouds with the 4D tables over the planet's sphere (the GPU draws clouds over a
-        // terrain not yet), their density filtered over the pixels' footprint as `render`
-        // sets it: the upload's with its shadow maps, each frame's from then on.
+        // The clouds with the 4D tables (over the planet's sphere or the terrain), their
+        // density filtered over the pixels' footprint as `render` sets it: the upload's
+        // with its shadow maps, each frame's from then on.
         let view = camera
             .prepare(radius, settings.width, settings.height)
             .pixel_footprint()
@@ -398,8 +398,8 @@ impl FramePath {
                 eye,
                 pixel_angle_rad,
             });
-        let clouds = match (&self.clouds, state.method, &self.terrain) {
-            (Some((_, _, media)), Method::Bruneton4d, None) if !media.is_empty() => {
+        let clouds = match (&self.clouds, state.method) {
+            (Some((_, _, media)), Method::Bruneton4d) if !media.is_empty() => {
                 if self
                     .gpu_clouds
                     .as_ref()

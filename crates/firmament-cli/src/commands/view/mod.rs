@@ -105,7 +105,7 @@ pub fn load_scene(path: Option<&PathBuf>) -> Result<(SceneFile, Vec<String>)> {
     }
     if !scene.clouds.is_empty() {
         not_drawn.push(
-            "the scene's clouds: drawn with bruneton4d over the planet's sphere (over a terrain, `firmament render` draws them on the CPU)"
+            "the scene's clouds: drawn with bruneton4d only (hillaire2020 and elek3d draw them in `firmament render` on the CPU)"
                 .into(),
         );
     }

@@ -145,7 +145,7 @@ pub(super) fn air_section(ui: &mut egui::Ui, state: &mut ViewState) {
 pub(super) fn clouds_section(ui: &mut egui::Ui, state: &mut ViewState) {
     use firmament::scene::clouds::{CloudKind, CloudLayerConfig};
     ui.horizontal(|ui| {
-        ui.label("Clouds (bruneton4d, no terrain)");
+        ui.label("Clouds (bruneton4d)");
         if ui.button("add a layer").clicked() {
             let layer = CloudLayerConfig::of_kind(CloudKind::Cumulus);
             state.scene.clouds.push(layer);
