@@ -260,13 +260,18 @@ pub fn compute_tables(model: &Model, config: &TableConfig, quiet: bool) -> Resul
 pub fn scene_clouds(
     scene: &firmament::scene::SceneFile,
     planet_radius_m: f64,
+    no_cache: bool,
     quiet: bool,
 ) -> Result<Vec<firmament::scene::clouds::CloudMedium>> {
     if scene.clouds.is_empty() {
         return Ok(Vec::new());
     }
     let started = Instant::now();
-    let cache = TableCache::from_env()?.map(|c| c.dir);
+    // The noise volumes from the table cache's directory, unless --no-cache.
+    let cache = match no_cache {
+        true => None,
+        false => TableCache::from_env()?.map(|c| c.dir),
+    };
     let clouds = scene.build_clouds(planet_radius_m, cache.as_deref())?;
     if !quiet {
         eprintln!(

@@ -125,6 +125,7 @@ fn render_takes_a_date_and_refuses_it_with_sun_angles() {
     let out = dir.join("both.png");
     let o = run(&[
         "render",
+        "--no-clouds",
         "--tables",
         t,
         "--time",
@@ -146,6 +147,7 @@ fn render_takes_a_date_and_refuses_it_with_sun_angles() {
     assert!(!out.exists());
     let o = run(&[
         "render",
+        "--no-clouds",
         "--tables",
         t,
         "--time",
@@ -163,6 +165,7 @@ fn render_takes_a_date_and_refuses_it_with_sun_angles() {
     let night = dir.join("night.png");
     let o = run(&[
         "render",
+        "--no-clouds",
         "--tables",
         t,
         "--time",
@@ -190,6 +193,7 @@ fn render_takes_a_date_and_refuses_it_with_sun_angles() {
     std::fs::write(&scene, body).unwrap();
     let o = run(&[
         "render",
+        "--no-clouds",
         "--tables",
         t,
         "--scene",
@@ -220,6 +224,7 @@ fn a_time_lapse_renders_resumes_and_follows_the_sun() {
     let args = |resume: bool| {
         let mut a = vec![
             "render",
+            "--no-clouds",
             "--tables",
             t,
             "--time",
@@ -304,6 +309,7 @@ fn ctrl_c_stops_a_time_lapse_cleanly_and_resume_finishes_it() {
     let pattern = dir.join("sky_%03d.png");
     let args = [
         "render",
+        "--no-clouds",
         "--tables",
         t,
         "--time",

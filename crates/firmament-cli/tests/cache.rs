@@ -19,6 +19,7 @@ fn render(cache: &Path, extra: &[&str]) -> Output {
         .args([
             "render",
             "--no-terrain",
+            "--no-clouds",
             "--wavelengths",
             "rgb",
             "--table-size",

@@ -120,7 +120,15 @@ fn adjusted_atmospheres_have_the_depths_asked_and_refuse_what_they_cannot() {
             vec!["adjust.planet_radius_m", "[100000, 100000000]"],
         ),
     ] {
-        let mut a = vec!["render", "--no-terrain", "--width", "16", "--height", "9"];
+        let mut a = vec![
+            "render",
+            "--no-terrain",
+            "--no-clouds",
+            "--width",
+            "16",
+            "--height",
+            "9",
+        ];
         a.extend(args);
         a.extend(["--out", out.to_str().unwrap()]);
         fails_with(&run(&a), &words);
@@ -285,6 +293,7 @@ fn bad_table_files_are_refused() {
 
 #[test]
 fn every_camera_and_format_renders() {
+    // The default scene's cameras and formats, without its clouds (their own tests).
     let t = tables().to_str().unwrap();
     for (camera, size) in [
         ("perspective", (64, 36)),
@@ -299,6 +308,7 @@ fn every_camera_and_format_renders() {
                 "render",
                 "--tables",
                 t,
+                "--no-clouds",
                 "--camera",
                 camera,
                 "--width",
@@ -323,6 +333,7 @@ fn every_camera_and_format_renders() {
             "render",
             "--tables",
             t,
+            "--no-clouds",
             "--width",
             "32",
             "--height",

@@ -87,7 +87,7 @@ fn a_scene_files_sun_without_azimuth_takes_the_default_scenes() {
 #[test]
 fn flags_a_projection_would_ignore_are_refused_and_sizes_follow_the_aspect() {
     let t = tables_arg();
-    let base = ["render", "--tables", t, "--no-terrain", "-q"];
+    let base = ["render", "--tables", t, "--no-terrain", "--no-clouds", "-q"];
     let with = |extra: &[&str]| {
         let mut a = base.to_vec();
         a.extend_from_slice(extra);
@@ -159,6 +159,7 @@ fn automatic_exposure_shows_a_noon_sky_bright_and_blue() {
         "--tables",
         tables_arg(),
         "--no-terrain",
+        "--no-clouds",
         "--sun-zenith-deg",
         "30",
         "--sun-azimuth-deg",
@@ -207,6 +208,7 @@ fn a_reference_render_says_how_long_it_will_take_and_how_noisy_it_is() {
         "--backend",
         "cpu",
         "--no-terrain",
+        "--no-clouds",
         "--samples",
         "16",
         "--width",

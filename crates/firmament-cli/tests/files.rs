@@ -18,6 +18,7 @@ fn sunset_sun(out: &Path, extra: &[&str]) -> std::process::Output {
         "--tables",
         tables_arg(),
         "--no-terrain",
+        "--no-clouds",
         "--camera",
         "perspective",
         "--width",

@@ -333,6 +333,7 @@ fn hillaire2020_answers_query_render_and_validate() {
         "hillaire2020",
         "--aerial-volume",
         "--no-terrain",
+        "--no-clouds",
         "--wavelengths",
         "rgb",
         "--width",

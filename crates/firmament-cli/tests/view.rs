@@ -44,10 +44,11 @@ fn mean_code_diff(a: &Path, b: &Path, from_x: usize) -> f64 {
     sum / n as f64
 }
 
-/// The default scene without its terrain (the clear sky), written to `dir`.
+/// The default scene without its terrain and clouds (the clear sky), written to `dir`.
 fn clear_scene(dir: &Path) -> std::path::PathBuf {
     let scene = firmament::scene::SceneFile {
         terrain: None,
+        clouds: Vec::new(),
         ..Default::default()
     };
     let path = dir.join("clear.toml");
@@ -220,13 +221,14 @@ fn exr_difference(a: &Path, b: &Path) -> (f64, f64, f64) {
 fn the_viewer_draws_the_terrain_as_render_does() {
     let Some(_gpu) = gpu() else { return };
     let dir = tmp_subdir("view-terrain");
-    // The default scene: the valley at golden hour, its shafts; the sun behind a ridge.
+    // The default scene: the valley at golden hour, its shafts; the sun behind a ridge (its
+    // clouds over the terrain: the_viewer_draws_the_clouds_over_the_terrain_as_render_does).
     let defaults = dir.join("default.toml");
-    std::fs::write(
-        &defaults,
-        toml::to_string(&firmament::scene::SceneFile::default()).unwrap(),
-    )
-    .unwrap();
+    let scene = firmament::scene::SceneFile {
+        clouds: Vec::new(),
+        ..firmament::scene::SceneFile::default()
+    };
+    std::fs::write(&defaults, toml::to_string(&scene).unwrap()).unwrap();
     succeeds(&offscreen(&dir, &defaults, (96, 54), "bruneton4d"));
     render_saved_scene(&dir);
     let (rel, mean, disks) = exr_difference(&dir.join("view.exr"), &dir.join("render.exr"));

@@ -64,6 +64,8 @@ struct View {
     terrain: bool,
     /// With the planet's procedural surface map (`[surface]`).
     surface: bool,
+    /// With the default scene's clouds.
+    clouds: bool,
 }
 
 fn views(width: usize) -> Vec<View> {
@@ -78,21 +80,21 @@ fn views(width: usize) -> Vec<View> {
     };
     use Projection::*;
     vec![
-        View { name: "noon", title: "Noon from the ground, looking north (sun 60° high in the south)", camera: cam(Perspective, 2.0, 0.0, 12.0, 80.0), sun: (30.0, 180.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: false, surface: false },
-        View { name: "afternoon", title: "Afternoon, facing the sun (30° high)", camera: cam(Perspective, 2.0, 240.0, 12.0, 80.0), sun: (60.0, 240.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: false, surface: false },
-        View { name: "sunset", title: "Sunset (sun 1° high in the west)", camera: cam(Perspective, 2.0, 270.0, 6.0, 80.0), sun: (89.0, 270.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: false, surface: false },
-        View { name: "twilight", title: "Twilight, facing east away from the sun 4° below the horizon: Earth's shadow and the Belt of Venus", camera: cam(Perspective, 2.0, 90.0, 8.0, 80.0), sun: (94.0, 270.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: false, surface: false },
-        View { name: "altitude-10km", title: "From 10 km, looking down the aerial perspective", camera: cam(Perspective, 10_000.0, 200.0, -8.0, 80.0), sun: (50.0, 160.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: false, surface: false },
-        View { name: "low-orbit", title: "From low orbit (400 km), the limb with the sun low", camera: cam(Perspective, 400_000.0, 90.0, -17.0, 60.0), sun: (75.0, 90.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: false, surface: true },
-        View { ev_offset: 2.5, name: "planet", title: "The whole planet from 30 000 km: oceans, continents and ice of the procedural surface map, the sun's glint on the sea, limb, terminator, night side", camera: cam(Orbit, 30_000_000.0, 0.0, 0.0, orbit_fit_fov_deg(6_424_000.0, 36_360_000.0)), sun: (75.0, 90.0), size: (width * 2 / 3, width * 2 / 3), when: None, strip: None, terrain: false, surface: true },
-        View { name: "fisheye", title: "All-sky fisheye (equidistant, north up, east left), sun 45° high in the south-east", camera: cam(Fisheye, 2.0, 0.0, 0.0, 60.0), sun: (45.0, 135.0), size: (width * 2 / 3, width * 2 / 3), ev_offset: 0.0, when: None, strip: None, terrain: false, surface: false },
-        View { name: "moonlit", title: "Full-moon night over the Alps (46.5° N, 8° E), 2026-01-03 21:00 CET, facing the moon 38° high in the east", camera: cam(Perspective, 2.0, 92.0, 14.0, 70.0), sun: (0.0, 0.0), size: (width, h), ev_offset: 0.0, when: Some(("2026-01-03T20:00:00Z", 46.5, 8.0)), strip: None, terrain: false, surface: false },
-        View { name: "starry-twilight", title: "Nautical twilight with a 4 % crescent moon in the west-south-west and the first stars, 2026-01-20 18:20 CET (46.5° N, 8° E), fisheye", camera: cam(Fisheye, 2.0, 0.0, 0.0, 60.0), sun: (0.0, 0.0), size: (width * 2 / 3, width * 2 / 3), ev_offset: 1.0, when: Some(("2026-01-20T17:20:00Z", 46.5, 8.0)), strip: None, terrain: false, surface: false },
-        View { name: "sunrise-strip", title: "Sunrise time-lapse, 21 June 2026 at 46.5° N, 8° E, facing north-east: 02:40 to 04:20 UTC every 20 min (sunrise 03:35)", camera: cam(Perspective, 2.0, 50.0, 8.0, 60.0), sun: (0.0, 0.0), size: (width / 3, width / 3), ev_offset: 0.0, when: Some(("2026-06-21T02:40:00Z", 46.5, 8.0)), strip: Some((6, 20)), terrain: false, surface: false },
-        View { name: "valley-sunset", title: "Golden hour in the valley (the default scene): the sun 5.5° high behind a peak, its shadow a shaft through the air", camera: cam(Perspective, 25.0, 250.0, 6.0, 55.0), sun: (84.5, 237.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: true, surface: false },
-        View { name: "valley-noon", title: "The valley at noon (sun 62° high in the south), looking north up the slopes", camera: cam(Perspective, 25.0, 20.0, 4.0, 60.0), sun: (28.0, 175.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: true, surface: false },
-        View { name: "valley-10km", title: "The mountains from 10 km, afternoon sun in the west-south-west", camera: cam(Perspective, 10_000.0, 30.0, -28.0, 70.0), sun: (70.0, 240.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: true, surface: false },
-        View { name: "equirect", title: "Equirectangular environment map (north at the centre column), sun 20° high in the east-south-east", camera: cam(Equirect, 2.0, 0.0, 0.0, 60.0), sun: (70.0, 120.0), size: (width, width / 2), ev_offset: 0.0, when: None, strip: None, terrain: false, surface: false },
+        View { name: "noon", title: "Noon from the ground, looking north (sun 60° high in the south)", camera: cam(Perspective, 2.0, 0.0, 12.0, 80.0), sun: (30.0, 180.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: false, surface: false, clouds: false },
+        View { name: "afternoon", title: "Afternoon, facing the sun (30° high)", camera: cam(Perspective, 2.0, 240.0, 12.0, 80.0), sun: (60.0, 240.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: false, surface: false, clouds: false },
+        View { name: "sunset", title: "Sunset (sun 1° high in the west)", camera: cam(Perspective, 2.0, 270.0, 6.0, 80.0), sun: (89.0, 270.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: false, surface: false, clouds: false },
+        View { name: "twilight", title: "Twilight, facing east away from the sun 4° below the horizon: Earth's shadow and the Belt of Venus", camera: cam(Perspective, 2.0, 90.0, 8.0, 80.0), sun: (94.0, 270.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: false, surface: false, clouds: false },
+        View { name: "altitude-10km", title: "From 10 km, looking down the aerial perspective", camera: cam(Perspective, 10_000.0, 200.0, -8.0, 80.0), sun: (50.0, 160.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: false, surface: false, clouds: false },
+        View { name: "low-orbit", title: "From low orbit (400 km), the limb with the sun low", camera: cam(Perspective, 400_000.0, 90.0, -17.0, 60.0), sun: (75.0, 90.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: false, surface: true, clouds: false },
+        View { ev_offset: 2.5, name: "planet", title: "The whole planet from 30 000 km: oceans, continents and ice of the procedural surface map, the sun's glint on the sea, limb, terminator, night side", camera: cam(Orbit, 30_000_000.0, 0.0, 0.0, orbit_fit_fov_deg(6_424_000.0, 36_360_000.0)), sun: (75.0, 90.0), size: (width * 2 / 3, width * 2 / 3), when: None, strip: None, terrain: false, surface: true, clouds: false },
+        View { name: "fisheye", title: "All-sky fisheye (equidistant, north up, east left), sun 45° high in the south-east", camera: cam(Fisheye, 2.0, 0.0, 0.0, 60.0), sun: (45.0, 135.0), size: (width * 2 / 3, width * 2 / 3), ev_offset: 0.0, when: None, strip: None, terrain: false, surface: false, clouds: false },
+        View { name: "moonlit", title: "Full-moon night over the Alps (46.5° N, 8° E), 2026-01-03 21:00 CET, facing the moon 38° high in the east", camera: cam(Perspective, 2.0, 92.0, 14.0, 70.0), sun: (0.0, 0.0), size: (width, h), ev_offset: 0.0, when: Some(("2026-01-03T20:00:00Z", 46.5, 8.0)), strip: None, terrain: false, surface: false, clouds: false },
+        View { name: "starry-twilight", title: "Nautical twilight with a 4 % crescent moon in the west-south-west and the first stars, 2026-01-20 18:20 CET (46.5° N, 8° E), fisheye", camera: cam(Fisheye, 2.0, 0.0, 0.0, 60.0), sun: (0.0, 0.0), size: (width * 2 / 3, width * 2 / 3), ev_offset: 1.0, when: Some(("2026-01-20T17:20:00Z", 46.5, 8.0)), strip: None, terrain: false, surface: false, clouds: false },
+        View { name: "sunrise-strip", title: "Sunrise time-lapse, 21 June 2026 at 46.5° N, 8° E, facing north-east: 02:40 to 04:20 UTC every 20 min (sunrise 03:35)", camera: cam(Perspective, 2.0, 50.0, 8.0, 60.0), sun: (0.0, 0.0), size: (width / 3, width / 3), ev_offset: 0.0, when: Some(("2026-06-21T02:40:00Z", 46.5, 8.0)), strip: Some((6, 20)), terrain: false, surface: false, clouds: false },
+        View { name: "valley-sunset", title: "Golden hour in the valley (the default scene): the sun 5.5° high behind a peak, its shadow a shaft through the air, a few cumulus over the ridges", camera: cam(Perspective, 25.0, 250.0, 6.0, 55.0), sun: (84.5, 237.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: true, surface: false, clouds: true },
+        View { name: "valley-noon", title: "The valley at noon (sun 62° high in the south), looking north up the slopes", camera: cam(Perspective, 25.0, 20.0, 4.0, 60.0), sun: (28.0, 175.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: true, surface: false, clouds: false },
+        View { name: "valley-10km", title: "The mountains from 10 km, afternoon sun in the west-south-west", camera: cam(Perspective, 10_000.0, 30.0, -28.0, 70.0), sun: (70.0, 240.0), size: (width, h), ev_offset: 0.0, when: None, strip: None, terrain: true, surface: false, clouds: false },
+        View { name: "equirect", title: "Equirectangular environment map (north at the centre column), sun 20° high in the east-south-east", camera: cam(Equirect, 2.0, 0.0, 0.0, 60.0), sun: (70.0, 120.0), size: (width, width / 2), ev_offset: 0.0, when: None, strip: None, terrain: false, surface: false, clouds: false },
     ]
 }
 
@@ -104,6 +106,7 @@ fn write_strip(
     frames: usize,
     minutes: i64,
     path: &std::path::Path,
+    no_cache: bool,
 ) -> Result<()> {
     let start = firmament::astro::Instant::parse(
         &scene.time.as_ref().context("a strip needs a time")?.at,
@@ -117,7 +120,7 @@ fn write_strip(
         if let Some(t) = &mut s.time {
             t.at = at.to_rfc3339();
         }
-        let (frame, ev100) = render_scene(sky, &s, None, true)?;
+        let (frame, ev100) = render_scene(sky, &s, None, no_cache, true)?;
         let rgb = frame.to_srgb8_dithered(
             firmament::render::tonemap::exposure_from_ev100(ev100, s.output.tonemap),
             s.output.tonemap,
@@ -139,6 +142,8 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
     base.atmosphere.preset = args.preset.clone();
     base.atmosphere.wavelengths = args.wavelengths.clone();
     let terrain_config = base.terrain.take();
+    // The default scene's cumulus, for its own view only.
+    let clouds = std::mem::take(&mut base.clouds);
     let backend = Backend::open(args.backend, args.quiet)?;
     let atmosphere = atmosphere_args(&base, args.tables.clone(), "default", args.no_cache);
     let wavelengths = atmosphere.wavelengths()?;
@@ -196,6 +201,9 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
         if v.terrain {
             scene.terrain = terrain_config.clone();
         }
+        if v.clouds {
+            scene.clouds = clouds.clone();
+        }
         let terrain = terrain.as_ref().filter(|_| v.terrain);
         let sky = match (&terrain_sky, v.terrain) {
             (Some(terrain_sky), true) => terrain_sky,
@@ -227,7 +235,7 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
         let t = Instant::now();
         let ev100 = match v.strip {
             None => {
-                let (frame, ev100) = render_scene(sky, &scene, terrain, true)?;
+                let (frame, ev100) = render_scene(sky, &scene, terrain, args.no_cache, true)?;
                 let ev100 = ev100 + v.ev_offset;
                 let files = FileOptions {
                     half: false,
@@ -239,7 +247,14 @@ pub fn run(args: &GalleryArgs) -> Result<()> {
                 ev100
             }
             Some((frames, minutes)) => {
-                write_strip(sky, &scene, frames, minutes, &args.out.join(&file))?;
+                write_strip(
+                    sky,
+                    &scene,
+                    frames,
+                    minutes,
+                    &args.out.join(&file),
+                    args.no_cache,
+                )?;
                 f64::NAN
             }
         };

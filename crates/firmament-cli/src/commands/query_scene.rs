@@ -61,7 +61,7 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
         .as_ref()
         .map_or(model.bottom_radius_m, |t| t.radius_m);
     let planet = scene.build_surface(radius, &nm)?;
-    let clouds = crate::common::scene_clouds(&scene, radius, args.quiet)?;
+    let clouds = crate::common::scene_clouds(&scene, radius, args.atmosphere.no_cache, args.quiet)?;
     let mut render_scene = RenderScene::clear_sky(sky.method(), sources.lights[0].direction, false);
     render_scene.lights = sources.lights.clone();
     render_scene

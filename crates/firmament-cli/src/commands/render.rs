@@ -165,13 +165,14 @@ pub fn render_scene(
     sky: &RenderSky,
     scene: &Scene,
     terrain: Option<&Heightfield>,
+    no_cache: bool,
     quiet: bool,
 ) -> Result<(render::Frame, f64)> {
     let sources = sources_of_scene(sky.model(), scene)?;
     let camera = scene.camera_over(terrain, sky.model().bottom_radius_m);
     let radius = terrain.map_or(sky.model().bottom_radius_m, |t| t.radius_m);
     let planet = scene.build_surface(radius, sky.model().wavelengths.nm())?;
-    let mut clouds = crate::common::scene_clouds(scene, radius, quiet)?;
+    let mut clouds = crate::common::scene_clouds(scene, radius, no_cache, quiet)?;
     let settings = RenderSettings {
         camera: &camera,
         ..render_settings(scene)
@@ -253,6 +254,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 &scene,
                 terrain.as_ref(),
                 args.samples,
+                args.no_cache,
                 args.quiet,
             )?;
             if !args.quiet {
@@ -355,6 +357,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             &times,
             args.resume,
             files,
+            args.no_cache,
             args.quiet,
         )?;
         if !args.quiet && rendered > 0 {
@@ -366,7 +369,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         return Ok(());
     }
     let t = Instant::now();
-    let (frame, ev100) = render_scene(&sky, &scene, terrain.as_ref(), args.quiet)?;
+    let (frame, ev100) = render_scene(&sky, &scene, terrain.as_ref(), args.no_cache, args.quiet)?;
     if !args.quiet {
         eprintln!(
             "render: {}×{} {:?}{} in {:.2} s (EV100 {:.1}{})",

@@ -79,6 +79,9 @@ pub struct RenderArgs {
     /// No terrain: the planet's smooth sphere (the default scene has mountains).
     #[arg(long)]
     pub no_terrain: bool,
+    /// No clouds: the scene's `[[clouds]]` left out (the default scene has a few cumulus).
+    #[arg(long)]
+    pub no_clouds: bool,
     /// No light shafts: the terrain's shadows stay on the ground, the air is lit throughout.
     #[arg(long)]
     pub no_light_shafts: bool,
@@ -472,6 +475,9 @@ pub fn scene_from_args(args: &RenderArgs) -> Result<Scene> {
     }
     if args.no_terrain {
         scene.terrain = None;
+    }
+    if args.no_clouds {
+        scene.clouds.clear();
     }
     if let Some(t) = &mut scene.terrain {
         t.light_shafts &= !args.no_light_shafts;

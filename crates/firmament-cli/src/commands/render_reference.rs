@@ -59,6 +59,7 @@ pub fn render_scene_reference(
     scene: &Scene,
     terrain: Option<&Heightfield>,
     samples: usize,
+    no_cache: bool,
     quiet: bool,
 ) -> Result<(render::Frame, f64)> {
     check_reference_samples(samples)?;
@@ -72,7 +73,7 @@ pub fn render_scene_reference(
     let sun = &lights[0];
     let surfaces: Vec<Box<dyn Surface + '_>> = terrain.iter().map(|t| Box::new(*t) as _).collect();
     let radius = terrain.map_or(model.bottom_radius_m, |t| t.radius_m);
-    let clouds = crate::common::scene_clouds(scene, radius, quiet)?;
+    let clouds = crate::common::scene_clouds(scene, radius, no_cache, quiet)?;
     let volumes: Vec<Box<dyn Volume + '_>> = clouds.iter().map(|c| Box::new(c) as _).collect();
     let camera = scene.camera_over(terrain, model.bottom_radius_m);
     let settings = RenderSettings {

@@ -74,6 +74,7 @@ pub fn run(
     times: &[Instant],
     resume: bool,
     options: FileOptions,
+    no_cache: bool,
     quiet: bool,
 ) -> Result<(usize, usize)> {
     let patterns = scene.output.files.clone();
@@ -115,7 +116,7 @@ pub fn run(
             continue;
         }
         frame_scene.output.files = files;
-        let (frame, ev100) = render_scene(sky, &frame_scene, terrain, true)?;
+        let (frame, ev100) = render_scene(sky, &frame_scene, terrain, no_cache, true)?;
         // Each frame's files carry its provenance and, for maps, its lamps.
         let notes = file_notes(sky, &frame_scene, terrain, &options, ev100)?;
         write_outputs(&frame, &frame_scene, ev100, options, &notes, true)?;

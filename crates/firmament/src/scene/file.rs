@@ -192,7 +192,7 @@ impl Default for SceneSun {
 impl Default for SceneFile {
     /// Golden hour in an alpine valley: the camera 25 m above the valley floor looking
     /// west-south-west up the valley towards the low sun behind the ridges, the light
-    /// shafts in the air between them.
+    /// shafts in the air between them, a few cumulus over the ridges.
     fn default() -> Self {
         SceneFile {
             atmosphere: SceneAtmosphere {
@@ -218,7 +218,7 @@ impl Default for SceneFile {
             time: None,
             terrain: Some(TerrainConfig::default()),
             surface: None,
-            clouds: Vec::new(),
+            clouds: vec![default_cumulus()],
             output: SceneOutput {
                 ev100: None,
                 tonemap: ToneCurve::Aces,
@@ -226,6 +226,18 @@ impl Default for SceneFile {
                 files: default_files(),
             },
         }
+    }
+}
+
+/// The default scene's few cumulus: a fair-weather layer based above the valley's ridges
+/// (~2.8 km), a tenth of the sky (coverage 0.12: a cluster over the northern ridge, the
+/// valley's shafts towards the sun left clear).
+fn default_cumulus() -> super::clouds::CloudLayerConfig {
+    super::clouds::CloudLayerConfig {
+        bottom_m: Some(3200.0),
+        top_m: Some(5000.0),
+        coverage: Some(0.12),
+        ..super::clouds::CloudLayerConfig::of_kind(super::clouds::CloudKind::Cumulus)
     }
 }
 

@@ -36,7 +36,7 @@ impl CloudFrame {
         let scene: SceneFile =
             toml::from_str(CUMULUS_NOON).context("the embedded cumulus scene")?;
         scene.validate()?;
-        let media = scene_clouds(&scene, sky.model.bottom_radius_m, true)?;
+        let media = scene_clouds(&scene, sky.model.bottom_radius_m, false, true)?;
         let sun = sun_direction(scene.sun.zenith_deg, scene.sun.azimuth_deg);
         Ok(CloudFrame { scene, media, sun })
     }

@@ -162,7 +162,7 @@ impl FramePath {
         {
             return Ok(());
         }
-        let media = crate::common::scene_clouds(&state.scene, radius_m, true)?;
+        let media = crate::common::scene_clouds(&state.scene, radius_m, false, true)?;
         self.clouds = Some((key, radius_m, Arc::new(media)));
         self.cloud_means = Vec::new();
         self.gpu_clouds = None;

@@ -66,6 +66,7 @@ fn backend(name: &str) -> Option<(&'static Backend, std::sync::MutexGuard<'stati
 fn view(method: Method) -> ViewState {
     let mut scene = SceneFile {
         terrain: None,
+        clouds: Vec::new(),
         ..SceneFile::default()
     };
     scene.atmosphere.wavelengths = Some("rgb".into());

@@ -273,11 +273,12 @@ impl ViewState {
     }
 }
 
-/// The default scene's golden hour without its terrain: the clear sky, for tests.
+/// The default scene's golden hour without its terrain and clouds: the clear sky, for tests.
 #[cfg(test)]
 pub fn clear_scene() -> SceneFile {
     SceneFile {
         terrain: None,
+        clouds: Vec::new(),
         ..SceneFile::default()
     }
 }
