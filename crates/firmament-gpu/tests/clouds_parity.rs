@@ -193,6 +193,7 @@ fn check_over_valley(
     sun_zenith_deg: f64,
     sun_azimuth_deg: f64,
     heading_deg: f64,
+    (above_m, pitch_deg): (f64, f64),
 ) -> Option<Frame> {
     let gpu = gpu(name)?;
     let _guard = serial();
@@ -201,8 +202,8 @@ fn check_over_valley(
         ..TerrainConfig::default()
     });
     let bottom = sky.model.bottom_radius_m;
-    // SceneFile::camera_over: 25 m above the terrain under the observer.
-    let altitude = 25.0 + terrain.height_at(0.0, 0.0) - (bottom - terrain.radius_m);
+    // SceneFile::camera_over: `above_m` above the terrain under the observer.
+    let altitude = above_m + terrain.height_at(0.0, 0.0) - (bottom - terrain.radius_m);
     // The clouds on the terrain's sphere, over its ridges (~2.8 km).
     let layer = CloudLayerConfig {
         bottom_m: Some(3200.0),
@@ -221,7 +222,13 @@ fn check_over_valley(
     let case = Case {
         name,
         layer,
-        camera: camera(Projection::Perspective, altitude, heading_deg, 4.0, 60.0),
+        camera: camera(
+            Projection::Perspective,
+            altitude,
+            heading_deg,
+            pitch_deg,
+            60.0,
+        ),
         sun_zenith_deg,
         size: (48, 27),
         filtered: false,
@@ -298,13 +305,34 @@ fn clouds_match_the_cpu_child() {
 }
 
 /// The scenes over the terrain (`main_clouds` compiled with WITH_TERRAIN), on one thread:
-/// the afternoon sun in the south behind the camera, and a low sun ahead through the ridges
-/// (light shafts cut by the terrain and the clouds).
+/// from 25 m, the afternoon sun in the south behind the camera, and a low sun ahead through
+/// the ridges (light shafts cut by the terrain and the clouds); from 7 km above the clouds
+/// looking down, the terrain behind them and their shadows on it.
 #[test]
 #[ignore = "run by `clouds_match_the_cpu` in a child process"]
 fn clouds_over_the_valley_match_the_cpu_child() {
-    let _ = check_over_valley("cumulus over the valley, afternoon", 40.0, 175.0, 20.0);
-    let _ = check_over_valley("cumulus over the valley, low sun ahead", 80.0, 237.0, 250.0);
+    let ground = (25.0, 4.0);
+    let _ = check_over_valley(
+        "cumulus over the valley, afternoon",
+        40.0,
+        175.0,
+        20.0,
+        ground,
+    );
+    let _ = check_over_valley(
+        "cumulus over the valley, low sun ahead",
+        80.0,
+        237.0,
+        250.0,
+        ground,
+    );
+    let _ = check_over_valley(
+        "the valley under cumulus from 7 km",
+        40.0,
+        175.0,
+        20.0,
+        (7000.0, -35.0),
+    );
 }
 
 /// Runs `child` (a test of this binary) in a child process, again (up to six times) while

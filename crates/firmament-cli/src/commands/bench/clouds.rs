@@ -6,7 +6,7 @@
 use anyhow::{Context, Result};
 use firmament::math::Vec3;
 use firmament::render::{self, RenderSettings, Shader, ToneCurve};
-use firmament::scene::clouds::CloudMedium;
+use firmament::scene::clouds::{CloudMedium, ViewFootprint};
 use firmament::scene::{sun_direction, Light, Scene, SceneFile};
 use firmament::sky::bruneton4d::Bruneton4d;
 use firmament_gpu::{GpuClouds, GpuRenderer, GpuSky, RenderInputs};
@@ -31,12 +31,25 @@ pub struct CloudFrame {
 }
 
 impl CloudFrame {
-    /// The cumulus scene over the planet of `sky`.
+    /// The cumulus scene over the planet of `sky`, its clouds' density filtered over the
+    /// pixels' footprint as `render` sets it (the filter's tables made here, once, where
+    /// `render` makes them per frame: about 0.4 s).
     pub fn new(sky: &Bruneton4d) -> Result<CloudFrame> {
         let scene: SceneFile =
             toml::from_str(CUMULUS_NOON).context("the embedded cumulus scene")?;
         scene.validate()?;
-        let media = scene_clouds(&scene, sky.model.bottom_radius_m, false, true)?;
+        let radius = sky.model.bottom_radius_m;
+        let mut media = scene_clouds(&scene, radius, false, true)?;
+        let (w, h) = (scene.image.width, scene.image.height);
+        if let Some((eye, pixel_angle_rad)) = scene.camera.prepare(radius, w, h).pixel_footprint() {
+            let view = ViewFootprint {
+                eye,
+                pixel_angle_rad,
+            };
+            for m in &mut media {
+                m.layer.set_view(view, None);
+            }
+        }
         let sun = sun_direction(scene.sun.zenith_deg, scene.sun.azimuth_deg);
         Ok(CloudFrame { scene, media, sun })
     }
