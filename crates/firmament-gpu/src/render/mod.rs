@@ -45,6 +45,7 @@
 //! ```
 
 pub(crate) mod frame;
+mod pipelines;
 pub mod stars;
 mod timing;
 
@@ -59,12 +60,12 @@ use firmament::scene::Light;
 use crate::bruneton4d::atmosphere::groups;
 use crate::clouds::{no_clouds_words, GpuClouds};
 use crate::device::{f32s, read_back, scoped, staging_buffer};
-use crate::passes::{init, workgroups, Pass, Slot, WORKGROUP};
+use crate::passes::{init, workgroups, Slot, WORKGROUP};
 use crate::planet::{GpuPlanet, NoPlanet};
-use crate::shader::render_source;
 use crate::terrain::{no_terrain_words, GpuTerrain};
 use crate::{GpuContext, GpuError, GpuSky};
 use frame::{light_words, slice_words, FrameConstants, MAX_LIGHTS};
+use pipelines::{compile, Pipelines};
 
 /// Bytes per pixel of a frame buffer (one `vec4<f32>`: linear sRGB and the mask).
 pub const PIXEL_BYTES: u64 = 16;
@@ -116,17 +117,6 @@ pub struct RenderInputs<'a> {
     pub timestamps: Option<&'a wgpu::QuerySet>,
 }
 
-/// A render pipeline (for one output), its `camera_slice` entry point, and its
-/// `main_terrain` and `main_clouds` entry points (compiled on first use).
-struct Pipelines {
-    pass: Pass,
-    slice: wgpu::ComputePipeline,
-    terrain: OnceLock<wgpu::ComputePipeline>,
-    clouds: OnceLock<wgpu::ComputePipeline>,
-    /// `main_clouds` with `WITH_TERRAIN` set: clouds over a terrain.
-    terrain_clouds: OnceLock<wgpu::ComputePipeline>,
-}
-
 /// The render pipelines, compiled once per context (the texture outputs on first use).
 pub struct GpuRenderer {
     buffer: Pipelines,
@@ -156,43 +146,6 @@ pub(crate) struct Job<'p> {
     dispatches: Vec<(u32, u32)>,
     /// Workgroups (x, y, groups) of the slices (None: observer in space, no slice).
     slice: Option<(u32, u32, u32)>,
-}
-
-fn compile(ctx: &GpuContext, output: Slot, format: Option<&str>) -> Pipelines {
-    use Slot::{Read, Texture, Uniform, Write};
-    let device = ctx.device();
-    let pass = Pass::new(
-        ctx,
-        "render",
-        render_source(format),
-        &[
-            (3, Read),
-            (4, Read),
-            (5, Read),
-            (6, Read),
-            (7, Read),
-            (10, Uniform),
-            (11, Uniform),
-            (12, output),
-            (13, Write),
-            (14, Uniform),
-            (15, Uniform),
-            (16, Texture),
-            (17, Read),
-            (18, Uniform),
-            (19, Read),
-            (20, Uniform),
-            (25, Texture),
-            (26, Uniform),
-        ],
-    );
-    Pipelines {
-        slice: pass.entry_point(device, "camera_slice"),
-        pass,
-        terrain: OnceLock::new(),
-        clouds: OnceLock::new(),
-        terrain_clouds: OnceLock::new(),
-    }
 }
 
 impl GpuRenderer {
@@ -493,48 +446,7 @@ impl GpuRenderer {
             ));
         }
         let pipelines = self.pipelines(ctx, &target)?;
-        let entry = |cell: &'p OnceLock<wgpu::ComputePipeline>,
-                     name: &str,
-                     constants: &[(&str, f64)]| match cell.get() {
-            Some(p) => Ok(p),
-            None => {
-                let what = match constants {
-                    [] => name.to_string(),
-                    _ => format!("{name} with {constants:?}"),
-                };
-                let p = scoped(ctx, &format!("render shader compilation ({what})"), || {
-                    Ok(pipelines
-                        .pass
-                        .entry_point_with(ctx.device(), name, constants))
-                })?;
-                Ok::<_, GpuError>(cell.get_or_init(|| p))
-            }
-        };
-        let main = match (inputs.terrain, inputs.clouds) {
-            (None, None) => &pipelines.pass.pipeline,
-            (Some(_), None) => entry(&pipelines.terrain, "main_terrain", &[])?,
-            (None, Some(_)) => entry(&pipelines.clouds, "main_clouds", &[])?,
-            (Some(t), Some(c)) => {
-                // The two share the observer's foot and the planet's sphere.
-                if (t.radius_m() - c.planet_radius_m()).abs() > 1.0 {
-                    return Err(firmament::Error::invalid(
-                        "RenderInputs",
-                        format!(
-                            "clouds over a planet of radius {} m above a terrain on one of {} m",
-                            c.planet_radius_m(),
-                            t.radius_m()
-                        ),
-                        "clouds on the terrain's sphere",
-                    )
-                    .into());
-                }
-                entry(
-                    &pipelines.terrain_clouds,
-                    "main_clouds",
-                    &[("WITH_TERRAIN", 1.0)],
-                )?
-            }
-        };
+        let main = pipelines.main_for(ctx, inputs.terrain, inputs.clouds)?;
         let cloud_words = match inputs.clouds {
             Some(c) => c.uniform_words(sky, lights, settings)?,
             None => no_clouds_words(),
