@@ -5,7 +5,8 @@
 //!
 //! - `state.rs`: what is shown (a scene file, the method, the viewer's settings);
 //! - `controls.rs`, `presets.rs`: the camera under the keys and the mouse, named views;
-//! - `frame_path.rs`: the sky into an HDR texture, the display pass into the target;
+//! - `frame_path.rs`: the sky into an HDR texture, the display pass into the target (its
+//!   sky in `frame_sky.rs`, the reference beside it in `frame_reference.rs`);
 //! - `panel.rs`: the egui panel; `window.rs`: winit, the surface, egui; `capture.rs`: files.
 
 pub mod capture;
