@@ -6,6 +6,8 @@
 mod common;
 
 use common::{fails_with, run, stderr, succeeds, tables_arg, tmp};
+use std::path::Path;
+
 use firmament::scene::SceneFile;
 
 /// The help text of `--flag` in `firmament COMMAND --help` (up to the next flag).
@@ -224,4 +226,61 @@ fn a_reference_render_says_how_long_it_will_take_and_how_noisy_it_is() {
     let e = stderr(&o);
     assert!(e.contains("about") && e.contains("pilot"), "{e}");
     assert!(e.contains("mean relative standard error"), "{e}");
+}
+
+/// The default scene has a few cumulus over its ridges (the written-out default,
+/// scenes/valley-sunset.toml, has the same), drawn where the cluster is (the upper right of
+/// the frame); `--no-clouds` leaves them out, and only them.
+#[test]
+fn the_default_scene_has_a_few_cumulus_and_no_clouds_leaves_them_out() {
+    let written = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/valley-sunset.toml");
+    let written = SceneFile::from_file(&written).unwrap();
+    assert_eq!(written.clouds, SceneFile::default().clouds);
+    assert_eq!(SceneFile::default().clouds.len(), 1);
+    let t = tables_arg();
+    let frame = |extra: &[&str], name: &str| {
+        let out = tmp().join(name);
+        let mut a = vec!["render", "--tables", t, "--width", "64", "--height", "36"];
+        a.extend_from_slice(extra);
+        a.extend(["--out", out.to_str().unwrap()]);
+        let o = run(&a);
+        succeeds(&o);
+        (stderr(&o), firmament::io::read_exr(&out).unwrap())
+    };
+    let (said, cloudy) = frame(&[], "default-clouds.exr");
+    assert!(
+        said.contains("clouds: 1 layer (cumulus 3200–5000 m)"),
+        "{said}"
+    );
+    let (said, clear) = frame(&["--no-clouds"], "default-clear.exr");
+    assert!(!said.contains("clouds:"), "{said}");
+    // Per pixel, |ΔL|/L: the cluster's rectangle (the upper right, x 38–61 and y 6–17 of
+    // 64×36) changes from sky to cloud pixel by pixel; the valley (the lower third, under the
+    // ridges' shadow, dimmed a little by the clouds' shadows in the air) less (11.5 % and
+    // 4.8 % when written).
+    let change = |xs: std::ops::Range<usize>, ys: std::ops::Range<usize>| {
+        let l = |p: [f32; 3]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
+        let mut sum = 0.0;
+        for y in ys.clone() {
+            for x in xs.clone() {
+                let i = y * clear.width + x;
+                sum += (l(cloudy.data[i]) - l(clear.data[i])).abs() / l(clear.data[i]);
+            }
+        }
+        sum / (xs.len() * ys.len()) as f64
+    };
+    let (cluster, valley) = (change(38..62, 6..18), change(0..64, 24..36));
+    eprintln!(
+        "the cumulus change the cluster's pixels by {:.1} %, the valley's by {:.1} % (mean |ΔL|/L)",
+        100.0 * cluster,
+        100.0 * valley
+    );
+    assert!(
+        cluster > 0.1,
+        "the clouds changed the sky by {cluster} only"
+    );
+    assert!(
+        valley < 0.5 * cluster,
+        "the valley changed by {valley}, the sky by {cluster}"
+    );
 }
