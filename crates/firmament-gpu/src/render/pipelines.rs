@@ -69,32 +69,10 @@ impl Pipelines {
         terrain: Option<&GpuTerrain>,
         clouds: Option<&GpuClouds>,
     ) -> Result<&wgpu::ComputePipeline, GpuError> {
-        let entry = |cell: &'_ OnceLock<wgpu::ComputePipeline>,
-                     name: &str,
-                     constants: &[(&str, f64)]| match cell.get() {
-            Some(_) => Ok(()),
-            None => {
-                let what = match constants {
-                    [] => name.to_string(),
-                    _ => format!("{name} with {constants:?}"),
-                };
-                let p = scoped(ctx, &format!("render shader compilation ({what})"), || {
-                    Ok(self.pass.entry_point_with(ctx.device(), name, constants))
-                })?;
-                let _ = cell.set(p);
-                Ok::<_, GpuError>(())
-            }
-        };
         Ok(match (terrain, clouds) {
             (None, None) => &self.pass.pipeline,
-            (Some(_), None) => {
-                entry(&self.terrain, "main_terrain", &[])?;
-                self.terrain.get().expect("just compiled")
-            }
-            (None, Some(_)) => {
-                entry(&self.clouds, "main_clouds", &[])?;
-                self.clouds.get().expect("just compiled")
-            }
+            (Some(_), None) => self.compiled(ctx, &self.terrain, "main_terrain", &[])?,
+            (None, Some(_)) => self.compiled(ctx, &self.clouds, "main_clouds", &[])?,
             (Some(t), Some(c)) => {
                 // The two share the observer's foot and the planet's sphere.
                 if (t.radius_m() - c.planet_radius_m()).abs() > 1.0 {
@@ -109,13 +87,30 @@ impl Pipelines {
                     )
                     .into());
                 }
-                entry(
-                    &self.terrain_clouds,
-                    "main_clouds",
-                    &[("WITH_TERRAIN", 1.0)],
-                )?;
-                self.terrain_clouds.get().expect("just compiled")
+                let constants = [("WITH_TERRAIN", 1.0)];
+                self.compiled(ctx, &self.terrain_clouds, "main_clouds", &constants)?
             }
         })
+    }
+
+    /// The entry point `name` with `constants` set, compiled into `cell` on first use.
+    fn compiled<'a>(
+        &self,
+        ctx: &GpuContext,
+        cell: &'a OnceLock<wgpu::ComputePipeline>,
+        name: &str,
+        constants: &[(&str, f64)],
+    ) -> Result<&'a wgpu::ComputePipeline, GpuError> {
+        if let Some(p) = cell.get() {
+            return Ok(p);
+        }
+        let what = match constants {
+            [] => name.to_string(),
+            _ => format!("{name} with {constants:?}"),
+        };
+        let p = scoped(ctx, &format!("render shader compilation ({what})"), || {
+            Ok(self.pass.entry_point_with(ctx.device(), name, constants))
+        })?;
+        Ok(cell.get_or_init(|| p))
     }
 }
