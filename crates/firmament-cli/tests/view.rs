@@ -56,15 +56,21 @@ fn clear_scene(dir: &Path) -> std::path::PathBuf {
     path
 }
 
-/// The offscreen viewer's frame of `scene`, its scene saved.
+/// The offscreen viewer's frame of `scene`, its scene saved: the second frame, or under
+/// clouds the fourth (the viewer marches a quarter of their pixels a frame: a still view is
+/// the full frame after four).
 fn offscreen(dir: &Path, scene: &Path, size: (u32, u32), method: &str) -> std::process::Output {
+    let cloudy = !firmament::scene::SceneFile::from_file(scene)
+        .unwrap()
+        .clouds
+        .is_empty();
     run(&[
         "view",
         "--scene",
         scene.to_str().unwrap(),
         "--offscreen",
         "--frames",
-        "2",
+        if cloudy { "4" } else { "2" },
         "--width",
         &size.0.to_string(),
         "--height",
@@ -349,9 +355,14 @@ fn the_viewer_draws_the_clouds_over_the_terrain_as_render_does() {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/clouds-over-the-valley.toml");
     let out = offscreen(&dir, &scene, (64, 36), "bruneton4d");
     succeeds(&out);
-    // Nothing of the scene is left out of the view.
+    // Nothing of the scene is left out of the view, and after four frames its clouds are
+    // the full frame (a quarter of their pixels marched a frame).
     let said = String::from_utf8_lossy(&out.stderr);
     assert!(!said.contains("over a terrain"), "{said}");
+    assert!(
+        said.contains("clouds: 1/4 of the pixels marched a frame; converged"),
+        "{said}"
+    );
     let text = std::fs::read_to_string(dir.join("scene.toml")).unwrap();
     assert!(
         text.contains("[[clouds]]") && text.contains("[terrain]"),
@@ -456,6 +467,10 @@ fn the_viewer_refuses_what_it_cannot_do() {
             "3",
         ]),
         &["--render-scale", "0.1 to 1"],
+    );
+    fails_with(
+        &run(&["view", "--offscreen", "--frames", "1", "--cloud-step", "3"]),
+        &["--cloud-step", "1, 2, 4"],
     );
     assert!(!jpg.exists());
 }

@@ -66,7 +66,9 @@ pub use hillaire2020::{
     HillairePrecomputer, HillaireTables,
 };
 pub use planet::GpuPlanet;
-pub use render::{GpuRenderer, RenderInputs, RenderTarget, RenderTiming, PIXEL_BYTES};
+pub use render::{
+    GpuRenderer, Interleave, RenderInputs, RenderTarget, RenderTiming, TemporalFrames, PIXEL_BYTES,
+};
 pub use terrain::GpuTerrain;
 
 use firmament::atmosphere::Model;

@@ -193,6 +193,54 @@ impl Pass {
     }
 }
 
+/// A compute pipeline of its own source's entry point `entry` over buffer bindings only
+/// (not an atmosphere pass: no common slots), and its bind group layout; the source's
+/// uniform blocks as `ctx` reads them ([`uniform_source`]).
+pub fn buffer_pipeline(
+    ctx: &GpuContext,
+    label: &str,
+    source: &str,
+    entry: &str,
+    bindings: &[(u32, wgpu::BufferBindingType)],
+) -> (wgpu::ComputePipeline, wgpu::BindGroupLayout) {
+    let device = ctx.device();
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(uniform_source(ctx, source).into()),
+    });
+    let entries: Vec<wgpu::BindGroupLayoutEntry> = bindings
+        .iter()
+        .map(|&(binding, ty)| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        })
+        .collect();
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &entries,
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: Some(&pipeline_layout),
+        module: &module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    (pipeline, layout)
+}
+
 /// Workgroup counts (x, y) covering `invocations` with 64-wide workgroups, x at most
 /// `max_per_dimension` (the shaders rebuild the flat index from both).
 pub fn workgroups(invocations: usize, max_per_dimension: u32) -> (u32, u32) {

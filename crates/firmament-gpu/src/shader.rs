@@ -108,7 +108,8 @@ pub const TERRAIN: [Module; 7] = [
 
 /// The renderer's modules: lights, cameras, the air volume, the scene over the terrain, the
 /// frame.
-pub const RENDER: [Module; 8] = [
+pub const RENDER: [Module; 9] = [
+    module!("render/frame.wgsl"),
     module!("render/light.wgsl"),
     module!("render/planet.wgsl"),
     module!("render/camera.wgsl"),
@@ -166,8 +167,9 @@ pub const HILLAIRE2020_VIEW: [Module; 2] = [
 
 /// What a Hillaire 2020 frame takes of the renderer's modules (no terrain: its scene is the
 /// clear sky, `hillaire2020/scene.wgsl`): lights, cameras, the disks' edges, the frame.
-pub const HILLAIRE2020_RENDER: [Module; 6] = [
+pub const HILLAIRE2020_RENDER: [Module; 7] = [
     module!("hillaire2020/scene.wgsl"),
+    module!("render/frame.wgsl"),
     module!("render/light.wgsl"),
     module!("render/planet.wgsl"),
     module!("render/camera.wgsl"),
@@ -188,13 +190,22 @@ pub const ELEK3D_VIEW: [Module; 2] = [
 
 /// What a 3D-table frame takes of the renderer's modules (no terrain: its scene is the
 /// clear sky, `elek3d/scene.wgsl`): lights, cameras, the disks' edges, the frame.
-pub const ELEK3D_RENDER: [Module; 6] = [
+pub const ELEK3D_RENDER: [Module; 7] = [
     module!("elek3d/scene.wgsl"),
+    module!("render/frame.wgsl"),
     module!("render/light.wgsl"),
     module!("render/planet.wgsl"),
     module!("render/camera.wgsl"),
     module!("render/disk_edges.wgsl"),
     module!("render/render.wgsl"),
+];
+
+/// The temporal resolve of interleaved frames (`render::temporal`): the frame's constants,
+/// the cameras and the resolve.
+pub const TEMPORAL: [Module; 3] = [
+    module!("render/frame.wgsl"),
+    module!("render/camera.wgsl"),
+    module!("render/temporal.wgsl"),
 ];
 
 /// The frame's output into a storage buffer.
@@ -264,6 +275,11 @@ pub fn render_source(output_format: Option<&str>) -> String {
         .chain([output])
         .collect();
     compose(&modules, output_format)
+}
+
+/// The temporal resolve's source (`render::temporal`).
+pub fn temporal_source() -> String {
+    compose(&TEMPORAL, None)
 }
 
 /// The constants Hillaire 2020's shaders add to the prelude.
@@ -418,12 +434,14 @@ mod tests {
                 hillaire2020_passes::MULTIPLE_SCATTERING,
                 hillaire2020_passes::IRRADIANCE,
             ])
+            .chain(&TEMPORAL)
             .chain(&[OUTPUT_BUFFER, OUTPUT_TEXTURE])
         {
             for line in p.lines().filter(|l| l.starts_with("const ")) {
                 let name = line.split([':', ' ']).nth(1).unwrap();
                 assert!(
-                    !m.source.contains(&format!("const {name}")),
+                    !m.source.contains(&format!("const {name}:"))
+                        && !m.source.contains(&format!("const {name} ")),
                     "{} redefines {name}",
                     m.path
                 );
@@ -464,6 +482,7 @@ mod tests {
                 elek3d_render_source(Some("rgba16float")),
             ),
             ("elek3d sky module".to_string(), elek3d_sky_module()),
+            ("temporal resolve".to_string(), temporal_source()),
             (
                 "hillaire2020 transmittance (16 segments)".to_string(),
                 hillaire2020_transmittance_source(16),

@@ -80,12 +80,20 @@ pub fn prelude() -> String {
         ("DISK_SUBSAMPLES", disk_edges::SUBSAMPLES),
         ("PLANET_BASIS", firmament::scene::planet::BASIS),
         ("PLANET_BASIS_VEC4", crate::planet::PLANET_BASIS_VEC4),
+        (
+            "DEPTH_IN_ALPHA",
+            crate::render::temporal::DEPTH_IN_ALPHA as usize,
+        ),
     ] {
         s += &u(name, v);
     }
     s += &format!(
         "const DISK_EDGE_FOOTPRINTS: f32 = {:?};\n",
         disk_edges::EDGE_FOOTPRINTS as f32
+    );
+    s += &format!(
+        "const SKY_DEPTH_M: f32 = {:?};\n",
+        crate::render::temporal::SKY_DEPTH_M
     );
     s += &clouds_prelude();
     // The orders' geometric tail (bruneton4d::precompute::order_tail_factors).

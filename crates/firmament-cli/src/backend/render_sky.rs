@@ -21,6 +21,7 @@ use firmament_gpu::elek3d::{GpuElek3d, GpuElek3dRenderer};
 use firmament_gpu::hillaire2020::{GpuHillaire, GpuHillaireRenderer, HillairePrecomputer};
 use firmament_gpu::{
     GpuClouds, GpuError, GpuPlanet, GpuRenderer, GpuSky, GpuTerrain, RenderInputs, RenderTarget,
+    TemporalFrames,
 };
 
 use super::{gpu_failure, on_gpu, Backend, Gpu};
@@ -314,7 +315,10 @@ impl<'a> RenderSky<'a> {
     /// only); no stars (those
     /// need the CPU's parts of [`RenderSky::render`]); `timestamps` as
     /// `RenderInputs::timestamps`, over the planet's map `planet` ([`RenderSky::gpu_planet`];
-    /// every method). The viewer's frame path.
+    /// every method); under clouds with `temporal` (a buffer target), one pixel of each of its
+    /// blocks marched and the rest resolved from the previous frames
+    /// ([`TemporalFrames::encode`]). The viewer's frame path.
+    #[allow(clippy::too_many_arguments)]
     pub fn encode_frame(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -325,6 +329,7 @@ impl<'a> RenderSky<'a> {
         terrain: Option<&GpuTerrain>,
         clouds: Option<&GpuClouds>,
         planet: Option<&GpuPlanet>,
+        temporal: Option<&mut TemporalFrames>,
     ) -> Result<()> {
         if (terrain.is_some() || clouds.is_some()) && !matches!(self, RenderSky::Gpu { .. }) {
             anyhow::bail!("a terrain or clouds are drawn on the GPU by the 4D tables only so far");
@@ -342,7 +347,16 @@ impl<'a> RenderSky<'a> {
             RenderSky::Cpu(..) => anyhow::bail!("encode_frame draws on the GPU only"),
             RenderSky::Gpu {
                 gpu, sky, renderer, ..
-            } => renderer.encode(&gpu.ctx, encoder, sky, lights, settings, target, inputs),
+            } => match (temporal, target) {
+                // Under clouds a share of the pixels, the rest from the previous frames.
+                (Some(t), RenderTarget::Buffer(output)) => {
+                    let ctx = &gpu.ctx;
+                    t.encode(
+                        ctx, encoder, renderer, sky, lights, settings, output, inputs,
+                    )
+                }
+                _ => renderer.encode(&gpu.ctx, encoder, sky, lights, settings, target, inputs),
+            },
             RenderSky::GpuHillaire {
                 gpu, sky, renderer, ..
             } => renderer.encode(&gpu.ctx, encoder, sky, lights, settings, target, inputs),

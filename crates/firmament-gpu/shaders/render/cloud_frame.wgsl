@@ -176,12 +176,15 @@ fn clouded_air(v: View, vl: ViewLight, l: u32, pray: PointRay, q: vec3<f32>, dir
     return tl.lit_at_end;
 }
 
-// Shader::shade under the clouds, summed to linear sRGB over the lights and channel groups.
+// Shader::shade under the clouds, summed to linear sRGB over the lights and channel groups,
+// and the ray's depth (m) for the temporal resolve (render/temporal.wgsl): the clouds' mean
+// depth where they hide more than half of what is behind them, else the ground's (or
+// SKY_DEPTH_M).
 // The clouds are marched first; then per light the air's light is summed over the whole ray
 // and, where the ray meets a cloud, again to the cloud's mean depth (its aerial perspective),
 // both from one call of clouded_air in a loop: every call site of a function is inlined
 // whole by the driver, and lavapipe's compile grows faster than the code.
-fn shade_clouds(dir: vec3<f32>) -> vec3<f32> {
+fn shade_clouds(dir: vec3<f32>) -> vec4<f32> {
     let o = observer();
     var v: View;
     v.mie_layout = frame.mie_layout;
@@ -333,10 +336,12 @@ fn shade_clouds(dir: vec3<f32>) -> vec3<f32> {
             rgb += to_srgb(air_volume_add(dir, end_m, k), k);
         }
     }
+    let behind_m = max(select(SKY_DEPTH_M, end_m, hit), 1e-3);
     if (m.depth_m < 0.0) {
-        return rgb;
+        return vec4<f32>(rgb, behind_m);
     }
-    return front + seen + m.t_vol * (rgb - front);
+    let depth_m = select(behind_m, max(m.depth_m, 1e-3), m.t_vol < 0.5);
+    return vec4<f32>(front + seen + m.t_vol * (rgb - front), depth_m);
 }
 
 // The frame under clouds: an entry point of its own, so that frames without them carry none
@@ -350,16 +355,19 @@ fn main_clouds(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     var out = vec4<f32>(0.0);
     if (p.ray.valid) {
         var rgb = vec3<f32>(0.0);
+        var depth_m = SKY_DEPTH_M;
         // One ray, or DISK_SUBSAMPLES² over the footprint of a pixel on a disk's edge.
         let n = pixel_rays(p);
         for (var k = 0u; k < n; k++) {
             let r = pixel_ray(p, k, n);
             if (r.valid) {
-                rgb += shade_clouds(r.dir);
+                let shaded = shade_clouds(r.dir);
+                rgb += shaded.xyz;
+                depth_m = shaded.w;
             }
         }
         rgb /= f32(n);
-        out = vec4<f32>(rgb * frame.balance.xyz, 1.0);
+        out = vec4<f32>(rgb * frame.balance.xyz, select(1.0, depth_m, depth_in_alpha()));
     }
     write_pixel(p.i, p.x, p.y, out);
 }

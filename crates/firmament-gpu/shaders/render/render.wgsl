@@ -5,41 +5,6 @@
 // channel groups into linear sRGB. An optional per-pixel shadowed length (paper eq. 17–18:
 // from shadow volumes or a shadow map) leaves the light shafts out.
 
-// Per-frame constants (firmament_gpu::render::FrameConstants writes them in this order).
-struct Frame {
-    width: u32,
-    height: u32,
-    // This dispatch covers rows first_row .. first_row + rows (frames too large for one
-    // storage binding are drawn in bands).
-    first_row: u32,
-    rows: u32,
-    // 0 perspective, 1 fisheye, 2 equirect, 3 cubemap, 4 orbit (camera::Projection).
-    projection: u32,
-    lights: u32,
-    // Whether a per-pixel shadowed length is bound (shadow_lengths, metres).
-    shadow_input: u32,
-    // Single Mie storage (View.mie_layout).
-    mie_layout: u32,
-    // View basis of the pinhole projections (PreparedCamera), local frame x east, y north, z up.
-    forward: vec4<f32>,
-    right: vec4<f32>,
-    up: vec4<f32>,
-    // White-balance factors per linear sRGB channel (1 when off).
-    balance: vec4<f32>,
-    // The observer: radius, ρ = sqrt(r² − R_g²) (inside the atmosphere) and r − R_t (km), and
-    // whether it is inside the atmosphere.
-    camera_r_km: f32,
-    camera_rho_km: f32,
-    camera_above_top_km: f32,
-    inside: u32,
-    tan_half_fov: f32,
-    // An upper bound on the pixels' footprints (rad; disk_edges.wgsl).
-    max_footprint_rad: f32,
-    pad1: f32,
-    pad2: f32,
-}
-
-@group(0) @binding(10) var<uniform> frame: Frame;
 // The shadowed length of each pixel (m), when frame.shadow_input is set.
 @group(0) @binding(16) var shadow_lengths: texture_2d<f32>;
 
@@ -133,15 +98,26 @@ struct Pixel {
     ray: CameraRay,
 }
 
+// An interleaved frame (render/frame.wgsl) draws pixel (phase.x, phase.y) of each k×k block
+// of the band only: invocation n is the n-th of those, i its index in the band.
 fn pixel(gid: vec3<u32>, nwg: vec3<u32>) -> Pixel {
     var p: Pixel;
-    p.i = invocation_index(gid, nwg);
-    p.in_band = p.i < frame.rows * frame.width;
+    let n = invocation_index(gid, nwg);
+    let k = interleave_step();
+    let phase = interleave_phase();
+    // The pixels drawn per row of the band, and the rows drawn.
+    let start_x = frame.interleave_columns & 0xffffu;
+    let end_x = select(frame.width, frame.interleave_columns >> 16u, frame.interleave_columns > 0xffffu);
+    let cols = select(0u, (end_x - start_x - phase.x + k - 1u) / k, end_x > start_x + phase.x);
+    let rows = select(0u, (frame.rows - phase.y + k - 1u) / k, frame.rows > phase.y);
+    p.in_band = n < cols * rows;
     if (!p.in_band) {
         return p;
     }
-    p.x = p.i % frame.width;
-    p.y = frame.first_row + p.i / frame.width;
+    p.x = start_x + (n % cols) * k + phase.x;
+    let row = (n / cols) * k + phase.y;
+    p.y = frame.first_row + row;
+    p.i = row * frame.width + p.x;
     p.ray = camera_ray(f32(p.x) + 0.5, f32(p.y) + 0.5);
     return p;
 }

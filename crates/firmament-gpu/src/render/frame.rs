@@ -1,5 +1,5 @@
 //! The render shader's per-frame uniforms, computed in f64 and rounded once: the `Frame`
-//! of `shaders/render/render.wgsl`, the `Lights` of `shaders/render/light.wgsl` and the
+//! of `shaders/render/frame.wgsl`, the `Lights` of `shaders/render/light.wgsl` and the
 //! `SliceCoordinates` of `shaders/bruneton4d/view.wgsl`, with the layout constants the
 //! prelude hands to WGSL. The first two serve every sky method on the device
 //! ([`FrameSky`]: the 4D tables' [`GpuSky`], Hillaire 2020's `GpuHillaire`).
@@ -98,6 +98,11 @@ pub(crate) struct FrameConstants {
     tan_half_fov: f64,
     /// An upper bound on the pixels' footprints (rad; render::disk_edges).
     max_footprint_rad: f64,
+    /// An interleaved frame's step, phase and depth flag ([`super::temporal::Interleave`];
+    /// 0: every pixel, the mask in alpha).
+    pub(crate) interleave: u32,
+    /// The columns it draws ([`super::temporal::Interleave::columns_word`]; 0: all).
+    pub(crate) interleave_columns: u32,
 }
 
 impl FrameConstants {
@@ -143,6 +148,8 @@ impl FrameConstants {
                 settings.width,
                 settings.height,
             ),
+            interleave: 0,
+            interleave_columns: 0,
         }
     }
 
@@ -169,8 +176,8 @@ impl FrameConstants {
             u32::from(self.inside),
             bits(self.tan_half_fov),
             bits(self.max_footprint_rad),
-            0,
-            0,
+            self.interleave,
+            self.interleave_columns,
         ]);
         out
     }

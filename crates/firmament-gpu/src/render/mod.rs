@@ -47,8 +47,11 @@
 pub(crate) mod frame;
 mod pipelines;
 pub mod stars;
+pub mod temporal;
 mod timing;
 
+use temporal::Extent;
+pub use temporal::{Interleave, TemporalFrames};
 pub use timing::RenderTiming;
 
 use std::sync::OnceLock;
@@ -115,6 +118,9 @@ pub struct RenderInputs<'a> {
     /// and 3D tables' frames; Hillaire 2020's sky-view pass at 0 and 1, its pixels at 2
     /// and 3. A viewer's per-pass times ([`crate::pass_timer::PassTimer`]).
     pub timestamps: Option<&'a wgpu::QuerySet>,
+    /// Draw one pixel of each k×k block only, each pixel's depth in alpha (a frame under
+    /// clouds, into a buffer in one band): a [`TemporalFrames`] resolves it.
+    pub interleave: Option<Interleave>,
 }
 
 /// The render pipelines, compiled once per context (the texture outputs on first use).
@@ -303,6 +309,19 @@ impl GpuRenderer {
         job: &Job,
         timestamps: Option<&wgpu::QuerySet>,
     ) {
+        self.record_then(encoder, &[job], timestamps, |_| {});
+    }
+
+    /// [`GpuRenderer::record`] of `jobs` (frames of one camera and lights: the first's
+    /// slices serve them all), then `after`'s dispatches, in one pass (within its
+    /// timestamps).
+    pub(crate) fn record_then(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        jobs: &[&Job],
+        timestamps: Option<&wgpu::QuerySet>,
+        after: impl FnOnce(&mut wgpu::ComputePass),
+    ) {
         let timestamp_writes = timestamps.map(|set| wgpu::ComputePassTimestampWrites {
             query_set: set,
             beginning_of_pass_write_index: Some(0),
@@ -312,16 +331,21 @@ impl GpuRenderer {
             label: Some("firmament frame"),
             timestamp_writes,
         });
-        if let (Some((x, y, z)), Some(bg)) = (job.slice, job.bind_groups.first()) {
-            cpass.set_pipeline(&job.pipelines.slice);
-            cpass.set_bind_group(0, bg, &[]);
-            cpass.dispatch_workgroups(x, y, z);
+        if let Some(job) = jobs.first() {
+            if let (Some((x, y, z)), Some(bg)) = (job.slice, job.bind_groups.first()) {
+                cpass.set_pipeline(&job.pipelines.slice);
+                cpass.set_bind_group(0, bg, &[]);
+                cpass.dispatch_workgroups(x, y, z);
+            }
         }
-        cpass.set_pipeline(job.main);
-        for (bg, &(x, y)) in job.bind_groups.iter().zip(&job.dispatches) {
-            cpass.set_bind_group(0, bg, &[]);
-            cpass.dispatch_workgroups(x, y, 1);
+        for job in jobs {
+            cpass.set_pipeline(job.main);
+            for (bg, &(x, y)) in job.bind_groups.iter().zip(&job.dispatches) {
+                cpass.set_bind_group(0, bg, &[]);
+                cpass.dispatch_workgroups(x, y, 1);
+            }
         }
+        after(&mut cpass);
     }
 
     /// Refuse a frame buffer larger than the device allocates.
@@ -435,6 +459,11 @@ impl GpuRenderer {
                 rows
             }
         };
+        let Extent {
+            rows: (row_start, row_end),
+            columns,
+            step,
+        } = Extent::of(&inputs, &target, (w, h), band_rows)?;
         let max_dim = limits.max_compute_workgroups_per_dimension;
         let (_, y) = workgroups(band_rows * w, max_dim);
         if y > max_dim {
@@ -455,8 +484,10 @@ impl GpuRenderer {
             Some(t) => t.uniform_words(sky, lights, settings)?,
             None => no_terrain_words(),
         };
-        let constants =
+        let mut constants =
             FrameConstants::new(sky, lights.len(), inputs.shadow_lengths.is_some(), settings);
+        constants.interleave = inputs.interleave.map_or(0, |il| il.word());
+        constants.interleave_columns = inputs.interleave.map_or(0, |il| il.columns_word());
         let device = ctx.device();
         scoped(ctx, "preparing the frame", || {
             let uniform = |label: &str, words: &[u32]| {
@@ -478,9 +509,9 @@ impl GpuRenderer {
             let tables = sky.tables();
             let mut bind_groups = Vec::new();
             let mut dispatches = Vec::new();
-            let mut first = 0;
-            while first < h {
-                let rows = band_rows.min(h - first);
+            let mut first = row_start;
+            while first < row_end {
+                let rows = band_rows.min(row_end - first);
                 let frame_uniform = uniform("frame constants", &constants.words(first, rows));
                 let output = match target {
                     RenderTarget::Buffer(buffer) => {
@@ -524,7 +555,8 @@ impl GpuRenderer {
                     layout: &pipelines.pass.layout,
                     entries: &entries,
                 }));
-                dispatches.push(workgroups(rows * w, max_dim));
+                let invocations = rows.div_ceil(step) * columns.div_ceil(step);
+                dispatches.push(workgroups(invocations, max_dim));
                 first += rows;
             }
             let slice = constants.inside.then(|| {

@@ -27,47 +27,17 @@ impl PointSplats {
     pub fn new(ctx: &GpuContext) -> Result<PointSplats, GpuError> {
         let device = ctx.device();
         scoped(ctx, "the stars' pass compilation", || {
-            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("stars"),
-                source: wgpu::ShaderSource::Wgsl(
-                    crate::passes::uniform_source(
-                        ctx,
-                        include_str!("../../shaders/render/stars.wgsl"),
-                    )
-                    .into(),
-                ),
-            });
-            let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-                binding,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            };
-            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("stars"),
-                entries: &[
-                    entry(0, wgpu::BufferBindingType::Storage { read_only: false }),
-                    entry(1, wgpu::BufferBindingType::Storage { read_only: true }),
-                    entry(2, crate::passes::uniform_binding(ctx)),
+            let (pipeline, layout) = crate::passes::buffer_pipeline(
+                ctx,
+                "stars",
+                include_str!("../../shaders/render/stars.wgsl"),
+                "add_points",
+                &[
+                    (0, wgpu::BufferBindingType::Storage { read_only: false }),
+                    (1, wgpu::BufferBindingType::Storage { read_only: true }),
+                    (2, crate::passes::uniform_binding(ctx)),
                 ],
-            });
-            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("stars"),
-                bind_group_layouts: &[Some(&layout)],
-                immediate_size: 0,
-            });
-            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("stars"),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some("add_points"),
-                compilation_options: Default::default(),
-                cache: None,
-            });
+            );
             let params = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("stars params"),
                 size: 16,

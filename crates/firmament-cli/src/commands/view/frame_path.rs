@@ -18,7 +18,7 @@ use firmament_gpu::display::{
 };
 use firmament_gpu::pass_timer::{PassTimer, PassTimes, SkySlots};
 use firmament_gpu::render::stars::PointSplats;
-use firmament_gpu::{GpuClouds, GpuPlanet, GpuTerrain, RenderTarget};
+use firmament_gpu::{GpuClouds, GpuPlanet, GpuTerrain, RenderTarget, TemporalFrames};
 
 use std::sync::Arc;
 
@@ -90,6 +90,12 @@ pub struct FramePath {
     /// The scene's surface map on the device, what its texture was baked for, and the
     /// observer's latitude and longitude on it (degrees).
     planet: Option<PlanetMap>,
+    /// Frames under clouds a share of the pixels at a time (made when first needed), and
+    /// what the scene was besides the camera when its history was drawn: anything else
+    /// changing resets it.
+    temporal: Option<(TemporalFrames, String)>,
+    /// Counts the skies and tables drawn (a new one resets the clouds' history).
+    sky_generation: u64,
     /// The reference path tracer's passes over the frame (`state.compare`).
     reference: Overlay,
     /// The atmosphere the reference traces, and the keys it was made for.
@@ -141,6 +147,8 @@ impl FramePath {
             gpu_clouds: None,
             points: None,
             planet: None,
+            temporal: None,
+            sky_generation: 0,
         })
     }
 
@@ -238,6 +246,28 @@ impl FramePath {
             && self.clouds.as_ref().is_some_and(|(_, _, m)| !m.is_empty())
     }
 
+    /// A line for the panel on the clouds' temporal frames: the share of pixels marched a
+    /// frame and whether the view has converged since the last change.
+    pub fn clouds_line(&self, state: &ViewState) -> Option<String> {
+        let (t, _) = self
+            .temporal
+            .as_ref()
+            .filter(|_| self.clouds_drawn(state))?;
+        let step = t.step();
+        if step == 1 {
+            return Some("clouds: every pixel marched each frame".into());
+        }
+        let needed = step * step;
+        let done = t.still_frames();
+        Some(if done >= needed {
+            format!("clouds: 1/{needed} of the pixels marched a frame; converged")
+        } else {
+            format!(
+                "clouds: 1/{needed} of the pixels marched a frame; {done} of {needed} frames since a change or a move (the rest reprojected or interpolated)"
+            )
+        })
+    }
+
     /// The sky in use (after [`FramePath::ensure_sky`]).
     pub fn sky(&self) -> Option<&RenderSky<'static>> {
         self.sky.as_ref().map(|(_, _, s)| s)
@@ -330,7 +360,7 @@ impl FramePath {
                         }
                         None => sky.gpu_clouds(media, &settings, sources, true)?,
                     };
-                    self.gpu_clouds = Some((light_key, uploaded));
+                    self.gpu_clouds = Some((light_key.clone(), uploaded));
                 }
                 if let (Some((_, c)), Some(v)) = (self.gpu_clouds.as_mut(), view) {
                     c.set_view(v);
@@ -357,6 +387,36 @@ impl FramePath {
             .collect();
         let splats = point_splats(&points, sky.model(), &settings, &occluders);
         let set = self.timer.as_ref().map(|t| t.query_set());
+        // Under clouds a share of the pixels marched, the rest from the previous frames:
+        // their history holds while only the camera moves.
+        let temporal = match clouds {
+            Some(_) => {
+                let scene = format!(
+                    "{:?}|{}|{}|{:?}|{}",
+                    light_key.lights,
+                    self.clouds.as_ref().map_or("", |(k, _, _)| k.as_str()),
+                    self.planet
+                        .as_ref()
+                        .map_or(String::new(), |m| format!("{}|{:?}", m.key, m.place)),
+                    state.scene.output.white_balance,
+                    self.sky_generation,
+                );
+                if self.temporal.is_none() {
+                    let made = TemporalFrames::new(self.ctx(), state.cloud_step)
+                        .map_err(|e| gpu_failure("the clouds' temporal resolve", e))?;
+                    self.temporal = Some((made, scene.clone()));
+                }
+                let (t, held) = self.temporal.as_mut().expect("just made");
+                t.set_step(state.cloud_step)
+                    .map_err(|e| gpu_failure("the clouds' temporal resolve", e))?;
+                if *held != scene {
+                    t.reset();
+                    *held = scene;
+                }
+                Some(t)
+            }
+            None => None,
+        };
         sky.encode_frame(
             encoder,
             &settings,
@@ -366,6 +426,7 @@ impl FramePath {
             terrain,
             clouds,
             self.planet.as_ref().map(|m| &m.gpu),
+            temporal,
         )?;
         let ctx = match self.backend {
             Backend::Gpu(gpu) => &gpu.ctx,

@@ -98,6 +98,7 @@ impl FramePath {
         sky.set_tables(tables)?;
         self.gpu_terrain = None;
         self.gpu_clouds = None;
+        self.sky_generation += 1;
         Ok(true)
     }
 
@@ -137,6 +138,7 @@ impl FramePath {
         self.terrain = terrain.map(Arc::new);
         self.gpu_terrain = None;
         self.gpu_clouds = None;
+        self.sky_generation += 1;
         self.amortised = None;
         self.update = None;
         Ok(())
@@ -175,6 +177,7 @@ impl FramePath {
             self.last_build_s = started.elapsed().as_secs_f64();
             self.gpu_terrain = None;
             self.gpu_clouds = None;
+            self.sky_generation += 1;
         }
         *held = air;
         self.args = Some(args);

@@ -41,6 +41,8 @@ pub struct PanelInfo {
     pub update: Option<String>,
     /// The reference's progress, in words.
     pub reference: Option<String>,
+    /// The clouds' temporal frames' progress, in words.
+    pub clouds: Option<String>,
     /// A line about the last capture or save, or an error.
     pub message: String,
     /// What the scene has that the viewer does not draw yet.
@@ -65,7 +67,7 @@ pub fn panel(ui: &mut egui::Ui, state: &mut ViewState, info: &PanelInfo) -> Pane
             ui.radio_value(&mut state.method, m, m.name());
         }
     });
-    if let Some(line) = &info.update {
+    for line in [&info.update, &info.clouds].into_iter().flatten() {
         ui.small(line);
     }
     ui.horizontal(|ui| {
@@ -437,6 +439,17 @@ mod tests {
         h.run();
         let p = h.state().scene.clouds[0].resolved();
         assert_eq!((p.bottom_m, p.top_m), (8000.0, 9500.0));
+        // A sixteenth of the pixels marched a frame, then every pixel.
+        assert_eq!(
+            h.state().cloud_step,
+            super::super::state::DEFAULT_CLOUD_STEP
+        );
+        h.get_by_label("1/16").click();
+        h.run();
+        assert_eq!(h.state().cloud_step, 4);
+        h.get_by_label("all").click();
+        h.run();
+        assert_eq!(h.state().cloud_step, 1);
         h.get_by_label("add a layer").click();
         h.run();
         assert_eq!(h.state().scene.clouds.len(), 2);

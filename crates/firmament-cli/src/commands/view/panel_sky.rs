@@ -151,6 +151,19 @@ pub(super) fn clouds_section(ui: &mut egui::Ui, state: &mut ViewState) {
             state.scene.clouds.push(layer);
         }
     });
+    if !state.scene.clouds.is_empty() {
+        ui.horizontal(|ui| {
+            ui.label("pixels marched a frame:");
+            for (step, label) in [(1, "all"), (2, "1/4"), (4, "1/16")] {
+                if ui
+                    .selectable_label(state.cloud_step == step, label)
+                    .clicked()
+                {
+                    state.cloud_step = step;
+                }
+            }
+        });
+    }
     let mut remove = None;
     for (i, layer) in state.scene.clouds.iter_mut().enumerate() {
         ui.horizontal(|ui| {
