@@ -57,20 +57,18 @@ fn clear_scene(dir: &Path) -> std::path::PathBuf {
 }
 
 /// The offscreen viewer's frame of `scene`, its scene saved: the second frame, or under
-/// clouds the fourth (the viewer marches a quarter of their pixels a frame: a still view is
-/// the full frame after four).
+/// clouds or over a terrain the fourth (the viewer marches a quarter of their pixels a
+/// frame: a still view is the full frame after four).
 fn offscreen(dir: &Path, scene: &Path, size: (u32, u32), method: &str) -> std::process::Output {
-    let cloudy = !firmament::scene::SceneFile::from_file(scene)
-        .unwrap()
-        .clouds
-        .is_empty();
+    let file = firmament::scene::SceneFile::from_file(scene).unwrap();
+    let marched = !file.clouds.is_empty() || file.terrain.is_some();
     run(&[
         "view",
         "--scene",
         scene.to_str().unwrap(),
         "--offscreen",
         "--frames",
-        if cloudy { "4" } else { "2" },
+        if marched { "4" } else { "2" },
         "--width",
         &size.0.to_string(),
         "--height",
@@ -360,7 +358,7 @@ fn the_viewer_draws_the_clouds_over_the_terrain_as_render_does() {
     let said = String::from_utf8_lossy(&out.stderr);
     assert!(!said.contains("over a terrain"), "{said}");
     assert!(
-        said.contains("clouds: 1/4 of the pixels marched a frame; converged"),
+        said.contains("march: 1/4 of the pixels a frame; converged"),
         "{said}"
     );
     let text = std::fs::read_to_string(dir.join("scene.toml")).unwrap();
@@ -469,8 +467,8 @@ fn the_viewer_refuses_what_it_cannot_do() {
         &["--render-scale", "0.1 to 1"],
     );
     fails_with(
-        &run(&["view", "--offscreen", "--frames", "1", "--cloud-step", "3"]),
-        &["--cloud-step", "1, 2, 4"],
+        &run(&["view", "--offscreen", "--frames", "1", "--march-step", "3"]),
+        &["--march-step", "1, 2, 4"],
     );
     assert!(!jpg.exists());
 }

@@ -315,7 +315,7 @@ impl<'a> RenderSky<'a> {
     /// only); no stars (those
     /// need the CPU's parts of [`RenderSky::render`]); `timestamps` as
     /// `RenderInputs::timestamps`, over the planet's map `planet` ([`RenderSky::gpu_planet`];
-    /// every method); under clouds with `temporal` (a buffer target), one pixel of each of its
+    /// every method); under clouds or over a terrain with `temporal` (a buffer target), one pixel of each of its
     /// blocks marched and the rest resolved from the previous frames
     /// ([`TemporalFrames::encode`]). The viewer's frame path.
     #[allow(clippy::too_many_arguments)]
@@ -348,7 +348,8 @@ impl<'a> RenderSky<'a> {
             RenderSky::Gpu {
                 gpu, sky, renderer, ..
             } => match (temporal, target) {
-                // Under clouds a share of the pixels, the rest from the previous frames.
+                // Under clouds or over a terrain a share of the pixels, the rest from the
+                // previous frames.
                 (Some(t), RenderTarget::Buffer(output)) => {
                     let ctx = &gpu.ctx;
                     t.encode(

@@ -4,6 +4,7 @@
 // function but firmament_gpu::hillaire2020::render never dispatches it.
 
 // Shader::shade of the clear sky (no surface but the ground sphere, no shadowed length).
-fn shade_scene(dir: vec3<f32>) -> vec3<f32> {
-    return shade(dir, 0.0);
+// (The depth of render/scene.wgsl's shade_scene: none kept, as this is never interleaved.)
+fn shade_scene(dir: vec3<f32>) -> vec4<f32> {
+    return vec4<f32>(shade(dir, 0.0), SKY_DEPTH_M);
 }

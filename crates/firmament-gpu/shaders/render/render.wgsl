@@ -160,16 +160,19 @@ fn main_terrain(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     var out = vec4<f32>(0.0);
     if (p.ray.valid) {
         var rgb = vec3<f32>(0.0);
+        var depth_m = SKY_DEPTH_M;
         // One ray, or DISK_SUBSAMPLES² over the footprint of a pixel on a disk's edge.
         let n = pixel_rays(p);
         for (var k = 0u; k < n; k++) {
             let r = pixel_ray(p, k, n);
             if (r.valid) {
-                rgb += shade_scene(r.dir);
+                let shaded = shade_scene(r.dir);
+                rgb += shaded.xyz;
+                depth_m = shaded.w;
             }
         }
         rgb /= f32(n);
-        out = vec4<f32>(rgb * frame.balance.xyz, 1.0);
+        out = vec4<f32>(rgb * frame.balance.xyz, select(1.0, depth_m, depth_in_alpha()));
     }
     write_pixel(p.i, p.x, p.y, out);
 }

@@ -129,8 +129,9 @@ fn shafts(v: View, l: u32, vl: ViewLight, ray: GridRay, pray: PointRay, start: P
     return lit_at_end;
 }
 
-// Shader::shade over the terrain, summed to linear sRGB over the lights and channel groups.
-fn shade_scene(dir: vec3<f32>) -> vec3<f32> {
+// Shader::shade over the terrain, summed to linear sRGB over the lights and channel groups,
+// and the ray's depth (m; SKY_DEPTH_M towards the sky) for the temporal resolve.
+fn shade_scene(dir: vec3<f32>) -> vec4<f32> {
     let o = observer();
     var v: View;
     v.mie_layout = frame.mie_layout;
@@ -240,5 +241,5 @@ fn shade_scene(dir: vec3<f32>) -> vec3<f32> {
     for (var k = 0u; k < atm.groups; k++) {
         rgb += to_srgb(air_volume_add(dir, hit.t_m, k), k);
     }
-    return rgb;
+    return vec4<f32>(rgb, select(SKY_DEPTH_M, max(hit.t_m, 1e-3), hit.hit));
 }

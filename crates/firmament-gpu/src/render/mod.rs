@@ -119,7 +119,8 @@ pub struct RenderInputs<'a> {
     /// and 3. A viewer's per-pass times ([`crate::pass_timer::PassTimer`]).
     pub timestamps: Option<&'a wgpu::QuerySet>,
     /// Draw one pixel of each k×k block only, each pixel's depth in alpha (a frame under
-    /// clouds, into a buffer in one band): a [`TemporalFrames`] resolves it.
+    /// clouds or over a terrain, into a buffer in one band): a [`TemporalFrames`] resolves
+    /// it.
     pub interleave: Option<Interleave>,
 }
 

@@ -1,15 +1,17 @@
-//! Frames under clouds at a fraction of the cost, for the viewer: each frame marches one
-//! pixel of every k×k block (an interleaved frame, [`Interleave`]: k = 2 draws a quarter of
-//! the pixels), and a resolve pass (`shaders/render/temporal.wgsl`) fills the others from
-//! the previous frames, reprojected through the two pinhole cameras at the depths of the
-//! pixels drawn around them, or, where nothing matches (the first frame after a change, a
-//! disocclusion, the view's new edge), from the drawn pixels around them (Schneider 2015,
-//! "The real-time volumetric cloudscapes of Horizon Zero Dawn"; Hillaire 2016 §4.4). The
-//! blocks' pixels are visited in ordered-dither (Bayer) order, so that each frame's pixels lie
-//! between the previous ones'. With the camera and the scene still, k² frames give every
-//! pixel its own march: the converged frame, exactly. Anything but the camera changing (the
-//! lights, the atmosphere, the clouds) calls for [`TemporalFrames::reset`]: the history is
-//! then not read. Offline frames (`render --backend gpu`) march every pixel.
+//! Frames under clouds or over a terrain at a fraction of the cost, for the viewer: each
+//! frame marches one pixel of every k×k block (an interleaved frame, [`Interleave`]: k = 2
+//! draws a quarter of the pixels), and a resolve pass (`shaders/render/temporal.wgsl`)
+//! fills the others from the previous frames, reprojected through the two pinhole cameras
+//! at the depths of the pixels drawn around them, or, where nothing matches (the first
+//! frame after a change, a disocclusion, the view's new edge), from the drawn pixels around
+//! them (Schneider 2015, "The real-time volumetric cloudscapes of Horizon Zero Dawn";
+//! Hillaire 2016 §4.4). The blocks' pixels are visited in ordered-dither (Bayer) order, so
+//! that each frame's pixels lie between the previous ones'; a window around each visible
+//! light disk is marched whole every frame. With the camera and the scene still, k² frames
+//! give every pixel its own march: the converged frame, exactly. Anything but the camera
+//! changing (the lights, the atmosphere, the clouds, the terrain) calls for
+//! [`TemporalFrames::reset`]: the history is then not read. Offline frames (`render
+//! --backend gpu`) march every pixel.
 
 use firmament::math::Vec3;
 use firmament::render::RenderSettings;
@@ -123,8 +125,9 @@ pub(crate) struct Extent {
 
 impl Extent {
     /// The extent of a `w`×`h` frame drawn into `target` in bands of `band_rows` rows;
-    /// refuses an interleaved frame without clouds (their depth drives the resolve), in
-    /// several bands or into a texture.
+    /// refuses an interleaved frame neither under clouds nor over a terrain (the frames
+    /// whose entry points write the depth that drives the resolve), in several bands or into
+    /// a texture.
     pub(crate) fn of(
         inputs: &RenderInputs,
         target: &RenderTarget,
@@ -139,11 +142,11 @@ impl Extent {
             });
         };
         il.check(w, h)?;
-        if inputs.clouds.is_none() {
+        if inputs.clouds.is_none() && inputs.terrain.is_none() {
             return Err(firmament::Error::invalid(
                 "RenderInputs.interleave",
-                "a frame without clouds",
-                "interleaved frames under clouds",
+                "a frame without clouds or a terrain",
+                "interleaved frames under clouds or over a terrain",
             )
             .into());
         }
@@ -292,9 +295,10 @@ impl TemporalFrames {
     }
 
     /// Record the next frame into `output` (a frame buffer of `settings`' size, as
-    /// [`GpuRenderer::frame_buffer`]): under clouds (`inputs.clouds`) one pixel of each
+    /// [`GpuRenderer::frame_buffer`]): under clouds or over a terrain one pixel of each
     /// block marched, then the resolve, in one compute pass (within `inputs.timestamps`);
-    /// without clouds, or at step 1, the frame as [`GpuRenderer::encode`] draws it.
+    /// the clear sky over the sphere (cheap), or any frame at step 1, as
+    /// [`GpuRenderer::encode`] draws it.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &mut self,
@@ -307,7 +311,7 @@ impl TemporalFrames {
         output: &wgpu::Buffer,
         inputs: RenderInputs,
     ) -> Result<(), GpuError> {
-        if self.step == 1 || inputs.clouds.is_none() {
+        if self.step == 1 || (inputs.clouds.is_none() && inputs.terrain.is_none()) {
             self.reset();
             let target = RenderTarget::Buffer(output);
             return renderer.encode(ctx, encoder, sky, lights, settings, target, inputs);

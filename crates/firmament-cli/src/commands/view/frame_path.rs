@@ -246,24 +246,24 @@ impl FramePath {
             && self.clouds.as_ref().is_some_and(|(_, _, m)| !m.is_empty())
     }
 
-    /// A line for the panel on the clouds' temporal frames: the share of pixels marched a
-    /// frame and whether the view has converged since the last change.
-    pub fn clouds_line(&self, state: &ViewState) -> Option<String> {
-        let (t, _) = self
-            .temporal
-            .as_ref()
-            .filter(|_| self.clouds_drawn(state))?;
+    /// A line for the panel on the temporal frames under clouds or over a terrain: the
+    /// share of pixels marched a frame and whether the view has converged since the last
+    /// change.
+    pub fn march_line(&self, state: &ViewState) -> Option<String> {
+        let marched = self.clouds_drawn(state)
+            || (self.terrain.is_some() && state.method == Method::Bruneton4d);
+        let (t, _) = self.temporal.as_ref().filter(|_| marched)?;
         let step = t.step();
         if step == 1 {
-            return Some("clouds: every pixel marched each frame".into());
+            return Some("march: every pixel each frame".into());
         }
         let needed = step * step;
         let done = t.still_frames();
         Some(if done >= needed {
-            format!("clouds: 1/{needed} of the pixels marched a frame; converged")
+            format!("march: 1/{needed} of the pixels a frame; converged")
         } else {
             format!(
-                "clouds: 1/{needed} of the pixels marched a frame; {done} of {needed} frames since a change or a move (the rest reprojected or interpolated)"
+                "march: 1/{needed} of the pixels a frame; {done} of {needed} frames since a change or a move (the rest reprojected or interpolated)"
             )
         })
     }
@@ -387,10 +387,11 @@ impl FramePath {
             .collect();
         let splats = point_splats(&points, sky.model(), &settings, &occluders);
         let set = self.timer.as_ref().map(|t| t.query_set());
-        // Under clouds a share of the pixels marched, the rest from the previous frames:
-        // their history holds while only the camera moves.
-        let temporal = match clouds {
-            Some(_) => {
+        // Under clouds or over a terrain a share of the pixels marched, the rest from the
+        // previous frames: their history holds while only the camera moves.
+        let temporal = match (clouds, terrain) {
+            (None, None) => None,
+            _ => {
                 let scene = format!(
                     "{:?}|{}|{}|{:?}|{}",
                     light_key.lights,
@@ -402,20 +403,19 @@ impl FramePath {
                     self.sky_generation,
                 );
                 if self.temporal.is_none() {
-                    let made = TemporalFrames::new(self.ctx(), state.cloud_step)
-                        .map_err(|e| gpu_failure("the clouds' temporal resolve", e))?;
+                    let made = TemporalFrames::new(self.ctx(), state.march_step)
+                        .map_err(|e| gpu_failure("the temporal resolve", e))?;
                     self.temporal = Some((made, scene.clone()));
                 }
                 let (t, held) = self.temporal.as_mut().expect("just made");
-                t.set_step(state.cloud_step)
-                    .map_err(|e| gpu_failure("the clouds' temporal resolve", e))?;
+                t.set_step(state.march_step)
+                    .map_err(|e| gpu_failure("the temporal resolve", e))?;
                 if *held != scene {
                     t.reset();
                     *held = scene;
                 }
                 Some(t)
             }
-            None => None,
         };
         sky.encode_frame(
             encoder,

@@ -51,12 +51,13 @@ pub struct ViewArgs {
     /// 0.5 on a software rasteriser).
     #[arg(long, value_name = "0.1-1")]
     pub render_scale: Option<f64>,
-    /// Under clouds, march one pixel of each N×N block a frame and take the others from
-    /// the previous frames (reprojected as the camera turns or climbs) or, where they do not
-    /// match, from this frame's pixels around them: 1 marches every pixel every frame, 2 a
-    /// quarter, 4 a sixteenth; a still view is the full frame after N² frames.
-    #[arg(long, default_value_t = state::DEFAULT_CLOUD_STEP, value_name = "1|2|4")]
-    pub cloud_step: u32,
+    /// Under clouds or over a terrain, march one pixel of each N×N block a frame and take
+    /// the others from the previous frames (reprojected as the camera turns or climbs) or,
+    /// where they do not match, from this frame's pixels around them: 1 marches every pixel
+    /// every frame, 2 a quarter, 4 a sixteenth; a still view is the full frame after N²
+    /// frames.
+    #[arg(long, default_value_t = state::DEFAULT_MARCH_STEP, value_name = "1|2|4")]
+    pub march_step: u32,
     /// Draw this many frames, write `--screenshot`, and exit.
     #[arg(long, value_name = "N")]
     pub frames: Option<u32>,
@@ -133,10 +134,10 @@ fn check(args: &ViewArgs) -> Result<()> {
             anyhow::bail!("invalid value for `{name}`: {v} (accepted: 16 to 8192)");
         }
     }
-    if !firmament_gpu::render::temporal::STEPS.contains(&args.cloud_step) {
+    if !firmament_gpu::render::temporal::STEPS.contains(&args.march_step) {
         anyhow::bail!(
-            "invalid value for `--cloud-step`: {} (accepted: 1, 2, 4)",
-            args.cloud_step
+            "invalid value for `--march-step`: {} (accepted: 1, 2, 4)",
+            args.march_step
         );
     }
     if args.frames == Some(0) {
@@ -203,7 +204,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     }
     let mut state = ViewState::new(scene, args.method, false);
     state.compare = compare_of(&args.reference)?;
-    state.cloud_step = args.cloud_step;
+    state.march_step = args.march_step;
     if let Some(s) = args.render_scale {
         state.render_scale = s;
     }
@@ -243,7 +244,7 @@ fn run_offscreen(args: &ViewArgs, mut state: ViewState) -> Result<()> {
             started.elapsed().as_secs_f64()
         );
     }
-    if let Some(line) = path.clouds_line(&state) {
+    if let Some(line) = path.march_line(&state) {
         if !args.quiet {
             eprintln!("view: {line}");
         }

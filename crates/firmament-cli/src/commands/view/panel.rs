@@ -41,8 +41,8 @@ pub struct PanelInfo {
     pub update: Option<String>,
     /// The reference's progress, in words.
     pub reference: Option<String>,
-    /// The clouds' temporal frames' progress, in words.
-    pub clouds: Option<String>,
+    /// The temporal frames' progress (under clouds or over a terrain), in words.
+    pub march: Option<String>,
     /// A line about the last capture or save, or an error.
     pub message: String,
     /// What the scene has that the viewer does not draw yet.
@@ -67,7 +67,7 @@ pub fn panel(ui: &mut egui::Ui, state: &mut ViewState, info: &PanelInfo) -> Pane
             ui.radio_value(&mut state.method, m, m.name());
         }
     });
-    for line in [&info.update, &info.clouds].into_iter().flatten() {
+    for line in [&info.update, &info.march].into_iter().flatten() {
         ui.small(line);
     }
     ui.horizontal(|ui| {
@@ -441,15 +441,15 @@ mod tests {
         assert_eq!((p.bottom_m, p.top_m), (8000.0, 9500.0));
         // A sixteenth of the pixels marched a frame, then every pixel.
         assert_eq!(
-            h.state().cloud_step,
-            super::super::state::DEFAULT_CLOUD_STEP
+            h.state().march_step,
+            super::super::state::DEFAULT_MARCH_STEP
         );
         h.get_by_label("1/16").click();
         h.run();
-        assert_eq!(h.state().cloud_step, 4);
+        assert_eq!(h.state().march_step, 4);
         h.get_by_label("all").click();
         h.run();
-        assert_eq!(h.state().cloud_step, 1);
+        assert_eq!(h.state().march_step, 1);
         h.get_by_label("add a layer").click();
         h.run();
         assert_eq!(h.state().scene.clouds.len(), 2);

@@ -151,15 +151,15 @@ pub(super) fn clouds_section(ui: &mut egui::Ui, state: &mut ViewState) {
             state.scene.clouds.push(layer);
         }
     });
-    if !state.scene.clouds.is_empty() {
+    if !state.scene.clouds.is_empty() || state.scene.terrain.is_some() {
         ui.horizontal(|ui| {
             ui.label("pixels marched a frame:");
             for (step, label) in [(1, "all"), (2, "1/4"), (4, "1/16")] {
                 if ui
-                    .selectable_label(state.cloud_step == step, label)
+                    .selectable_label(state.march_step == step, label)
                     .clicked()
                 {
-                    state.cloud_step = step;
+                    state.march_step = step;
                 }
             }
         });

@@ -20,9 +20,9 @@ pub const PRESETS: [&str; 5] = ["earth", "bruneton2008", "frostbite2016", "hazy"
 
 /// The highest camera altitude the viewer flies to (m): geostationary orbit.
 pub const MAX_ALTITUDE_M: f64 = 35_786_000.0;
-/// The viewer's cloud step: a quarter of the pixels marched a frame (a still view is the
-/// full frame after four).
-pub const DEFAULT_CLOUD_STEP: u32 = 2;
+/// The viewer's step under clouds or over a terrain: a quarter of the pixels marched a
+/// frame (a still view is the full frame after four).
+pub const DEFAULT_MARCH_STEP: u32 = 2;
 
 /// The viewer's state.
 #[derive(Clone, Debug, PartialEq)]
@@ -44,9 +44,10 @@ pub struct ViewState {
     pub update_frames: usize,
     /// The reference path tracer beside the method's frame (or instead of it).
     pub compare: Compare,
-    /// Under clouds, one pixel of each N×N block marched a frame, the others from the
-    /// previous frames reprojected (`firmament_gpu::TemporalFrames`): 1, 2 or 4.
-    pub cloud_step: u32,
+    /// Under clouds or over a terrain, one pixel of each N×N block marched a frame, the
+    /// others from the previous frames reprojected (`firmament_gpu::TemporalFrames`): 1, 2
+    /// or 4.
+    pub march_step: u32,
     /// [`ViewState::air_values`] of the atmosphere last asked (preset, file).
     air_cache: Option<(AirSource, Option<AirValues>)>,
 }
@@ -103,7 +104,7 @@ impl ViewState {
             update_frames: 8,
             air_cache: None,
             compare: Compare::Off,
-            cloud_step: DEFAULT_CLOUD_STEP,
+            march_step: DEFAULT_MARCH_STEP,
         }
     }
 

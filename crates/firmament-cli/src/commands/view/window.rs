@@ -386,7 +386,7 @@ impl App {
             .submit(extra.into_iter().chain([encoder.finish()]));
         g.path.submitted();
         self.info.reference = g.path.reference_line();
-        self.info.clouds = g.path.clouds_line(&self.state);
+        self.info.march = g.path.march_line(&self.state);
         self.info.gpu_ms = g.path.pass_times().map(|t| (t.sky_ms, t.display_ms));
         if let Some(staging) = &copy {
             let shown = read_copy(ctx, staging, &frame.texture)?;

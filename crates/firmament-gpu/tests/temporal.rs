@@ -1,17 +1,19 @@
-//! Frames under clouds a quarter (or a sixteenth) of the pixels at a time
+//! Frames under clouds or over a terrain a quarter (or a sixteenth) of the pixels at a time
 //! (`firmament_gpu::TemporalFrames`, the viewer's): against the full frame of the same
 //! camera, drawn by `GpuRenderer` marching every pixel. With the camera still the k² phases
-//! rebuild the full frame exactly; a turned and raised camera reuses the reprojected history
-//! (closer to the full frame than this frame's pixels interpolated alone); a reset forgets
-//! it. Cumulus from the ground, 48×28, RGB small tables.
+//! rebuild the full frame exactly; a turned camera reuses the previous frame reprojected,
+//! a turned and raised one is closer to the full frame than this frame's pixels
+//! interpolated alone; a reset forgets the history; a visible sun's disk is drawn whole
+//! every frame. Cumulus from the ground and the valley's terrain, 96×56, RGB small tables.
 
 mod common;
 
 use firmament::math::Vec3;
 use firmament::render::{Frame, RenderSettings, Shader};
 use firmament::scene::clouds::{cloud_media, CloudKind, CloudLayerConfig, CloudNoise};
+use firmament::scene::terrain::TerrainConfig;
 use firmament::scene::{sun_direction, Camera, Light, Projection, Scene};
-use firmament_gpu::{GpuClouds, GpuSky, RenderInputs, TemporalFrames};
+use firmament_gpu::{GpuClouds, GpuSky, GpuTerrain, RenderInputs, TemporalFrames};
 
 use common::*;
 
@@ -49,16 +51,16 @@ fn picture(name: &str, frame: &Frame) {
     }
 }
 
-struct Setup {
+struct Setup<'a> {
     gpu: &'static Gpu,
-    sky: GpuSky,
-    /// The clouds' shadow maps for the sun at 40° and at 70° from the zenith.
-    clouds: GpuClouds,
-    clouds_later: GpuClouds,
+    sky: &'a GpuSky,
+    /// What a frame takes besides the sky, for its lights (the clouds' or the terrain's
+    /// uploads are per light).
+    inputs: Box<dyn Fn(&[Light]) -> RenderInputs<'a> + 'a>,
 }
 
-impl Setup {
-    fn settings<'c>(camera: &'c Camera) -> RenderSettings<'c> {
+impl Setup<'_> {
+    fn settings(camera: &Camera) -> RenderSettings<'_> {
         RenderSettings {
             camera,
             width: SIZE.0,
@@ -68,27 +70,16 @@ impl Setup {
     }
 
     /// Every pixel marched.
-    /// The clouds uploaded for `lights`.
-    fn clouds_for(&self, lights: &[Light]) -> &GpuClouds {
-        if lights[0].direction == self.later_sun() {
-            &self.clouds_later
-        } else {
-            &self.clouds
-        }
-    }
-
-    fn later_sun(&self) -> Vec3 {
-        sun_direction(70.0, 200.0)
-    }
-
     fn full(&self, camera: &Camera, lights: &[Light]) -> Frame {
-        let inputs = RenderInputs {
-            clouds: Some(self.clouds_for(lights)),
-            ..RenderInputs::default()
-        };
         let settings = Self::settings(camera);
         (self.gpu.renderer)
-            .render_with(&self.gpu.ctx, &self.sky, lights, &settings, inputs)
+            .render_with(
+                &self.gpu.ctx,
+                self.sky,
+                lights,
+                &settings,
+                (self.inputs)(lights),
+            )
             .unwrap()
     }
 
@@ -105,15 +96,12 @@ impl Setup {
         let output = renderer.frame_buffer(ctx, &settings);
         for _ in 0..frames {
             let mut encoder = ctx.device().create_command_encoder(&Default::default());
-            let inputs = RenderInputs {
-                clouds: Some(self.clouds_for(lights)),
-                ..RenderInputs::default()
-            };
+            let inputs = (self.inputs)(lights);
             t.encode(
                 ctx,
                 &mut encoder,
                 renderer,
-                &self.sky,
+                self.sky,
                 lights,
                 &settings,
                 &output,
@@ -124,6 +112,62 @@ impl Setup {
         }
         renderer.read_frame(ctx, &output, SIZE.0, SIZE.1).unwrap()
     }
+}
+
+/// The share of the pixels `turned` did not draw (its phase (0, 0) at step 2) that equal
+/// `before_frame` of `before` reprojected: bilinear at the pixel's direction in the previous
+/// camera, found through `PreparedCamera::ray` independently of the shader, within 10⁻⁴.
+fn reprojected_share(
+    before: &Camera,
+    turned: &Camera,
+    before_frame: &Frame,
+    turned_frame: &Frame,
+    radius: f64,
+) -> f64 {
+    let (b, now) = (
+        before.prepare(radius, SIZE.0, SIZE.1),
+        turned.prepare(radius, SIZE.0, SIZE.1),
+    );
+    let (mut matched, mut undrawn) = (0, 0);
+    for y in 0..SIZE.1 {
+        for x in 0..SIZE.0 {
+            if x % 2 == 0 && y % 2 == 0 {
+                continue;
+            }
+            let dir = now.ray(x as f64 + 0.5, y as f64 + 0.5).unwrap().dir;
+            // Where the previous camera saw `dir`: Newton steps on its ray through (px, py).
+            let (mut px, mut py) = (x as f64 + 0.5, y as f64 + 0.5);
+            for _ in 0..20 {
+                let at = |px: f64, py: f64| b.ray(px, py).unwrap().dir;
+                let (d, e) = (1e-3, at(px, py));
+                let (dx, dy) = ((at(px + d, py) - e) / d, (at(px, py + d) - e) / d);
+                let r = dir - e;
+                // Least squares in the two image directions.
+                let (a, bb, c) = (dx.dot(dx), dx.dot(dy), dy.dot(dy));
+                let (p, q) = (dx.dot(r), dy.dot(r));
+                let det = a * c - bb * bb;
+                px += (c * p - bb * q) / det;
+                py += (a * q - bb * p) / det;
+            }
+            let (cx, cy) = (px - 0.5, py - 0.5);
+            let (x0, y0) = (cx.floor(), cy.floor());
+            if x0 < 0.0 || y0 < 0.0 || x0 + 1.0 >= SIZE.0 as f64 || y0 + 1.0 >= SIZE.1 as f64 {
+                continue;
+            }
+            let (fx, fy) = (cx - x0, cy - y0);
+            let l = |i: f64, j: f64| {
+                luminance(&before_frame.image.data[j as usize * SIZE.0 + i as usize])
+            };
+            let expected = (1.0 - fy) * ((1.0 - fx) * l(x0, y0) + fx * l(x0 + 1.0, y0))
+                + fy * ((1.0 - fx) * l(x0, y0 + 1.0) + fx * l(x0 + 1.0, y0 + 1.0));
+            let got = luminance(&turned_frame.image.data[y * SIZE.0 + x]);
+            undrawn += 1;
+            if (got - expected).abs() <= 1e-4 * expected {
+                matched += 1;
+            }
+        }
+    }
+    matched as f64 / undrawn as f64
 }
 
 #[test]
@@ -152,11 +196,18 @@ fn interleaved_cloud_frames_converge_reproject_and_reset() {
         GpuClouds::new(&gpu.ctx, &gpu_sky, &media, &shader).unwrap()
     };
     let (clouds, clouds_later) = (upload(40.0), upload(70.0));
+    let later_sun = sun_direction(70.0, 200.0);
     let setup = Setup {
         gpu,
-        sky: gpu_sky,
-        clouds,
-        clouds_later,
+        sky: &gpu_sky,
+        inputs: Box::new(|lights: &[Light]| RenderInputs {
+            clouds: Some(if lights[0].direction == later_sun {
+                &clouds_later
+            } else {
+                &clouds
+            }),
+            ..RenderInputs::default()
+        }),
     };
     let full = setup.full(&camera, &lights);
     picture("full", &full);
@@ -197,49 +248,11 @@ fn interleaved_cloud_frames_converge_reproject_and_reset() {
     let turned_frame = setup.temporal(&mut t, &turned, &lights, 1);
     assert_eq!(t.still_frames(), 1, "the camera moved");
     picture("turned-reprojected", &turned_frame);
-    let (before, now) = (
-        camera.prepare(radius, SIZE.0, SIZE.1),
-        turned.prepare(radius, SIZE.0, SIZE.1),
+    let share = reprojected_share(&camera, &turned, &full, &turned_frame, radius);
+    eprintln!(
+        "turned: {:.1} % of the undrawn pixels are the previous frame's, reprojected",
+        100.0 * share
     );
-    let (mut matched, mut undrawn) = (0, 0);
-    for y in 0..SIZE.1 {
-        for x in 0..SIZE.0 {
-            if x % 2 == 0 && y % 2 == 0 {
-                continue;
-            }
-            let dir = now.ray(x as f64 + 0.5, y as f64 + 0.5).unwrap().dir;
-            // Where the previous camera saw `dir`: Newton steps on its ray through (px, py).
-            let (mut px, mut py) = (x as f64 + 0.5, y as f64 + 0.5);
-            for _ in 0..20 {
-                let at = |px: f64, py: f64| before.ray(px, py).unwrap().dir;
-                let (d, e) = (1e-3, at(px, py));
-                let (dx, dy) = ((at(px + d, py) - e) / d, (at(px, py + d) - e) / d);
-                let r = dir - e;
-                // Least squares in the two image directions.
-                let (a, b, c) = (dx.dot(dx), dx.dot(dy), dy.dot(dy));
-                let (p, q) = (dx.dot(r), dy.dot(r));
-                let det = a * c - b * b;
-                px += (c * p - b * q) / det;
-                py += (a * q - b * p) / det;
-            }
-            let (cx, cy) = (px - 0.5, py - 0.5);
-            let (x0, y0) = (cx.floor(), cy.floor());
-            if x0 < 0.0 || y0 < 0.0 || x0 + 1.0 >= SIZE.0 as f64 || y0 + 1.0 >= SIZE.1 as f64 {
-                continue;
-            }
-            let (fx, fy) = (cx - x0, cy - y0);
-            let l = |i: f64, j: f64| luminance(&full.image.data[j as usize * SIZE.0 + i as usize]);
-            let expected = (1.0 - fy) * ((1.0 - fx) * l(x0, y0) + fx * l(x0 + 1.0, y0))
-                + fy * ((1.0 - fx) * l(x0, y0 + 1.0) + fx * l(x0 + 1.0, y0 + 1.0));
-            let got = luminance(&turned_frame.image.data[y * SIZE.0 + x]);
-            undrawn += 1;
-            if (got - expected).abs() <= 1e-4 * expected {
-                matched += 1;
-            }
-        }
-    }
-    let share = matched as f64 / undrawn as f64;
-    eprintln!("turned: {matched} of {undrawn} undrawn pixels are the previous frame's, reprojected ({:.1} %)", 100.0 * share);
     assert!(
         share > 0.7,
         "only {share} of the undrawn pixels reprojected"
@@ -334,10 +347,84 @@ fn interleaved_cloud_frames_converge_reproject_and_reset() {
     let settings = Setup::settings(&camera);
     let Err(e) = gpu
         .renderer
-        .render_with(&gpu.ctx, &setup.sky, &lights, &settings, inputs)
+        .render_with(&gpu.ctx, setup.sky, &lights, &settings, inputs)
     else {
         panic!("an interleaved frame without clouds was drawn");
     };
     let e = e.to_string();
     assert!(e.contains("interleave"), "{e}");
+}
+
+#[test]
+fn interleaved_terrain_frames_converge_and_reproject() {
+    let Some(gpu) = gpu("interleaved_terrain_frames_converge_and_reproject") else {
+        return;
+    };
+    let _guard = serial();
+    // The valley from 25 m at golden hour, the sun behind the ridges ahead (its shafts).
+    let (terrain, sky) = valley(TerrainConfig {
+        resolution: 257,
+        ..TerrainConfig::default()
+    });
+    let bottom = sky.model.bottom_radius_m;
+    let altitude = 25.0 + terrain.height_at(0.0, 0.0) - (bottom - terrain.radius_m);
+    let camera = common::camera(Projection::Perspective, altitude, 250.0, 4.0, 60.0);
+    let mut scene = Scene::clear_sky(&sky, sun_direction(84.5, 237.0), false);
+    scene.add_terrain(&terrain, terrain.radius_m);
+    let lights = scene.lights.clone();
+    let shader = Shader::new(&scene, Vec3::new(0.0, 0.0, bottom + altitude)).unwrap();
+    let gpu_sky = GpuSky::from_sky(&gpu.ctx, &sky).unwrap();
+    let gpu_terrain = GpuTerrain::new(&gpu.ctx, &gpu_sky, &terrain, &shader).unwrap();
+    let setup = Setup {
+        gpu,
+        sky: &gpu_sky,
+        inputs: Box::new(|_: &[Light]| RenderInputs {
+            terrain: Some(&gpu_terrain),
+            ..RenderInputs::default()
+        }),
+    };
+    let full = setup.full(&camera, &lights);
+    picture("terrain-full", &full);
+    let mut t = TemporalFrames::new(&gpu.ctx, 2).unwrap();
+    let first = setup.temporal(&mut t, &camera, &lights, 1);
+    picture("terrain-first-step2", &first);
+    let converged = setup.temporal(&mut t, &camera, &lights, 3);
+    let (first_err, err) = (mean_rel(&first, &full), max_rel(&converged, &full));
+    eprintln!(
+        "terrain: first frame {first_err:.3e} from the full frame, after 4 frames the largest difference {err:.1e}"
+    );
+    assert!(
+        first_err > 1e-4,
+        "the first frame is the full one: {first_err}"
+    );
+    assert_eq!(err, 0.0, "not converged to the full frame");
+    // Turned: the ridges' and the sky's pixels reprojected (the depth edges of a ridge
+    // against the sky or the slope behind it left to this frame's pixels).
+    let mut turned = camera.clone();
+    turned.heading_deg += 2.5 * camera.fov_deg / SIZE.1 as f64;
+    turned.pitch_deg -= 1.5 * camera.fov_deg / SIZE.1 as f64;
+    let turned_frame = setup.temporal(&mut t, &turned, &lights, 1);
+    picture("terrain-turned", &turned_frame);
+    let share = reprojected_share(&camera, &turned, &full, &turned_frame, bottom);
+    let (e_turned, e_alone) = (
+        mean_rel(&turned_frame, &setup.full(&turned, &lights)),
+        mean_rel(
+            &setup.temporal(
+                &mut TemporalFrames::new(&gpu.ctx, 2).unwrap(),
+                &turned,
+                &lights,
+                1,
+            ),
+            &setup.full(&turned, &lights),
+        ),
+    );
+    eprintln!(
+        "terrain turned: {:.1} % of the undrawn pixels are the previous frame's, reprojected; {e_turned:.3e} from the full frame (this frame's pixels alone {e_alone:.3e})",
+        100.0 * share
+    );
+    assert!(
+        share > 0.7,
+        "only {share} of the undrawn pixels reprojected"
+    );
+    assert!(e_turned < e_alone, "{e_turned} vs {e_alone}");
 }
