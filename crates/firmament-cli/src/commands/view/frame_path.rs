@@ -389,6 +389,7 @@ impl FramePath {
         let set = self.timer.as_ref().map(|t| t.query_set());
         // Under clouds or over a terrain a share of the pixels marched, the rest from the
         // previous frames: their history holds while only the camera moves.
+        let step = march_step(state);
         let temporal = match (clouds, terrain) {
             (None, None) => None,
             _ => {
@@ -403,12 +404,12 @@ impl FramePath {
                     self.sky_generation,
                 );
                 if self.temporal.is_none() {
-                    let made = TemporalFrames::new(self.ctx(), state.march_step)
+                    let made = TemporalFrames::new(self.ctx(), step)
                         .map_err(|e| gpu_failure("the temporal resolve", e))?;
                     self.temporal = Some((made, scene.clone()));
                 }
                 let (t, held) = self.temporal.as_mut().expect("just made");
-                t.set_step(state.march_step)
+                t.set_step(step)
                     .map_err(|e| gpu_failure("the temporal resolve", e))?;
                 if *held != scene {
                     t.reset();
@@ -558,6 +559,15 @@ impl FramePath {
         let pixels = read_rgba8(self.ctx(), &target)
             .map_err(|e| gpu_failure("reading the display back", e))?;
         Ok((self.hdr_frame()?, pixels))
+    }
+}
+
+/// The step of the temporal frames: the state's, but every pixel beside the reference (the
+/// method's frame compared as `render` draws it, not while it converges).
+pub fn march_step(state: &ViewState) -> u32 {
+    match state.compare {
+        super::progressive::Compare::Off => state.march_step,
+        _ => 1,
     }
 }
 

@@ -163,6 +163,16 @@ fn hillaire_redraws_a_new_atmosphere_in_the_next_frame() {
 }
 
 #[test]
+fn beside_the_reference_every_pixel_is_marched() {
+    let mut state = view(Method::Bruneton4d);
+    assert_eq!(super::march_step(&state), 2);
+    state.march_step = 4;
+    assert_eq!(super::march_step(&state), 4);
+    state.compare = Compare::Difference;
+    assert_eq!(super::march_step(&state), 1);
+}
+
+#[test]
 fn the_panel_compares_the_method_with_the_reference_over_the_frame() {
     let Some((backend, _serial)) =
         backend("the_panel_compares_the_method_with_the_reference_over_the_frame")
