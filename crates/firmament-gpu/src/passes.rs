@@ -79,21 +79,13 @@ impl Pass {
                 binding,
                 visibility: wgpu::ShaderStages::COMPUTE,
                 ty: match slot {
-                    Slot::Uniform => wgpu::BindingType::Buffer {
-                        ty: uniform_binding(ctx),
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    Slot::Read => wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    Slot::Write => wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: false },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
+                    Slot::Uniform => buffer_binding(uniform_binding(ctx)),
+                    Slot::Read => {
+                        buffer_binding(wgpu::BufferBindingType::Storage { read_only: true })
+                    }
+                    Slot::Write => {
+                        buffer_binding(wgpu::BufferBindingType::Storage { read_only: false })
+                    }
                     Slot::Texture => wgpu::BindingType::Texture {
                         sample_type: wgpu::TextureSampleType::Float { filterable: false },
                         view_dimension: wgpu::TextureViewDimension::D2,
@@ -193,6 +185,15 @@ impl Pass {
     }
 }
 
+/// A whole-buffer binding of type `ty`.
+fn buffer_binding(ty: wgpu::BufferBindingType) -> wgpu::BindingType {
+    wgpu::BindingType::Buffer {
+        ty,
+        has_dynamic_offset: false,
+        min_binding_size: None,
+    }
+}
+
 /// A compute pipeline of its own source's entry point `entry` over buffer bindings only
 /// (not an atmosphere pass: no common slots), and its bind group layout; the source's
 /// uniform blocks as `ctx` reads them ([`uniform_source`]).
@@ -213,11 +214,7 @@ pub fn buffer_pipeline(
         .map(|&(binding, ty)| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
+            ty: buffer_binding(ty),
             count: None,
         })
         .collect();

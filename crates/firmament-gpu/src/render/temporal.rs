@@ -360,7 +360,8 @@ impl TemporalFrames {
         // The windows around the lights' disks in view, drawn whole every frame: a disk a
         // few pixels wide holds much of the frame's light, and an interpolated one would
         // spread it (and move the exposure).
-        let windows = disk_windows(sky, lights, settings);
+        let now = Seen::of(sky, settings);
+        let windows = disk_windows(&now, lights);
         let window_jobs = windows
             .iter()
             .map(|&w| {
@@ -372,7 +373,6 @@ impl TemporalFrames {
                 renderer.prepare(ctx, sky, lights, settings, target, inputs)
             })
             .collect::<Result<Vec<_>, _>>()?;
-        let now = Seen::of(sky, settings);
         let mut flags = (windows.len() as u32) << 8;
         let mut before = now;
         if let Some(seen) = self.seen {
@@ -467,22 +467,17 @@ impl TemporalFrames {
     }
 }
 
-/// The windows of the frame drawn whole around the visible disks of `lights` (pinhole
-/// cameras; none otherwise): the disk's radius in pixels at the frame's centre, doubled (a
+/// The windows of the frame drawn whole around the visible disks of `lights` seen by the
+/// camera `seen` (pinhole cameras; none otherwise): the disk's radius in pixels at the frame's centre, doubled (a
 /// pixel off-centre subtends less), and the footprints its edge's subsamples take
 /// (`disk_edges::EDGE_FOOTPRINTS`) and one pixel around; rows from a multiple of 16.
-fn disk_windows(sky: &GpuSky, lights: &[Light], settings: &RenderSettings) -> Vec<[u32; 4]> {
-    let camera = settings.camera;
-    if !matches!(
-        camera.projection,
-        Projection::Perspective | Projection::Orbit
-    ) {
+fn disk_windows(seen: &Seen, lights: &[Light]) -> Vec<[u32; 4]> {
+    if !seen.pinhole {
         return Vec::new();
     }
-    let (w, h) = (settings.width as f64, settings.height as f64);
-    let prepared = camera.prepare(sky.radii_m().0, settings.width, settings.height);
-    let (forward, right, up) = prepared.basis();
-    let t = prepared.tan_half_fov();
+    let (w, h) = (seen.size.0 as f64, seen.size.1 as f64);
+    let (forward, right, up) = seen.basis;
+    let t = seen.tan_half_fov;
     let pixel_angle = 2.0 * t / h;
     let align = super::BAND_ROW_ALIGN as f64;
     lights
