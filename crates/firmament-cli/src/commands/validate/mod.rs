@@ -63,6 +63,11 @@ pub struct ValidateArgs {
     /// Presets to validate, comma-separated (default: earth,bruneton2008,hazy; --quick: earth).
     #[arg(long, value_name = "NAME,...")]
     pub preset: Option<String>,
+    /// Atmosphere TOML files to validate, comma-separated, after the presets (with no
+    /// --preset, the files alone): e.g. the extreme geometries of `atmospheres/`. Each is
+    /// labelled by its file stem.
+    #[arg(long, value_name = "FILE,...")]
+    pub atmosphere: Option<String>,
     /// Write every figure (per view and summaries) to this JSON file.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
@@ -128,7 +133,8 @@ fn parse_list<T: std::str::FromStr>(flag: &str, s: &str, what: &str) -> Result<V
 
 /// What a run validates, from the arguments; everything is checked before the long work.
 struct Selection {
-    presets: Vec<String>,
+    /// Preset names and atmosphere files (their stems label them).
+    presets: Vec<Source>,
     altitudes_m: Vec<f64>,
     sun_elevations_deg: Vec<f64>,
     /// The methods, each 4D one with each of `orders`; the first is checked.
@@ -144,11 +150,26 @@ struct Selection {
 
 impl Selection {
     fn from_args(args: &ValidateArgs) -> Result<Selection> {
-        let presets: Vec<String> = match &args.preset {
-            Some(p) => parse_list("--preset", p, "preset names separated by commas")?,
-            None if args.quick => vec!["earth".into()],
-            None => vec!["earth".into(), "bruneton2008".into(), "hazy".into()],
+        let names: Vec<String> = match (&args.preset, &args.atmosphere) {
+            (Some(p), _) => parse_list("--preset", p, "preset names separated by commas")?,
+            (None, Some(_)) => Vec::new(),
+            (None, None) if args.quick => vec!["earth".into()],
+            (None, None) => vec!["earth".into(), "bruneton2008".into(), "hazy".into()],
         };
+        let mut presets: Vec<Source> = names.into_iter().map(Source::Preset).collect();
+        if let Some(files) = &args.atmosphere {
+            let files: Vec<PathBuf> =
+                parse_list("--atmosphere", files, "TOML files separated by commas")?;
+            for f in files {
+                if !f.is_file() {
+                    anyhow::bail!(
+                        "invalid value for `--atmosphere`: {} is not a file (accepted: atmosphere TOML files separated by commas)",
+                        f.display()
+                    );
+                }
+                presets.push(Source::File(f));
+            }
+        }
         let altitudes_m: Vec<f64> = match &args.altitudes {
             Some(s) => parse_list("--altitudes", s, "altitudes in m separated by commas")?,
             None if args.quick => vec![0.0, 1000.0],
@@ -251,9 +272,14 @@ impl Selection {
     }
 
     /// The atmosphere and tables of `preset` with `orders`.
-    fn atmosphere(&self, preset: &str, orders: usize) -> AtmosphereArgs {
+    fn atmosphere(&self, preset: &Source, orders: usize) -> AtmosphereArgs {
+        let (preset, atmosphere) = match preset {
+            Source::Preset(name) => (Some(name.clone()), None),
+            Source::File(path) => (None, Some(path.clone())),
+        };
         AtmosphereArgs {
-            preset: Some(preset.to_string()),
+            preset,
+            atmosphere,
             wavelengths: Some(self.wavelengths.clone()),
             order_args: OrderArgs {
                 orders,
@@ -305,12 +331,13 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
     let mut daylight: Vec<Option<RelativeErrors>> = candidates.iter().map(|_| None).collect();
     let mut configuration_index = 0u64;
     println!("{}", selection.headline());
-    for preset in &selection.presets {
+    for source in &selection.presets {
+        let preset = source.label();
         let skies: Vec<CpuSky> = candidates
             .iter()
             .map(|c| {
                 selection
-                    .atmosphere(preset, c.orders.unwrap_or(selection.orders[0]))
+                    .atmosphere(source, c.orders.unwrap_or(selection.orders[0]))
                     .cpu_sky(c.method, args.quiet)
                     .with_context(|| format!("{} for {preset}", c.label()))
             })
@@ -380,7 +407,7 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
                     s.print();
                 }
             });
-            if preset == "earth" && elevation >= DAYLIGHT_DEG {
+            if matches!(source, Source::Preset(n) if n == "earth") && elevation >= DAYLIGHT_DEG {
                 for (aggregate, e) in daylight.iter_mut().zip(&errors) {
                     aggregate
                         .get_or_insert_with(|| RelativeErrors::new(wavelengths_nm.len()))
@@ -443,7 +470,7 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
         let value = json!({
             "command": std::env::args().collect::<Vec<_>>(),
             "quick": args.quick,
-            "presets": selection.presets,
+            "presets": selection.presets.iter().map(Source::label).collect::<Vec<_>>(),
             "altitudes_m": selection.altitudes_m,
             "sun_elevations_deg": selection.sun_elevations_deg,
             "methods": selection.methods.iter().map(|m| m.name()).collect::<Vec<_>>(),
@@ -485,6 +512,25 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
         anyhow::bail!("daylight thresholds broken: {msg}");
     }
     Ok(())
+}
+
+/// An atmosphere `validate` measures: an embedded preset or a TOML file.
+enum Source {
+    Preset(String),
+    File(PathBuf),
+}
+
+impl Source {
+    /// The preset's name, or the file's stem.
+    fn label(&self) -> String {
+        match self {
+            Source::Preset(name) => name.clone(),
+            Source::File(path) => path.file_stem().map_or_else(
+                || path.display().to_string(),
+                |s| s.to_string_lossy().into(),
+            ),
+        }
+    }
 }
 
 /// One sky method compared with the reference: a method, and the orders of 4D tables.
