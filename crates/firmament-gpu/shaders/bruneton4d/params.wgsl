@@ -51,7 +51,7 @@ fn irradiance_texel(x: u32, y: u32) -> vec3<f32> {
 }
 
 // The non-linear μ_s coordinate in [0, 1] (params::x_mu_s): Bruneton's mapping below the
-// joint (Bruneton's coordinate MU_S_JOINT_BRUNETON_X, placed at MU_S_JOINT_X; prelude),
+// joint (Bruneton's coordinate atm.mu_s_joint_bruneton_x, placed at MU_S_JOINT_X; prelude),
 // linear in the sun's zenith angle above it.
 fn x_mu_s(mu_s: f32) -> f32 {
     let d_min_km = atm.top_radius_km - atm.bottom_radius_km;
@@ -59,8 +59,8 @@ fn x_mu_s(mu_s: f32) -> f32 {
     let d_km = distance_to_top(atm.bottom_radius_km, 0.0, mu_s);
     let a = (d_km - d_min_km) / (d_max_km - d_min_km);
     let bruneton = clamp(max(1.0 - a / atm.mu_s_big_a, 0.0) / (1.0 + a), 0.0, 1.0);
-    if (bruneton <= MU_S_JOINT_BRUNETON_X) {
-        return MU_S_JOINT_X * bruneton / MU_S_JOINT_BRUNETON_X;
+    if (bruneton <= atm.mu_s_joint_bruneton_x) {
+        return MU_S_JOINT_X * bruneton / atm.mu_s_joint_bruneton_x;
     }
     let above = (atm.mu_s_theta_joint - acos(clamp_cosine(mu_s))) / atm.mu_s_theta_joint;
     return clamp(MU_S_JOINT_X + (1.0 - MU_S_JOINT_X) * above, 0.0, 1.0);
@@ -72,7 +72,7 @@ fn mu_s_from_x(x: f32) -> f32 {
         let above = min((x - MU_S_JOINT_X) / (1.0 - MU_S_JOINT_X), 1.0);
         return cos(atm.mu_s_theta_joint * (1.0 - above));
     }
-    return bruneton_mu_s_from_x(x * MU_S_JOINT_BRUNETON_X / MU_S_JOINT_X);
+    return bruneton_mu_s_from_x(x * atm.mu_s_joint_bruneton_x / MU_S_JOINT_X);
 }
 
 // Inverse of Bruneton's mapping alone.

@@ -47,6 +47,9 @@ struct Atmosphere {
     // blend (firmament::sky::bruneton4d::mu_s_blend::twilight_cells, irradiance_twilight_cells).
     mu_s_twilight_cells: u32,
     irradiance_twilight_cells: u32,
+    // Bruneton's coordinate at the joint of the μ_s mapping (params::MuSMap::joint_bruneton_x:
+    // 26/31, or higher over a shell thin for its planet).
+    mu_s_joint_bruneton_x: f32,
 }
 
 // Which radiance field a pass reads (0: single scattering, phase functions applied at lookup;

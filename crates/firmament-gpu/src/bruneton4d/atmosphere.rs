@@ -62,12 +62,12 @@ pub fn pack(model: &Model, sizes: &TableSizes) -> Packed {
     let d_min = top - bottom;
     let big_d = distance_to_top_atmosphere_boundary(bottom, model.mu_s_min, top);
     let big_a = (big_d - d_min) / (h - d_min);
-    let theta_joint = params::MuSMap::new(&params::Radii {
+    let mu_s_map = params::MuSMap::new(&params::Radii {
         bottom,
         top,
         mu_s_min: model.mu_s_min,
-    })
-    .theta_joint();
+    });
+    let theta_joint = mu_s_map.theta_joint();
 
     let mut data: Vec<f32> = Vec::new();
     let per_wavelength = |data: &mut Vec<f32>, values: &[f64], scale: f64| {
@@ -164,6 +164,7 @@ pub fn pack(model: &Model, sizes: &TableSizes) -> Packed {
     uniform.push(u(mu_s_blend::irradiance_twilight_cells(
         sizes.irradiance_mu_s,
     )));
+    uniform.push(f(mu_s_map.joint_bruneton_x()));
     while !uniform.len().is_multiple_of(4) {
         uniform.push(0);
     }

@@ -1,9 +1,9 @@
-//! The table file format, version 5 (little-endian):
+//! The table file format, version 6 (little-endian):
 //!
 //! | bytes | content |
 //! |---|---|
 //! | 8 | magic `FIRMLUT\0` |
-//! | 4 | format version (u32, = 5; older versions are refused: 3 and 4 sampled the sun's elevation by Bruneton's μ_s mapping alone (`params::x_mu_s`), version 2 stored the transmittance instead of the optical depth, version 1 folded multiple scattering into `scattering`) |
+//! | 4 | format version (u32, = 6; older versions are refused: 5 held the μ_s mapping's joint at Bruneton's coordinate over any shell, 3 and 4 sampled the sun's elevation by Bruneton's μ_s mapping alone (`params::x_mu_s`), version 2 stored the transmittance instead of the optical depth, version 1 folded multiple scattering into `scattering`) |
 //! | 4 | header length L (u32) |
 //! | L | header, UTF-8 JSON: `config` (sizes, orders, mie storage), `wavelengths_nm`, `atmosphere_hash` (hex), `channels`, `order_means`, `mie_ratio`, `encoding` (`f32` or `half`) |
 //! | … | f32 arrays: optical depth to the top (τ = −ln T), irradiance; then single Rayleigh (molecular), single Mie, multiple scattering, as f32 arrays (`f32`) or each as per-texel exponents and half floats ([`compact`], `half`); sizes from the header |
@@ -22,9 +22,11 @@ use super::{MieStorage, TableConfig, Tables};
 use crate::{Error, Result};
 
 const MAGIC: &[u8; 8] = b"FIRMLUT\0";
-/// Current format version (5: the μ_s mapping with samples added above 18°; a version 4
-/// file's texels would be read at the wrong sun elevations).
-pub const VERSION: u32 = 5;
+/// Current format version (6: the μ_s mapping's joint held at 15° sun elevation or above,
+/// which moves the sun samples of shells thinner than about 5.5·10⁻³ of their planet’s radius;
+/// 5: samples added above 18°; an older file's texels would be read at the wrong sun
+/// elevations).
+pub const VERSION: u32 = 6;
 
 /// How the 4D scattering tables' values are stored (the 2D tables are always f32).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
