@@ -119,6 +119,15 @@ fn adjusted_atmospheres_have_the_depths_asked_and_refuse_what_they_cannot() {
             vec!["--planet-radius-m", "10"],
             vec!["adjust.planet_radius_m", "[100000, 100000000]"],
         ),
+        // Earth's 60 km of air over a planet of 50 000 km: a shell too thin for the tables.
+        (
+            vec!["--planet-radius-m", "5e7"],
+            vec![
+                "bottom_radius_m",
+                "at most 20000000 m",
+                "--method reference",
+            ],
+        ),
     ] {
         let mut a = vec![
             "render",

@@ -361,3 +361,51 @@ fn hillaire2020_answers_query_render_and_validate() {
     assert!(!dir.join("refused.png").exists());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The extreme geometries of `atmospheres/` (issue 15, item 6): Earth's air over a planet
+/// whose shell is 3·10⁻³ of its radius (the thinnest the tables take) and a shell 0.3 of a
+/// Titan-sized planet's radius, measured by `validate --quick`'s views with the default
+/// tables (the small ones' 16 altitude rows are too few for the thick shell: p95 8 % from
+/// 10 km) from the ground and from 10 km against the quick run's thresholds. (From 1 km the thick
+/// shell's views down to the ground read 8–18 % low: docs/accuracy.md.)
+#[test]
+fn thin_and_thick_shells_hold_the_daylight_thresholds() {
+    let dir = tmp_subdir("validate-shells");
+    let json_path = dir.join("shells.json");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../atmospheres");
+    let files = ["thin-shell.toml", "thick-shell.toml"].map(|f| root.join(f));
+    let list = format!("{},{}", files[0].display(), files[1].display());
+    let out = run(&[
+        "validate",
+        "--quick",
+        "--quiet",
+        "--atmosphere",
+        &list,
+        "--altitudes",
+        "0,10000",
+        "--table-size",
+        "default",
+        "--json",
+        json_path.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    println!("{stdout}\n{}", stderr(&out));
+    assert!(out.status.success(), "validate failed");
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&json_path).unwrap()).unwrap();
+    let configs = v["configurations"].as_array().unwrap();
+    assert_eq!(configs.len(), 8);
+    for c in configs {
+        let preset = c["preset"].as_str().unwrap();
+        assert!(
+            preset == "thin-shell" || preset == "thick-shell",
+            "{preset}"
+        );
+        let y = &c["tables"][0]["summary"]["luminance"];
+        let (median, p95) = (y["median"].as_f64().unwrap(), y["p95"].as_f64().unwrap());
+        let at = format!("{preset} {} m {}°", c["altitude_m"], c["sun_elevation_deg"]);
+        assert!(median <= 0.02 && p95 <= 0.05, "{at}: {median} {p95}");
+    }
+    // No earth configuration, so no daylight aggregate is checked.
+    assert!(v["aggregates"].as_array().unwrap().is_empty());
+    std::fs::remove_dir_all(&dir).ok();
+}

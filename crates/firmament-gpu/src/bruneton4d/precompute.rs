@@ -138,6 +138,7 @@ impl Precomputer {
     ) -> Result<GpuTables, GpuError> {
         config.validate()?;
         firmament::sky::bruneton4d::thickness::check(model)?;
+        firmament::sky::bruneton4d::shell::check(model)?;
         let n = model.channels();
         firmament::spectrum::check_channels(n, "the precomputed tables")?;
         let s = config.sizes;

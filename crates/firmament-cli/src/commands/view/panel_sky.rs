@@ -2,6 +2,8 @@
 //! adjustments and the cloud layers (each edits the scene file, so "save scene" keeps it).
 
 use super::ViewState;
+use firmament::atmosphere::adjust;
+use firmament::sky::bruneton4d::shell;
 
 /// The date, the time of day and the place of a dated scene.
 pub(super) fn date_section(ui: &mut egui::Ui, state: &mut ViewState) {
@@ -118,9 +120,12 @@ pub(super) fn air_section(ui: &mut egui::Ui, state: &mut ViewState) {
         ui.small("(the terrain's materials light the tables' ground)");
     }
     let mut km = a.planet_radius_m.unwrap_or(own.planet_radius_m) / 1e3;
+    // Up to the largest planet the tables take under this shell (bruneton4d::shell).
+    let (lo, hi) = adjust::PLANET_RADIUS_RANGE_M;
+    let hi = hi.min(own.shell_m / shell::MIN_RELATIVE_THICKNESS).max(lo);
     if ui
         .add(
-            egui::Slider::new(&mut km, 100.0..=100_000.0)
+            egui::Slider::new(&mut km, lo / 1e3..=hi / 1e3)
                 .logarithmic(true)
                 .text("planet radius km"),
         )

@@ -66,6 +66,8 @@ pub struct AirValues {
     pub ground_albedo: f64,
     /// Planet radius (m).
     pub planet_radius_m: f64,
+    /// The shell's thickness, top radius − planet radius (m).
+    pub shell_m: f64,
 }
 
 impl AirValues {
@@ -84,6 +86,7 @@ impl AirValues {
                 }
             },
             planet_radius_m: a.bottom_radius_m,
+            shell_m: a.top_radius_m - a.bottom_radius_m,
         })
     }
 }

@@ -12,6 +12,7 @@ pub mod lookup;
 pub mod mu_s_blend;
 pub mod params;
 pub mod precompute;
+pub mod shell;
 pub mod table;
 mod tables;
 pub mod thickness;

@@ -95,6 +95,7 @@ impl Elek3d {
         config.validate()?;
         crate::spectrum::check_channels(model.channels(), "the 3D-table method")?;
         super::bruneton4d::thickness::check(&model)?;
+        super::bruneton4d::shell::check(&model)?;
         let p = precompute::precompute(&model, config);
         Ok(Elek3d {
             model,

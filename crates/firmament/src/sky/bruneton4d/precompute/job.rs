@@ -61,6 +61,7 @@ impl PrecomputeJob {
     pub fn new(model: Model, config: &TableConfig) -> Result<PrecomputeJob> {
         config.validate()?;
         crate::sky::bruneton4d::thickness::check(&model)?;
+        crate::sky::bruneton4d::shell::check(&model)?;
         let n = model.channels();
         crate::spectrum::check_channels(n, "the precomputed tables")?;
         let s = config.sizes;
