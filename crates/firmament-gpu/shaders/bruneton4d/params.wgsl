@@ -143,12 +143,15 @@ fn scattering_texel(x: u32, y: u32, z: u32) -> ScatteringTexel {
     let half = atm.scattering_mu / 2u;
     if (y < half) {
         let x_mu = f32(half - 1u - y) / f32(half - 1u);
-        let d_min_km = t.rho_km * t.rho_km / (t.r_km + atm.bottom_radius_km);
-        let d_max_km = t.rho_km;
+        // The ground row takes the next row's ground-ray directions (params::ground_row_rho).
+        let rho_km = select(t.rho_km, atm.h_km / f32(atm.scattering_r - 1u), z == 0u);
+        let r_km = radius_from_rho(rho_km);
+        let d_min_km = rho_km * rho_km / (r_km + atm.bottom_radius_km);
+        let d_max_km = rho_km;
         let d_km = d_min_km + (d_max_km - d_min_km) * x_mu * x_mu;
         t.mu = -1.0;
         if (d_km != 0.0) {
-            t.mu = clamp_cosine(-(t.rho_km * t.rho_km + d_km * d_km) / (2.0 * t.r_km * d_km));
+            t.mu = clamp_cosine(-(rho_km * rho_km + d_km * d_km) / (2.0 * r_km * d_km));
         }
         t.ground = true;
     } else {
