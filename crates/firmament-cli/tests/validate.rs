@@ -367,7 +367,7 @@ fn hillaire2020_answers_query_render_and_validate() {
 /// Titan-sized planet's radius, measured by `validate --quick`'s views with the default
 /// tables (the small ones' 16 altitude rows are too few for the thick shell: p95 8 % from
 /// 10 km) from the ground and from 10 km against the quick run's thresholds. (From 1 km the thick
-/// shell's views down to the ground read 8–18 % low: docs/accuracy.md.)
+/// shell's views down to the ground read 3–10 % low: docs/accuracy.md.)
 #[test]
 fn thin_and_thick_shells_hold_the_daylight_thresholds() {
     let dir = tmp_subdir("validate-shells");
