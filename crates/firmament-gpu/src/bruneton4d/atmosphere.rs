@@ -58,7 +58,7 @@ pub fn pack(model: &Model, sizes: &TableSizes) -> Packed {
     let km = 1e-3;
     let (bottom, top) = (model.bottom_radius_m, model.top_radius_m);
     let h = (top * top - bottom * bottom).sqrt();
-    // The A of the μ_s mapping (params::x_mu_s) for μ_s,min.
+    // The A of the μ_s mapping (mu_s_map::x_mu_s) for μ_s,min.
     let d_min = top - bottom;
     let big_d = distance_to_top_atmosphere_boundary(bottom, model.mu_s_min, top);
     let big_a = (big_d - d_min) / (h - d_min);

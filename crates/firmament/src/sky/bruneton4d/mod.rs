@@ -10,6 +10,7 @@ pub mod compact;
 pub mod file;
 pub mod lookup;
 pub mod mu_s_blend;
+pub mod mu_s_map;
 pub mod params;
 pub mod precompute;
 pub mod shell;
