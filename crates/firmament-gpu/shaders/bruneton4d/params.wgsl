@@ -78,9 +78,25 @@ fn scattering_u_mu(r_km: f32, rho_km: f32, mu: f32, ground: bool) -> f32 {
     let d_max_km = rho_km + atm.h_km;
     var x = 0.0;
     if (d_max_km > d_min_km) {
-        x = clamp((d_km - d_min_km) / (d_max_km - d_min_km), 0.0, 1.0);
+        x = sky_x_from_distance_fraction((d_km - d_min_km) / (d_max_km - d_min_km));
     }
     return 0.5 + 0.5 * texcoord_from_unit(x, half);
+}
+
+// The unit coordinate of a sky ray from the fraction f of its distance to the top between
+// straight up and the horizon: x = (s + s³)/2 with s = √f, linear in the angle near the
+// zenith (params::sky_x_from_distance_fraction).
+fn sky_x_from_distance_fraction(f: f32) -> f32 {
+    let s = sqrt(clamp(f, 0.0, 1.0));
+    return 0.5 * (s + s * s * s);
+}
+
+// Inverse of sky_x_from_distance_fraction: s = (2/√3)·sinh(asinh(3√3·x)/3), f = s²
+// (params::distance_fraction_from_sky_x).
+fn distance_fraction_from_sky_x(x: f32) -> f32 {
+    let sqrt_3 = 1.7320508;
+    let s = 2.0 / sqrt_3 * sinh(asinh(3.0 * sqrt_3 * clamp(x, 0.0, 1.0)) / 3.0);
+    return min(s * s, 1.0);
 }
 
 // A scattering texel's parameters.
@@ -120,7 +136,7 @@ fn scattering_texel(x: u32, y: u32, z: u32) -> ScatteringTexel {
         let x_mu = f32(y - half) / f32(half - 1u);
         let d_min_km = (atm.h_sq_km2 - t.rho_km * t.rho_km) / (atm.top_radius_km + t.r_km);
         let d_max_km = t.rho_km + atm.h_km;
-        let d_km = d_min_km + (d_max_km - d_min_km) * x_mu;
+        let d_km = d_min_km + (d_max_km - d_min_km) * distance_fraction_from_sky_x(x_mu);
         t.mu = 1.0;
         if (d_km != 0.0) {
             t.mu = clamp_cosine((atm.h_sq_km2 - t.rho_km * t.rho_km - d_km * d_km) / (2.0 * t.r_km * d_km));

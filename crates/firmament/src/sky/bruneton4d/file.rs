@@ -1,9 +1,9 @@
-//! The table file format, version 6 (little-endian):
+//! The table file format, version 7 (little-endian):
 //!
 //! | bytes | content |
 //! |---|---|
 //! | 8 | magic `FIRMLUT\0` |
-//! | 4 | format version (u32, = 6; older versions are refused: 5 held the μ_s mapping's joint at Bruneton's coordinate over any shell, 3 and 4 sampled the sun's elevation by Bruneton's μ_s mapping alone (`params::x_mu_s`), version 2 stored the transmittance instead of the optical depth, version 1 folded multiple scattering into `scattering`) |
+//! | 4 | format version (u32, = 7; older versions are refused: 6 mapped the sky rays' distance to the top linearly (`params::sky_x_from_distance_fraction`), 5 held the μ_s mapping's joint at Bruneton's coordinate over any shell, 3 and 4 sampled the sun's elevation by Bruneton's μ_s mapping alone (`params::x_mu_s`), version 2 stored the transmittance instead of the optical depth, version 1 folded multiple scattering into `scattering`) |
 //! | 4 | header length L (u32) |
 //! | L | header, UTF-8 JSON: `config` (sizes, orders, mie storage), `wavelengths_nm`, `atmosphere_hash` (hex), `channels`, `order_means`, `mie_ratio`, `encoding` (`f32` or `half`) |
 //! | … | f32 arrays: optical depth to the top (τ = −ln T), irradiance; then single Rayleigh (molecular), single Mie, multiple scattering, as f32 arrays (`f32`) or each as per-texel exponents and half floats ([`compact`], `half`); sizes from the header |
@@ -26,7 +26,7 @@ const MAGIC: &[u8; 8] = b"FIRMLUT\0";
 /// which moves the sun samples of shells thinner than about 5.5·10⁻³ of their planet’s radius;
 /// 5: samples added above 18°; an older file's texels would be read at the wrong sun
 /// elevations).
-pub const VERSION: u32 = 6;
+pub const VERSION: u32 = 7;
 
 /// How the 4D scattering tables' values are stored (the 2D tables are always f32).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -152,7 +152,7 @@ fn prefix(bytes: &[u8], path: &str) -> Result<(u32, usize)> {
     let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
     if version != VERSION {
         return Err(bad(format!(
-            "format version {version}, this program reads version {VERSION} (older files sample the sun's elevation differently); bake the tables again"
+            "format version {version}, this program reads version {VERSION} (older files sample the sky's directions or the sun's elevation differently); bake the tables again"
         )));
     }
     let hlen = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
