@@ -11,7 +11,8 @@
 @group(0) @binding(8) var<storage, read_write> multiple_sum: array<vec4<f32>>;
 
 // One ray sample: the transmittance from the ray origin, the total β_s·T (which the
-// quadrature's exponential fit follows: ΔJ is β_s times a smooth field) and ΔJ there.
+// quadrature's exponential fit follows: ΔJ is β_s times a smooth field) and ΔJ there
+// (the table's ΔJ/β_s, interpolated, times β_s at the sample).
 struct MultipleSample {
     t: vec4<f32>,
     f: vec4<f32>,
@@ -30,8 +31,10 @@ fn multiple_sample(t: ScatteringTexel, d_km: f32, k: u32) -> MultipleSample {
     var s: MultipleSample;
     s.t = transmittance(t.r_km, t.rho_km, t.mu, d_km, t.ground, k);
     let altitude_km = altitude_of(rho_d_km, r_d_km);
-    s.f = (group_scattering(0u, altitude_km, k) + group_scattering(1u, altitude_km, k)) * s.t;
-    s.j = sample_density_rows_first(f, k);
+    let beta_s = group_scattering(0u, altitude_km, k) + group_scattering(1u, altitude_km, k);
+    s.f = beta_s * s.t;
+    // The table holds ΔJ/β_s (scattering_density.wgsl).
+    s.j = sample_density_rows_first(f, k) * beta_s;
     return s;
 }
 

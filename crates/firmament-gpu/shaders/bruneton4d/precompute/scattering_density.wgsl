@@ -24,7 +24,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let mu_s = t0.mu_s;
     let sin_s = sqrt(max(1.0 - mu_s * mu_s, 0.0));
     let altitude_km = altitude_of(t0.rho_km, t0.r_km);
-    var beta = array<vec4<f32>, 2>(group_scattering(0u, altitude_km, k), group_scattering(1u, altitude_km, k));
+    // Each group's share of the total β_s in place of its β_s: the table holds ΔJ/β_s,
+    // smooth in r (scattering_density.rs); multiple_scattering.wgsl multiplies by β_s.
+    let beta_0 = group_scattering(0u, altitude_km, k);
+    let beta_1 = group_scattering(1u, altitude_km, k);
+    let total = beta_0 + beta_1;
+    let inv = select(vec4<f32>(0.0), 1.0 / max(total, vec4<f32>(1e-30)), total > vec4<f32>(0.0));
+    var beta = array<vec4<f32>, 2>(beta_0 * inv, beta_1 * inv);
     var present = array<bool, 2>(atm.group0_present != 0u, atm.group1_present != 0u);
     let dtheta = PI / f32(DENSITY_THETA);
     var acc: array<vec4<f32>, 2u * HARMONICS>;

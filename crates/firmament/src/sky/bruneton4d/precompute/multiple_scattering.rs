@@ -47,7 +47,10 @@ pub(super) fn multiple_scattering_slices(
         for i in 0..count {
             model.scattering_into(rays.r[i] - radii.bottom, &mut beta[i * n..(i + 1) * n]);
         }
-        let tw = rays.weights(&beta, n);
+        let mut tw = rays.weights(&beta, n);
+        // The density table holds ΔJ/β_s (scattering_density.rs): ΔJ at a sample is that,
+        // interpolated, times β_s there, folded into the weights.
+        tw.iter_mut().zip(&beta).for_each(|(w, b)| *w *= b);
         // Each sample's (μ, r)-filtered row of ΔJ, so a texel's lookup is a bilinear
         // filter in (ν, μ_s) only.
         let row_len = density.row_len();

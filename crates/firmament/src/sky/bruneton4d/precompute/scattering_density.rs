@@ -1,5 +1,6 @@
 //! The scattering density pass ΔJ (paper eq. 11), by spherical convolution per (r, μ_s):
-//! the incident field of the previous order sampled once on a (θ, φ) grid in the sun's frame
+//! stored as ΔJ/β_s (the multiple-scattering pass multiplies by β_s at its samples); the
+//! incident field of the previous order sampled once on a (θ, φ) grid in the sun's frame
 //! (`scattering_density_field.wgsl` on the GPU), expanded in azimuthal harmonics and
 //! convolved with the phase kernels (`scattering_density.wgsl`).
 
@@ -64,6 +65,17 @@ pub(super) fn scattering_density_slices(
             let mut beta = [vec![0.0; n], vec![0.0; n]];
             for group in 0..2 {
                 groups.scattering_into(model, group, alt, &mut beta[group]);
+            }
+            // The table holds ΔJ/β_s, each group's share of the total β_s in place of its
+            // β_s: ΔJ falls with the scatterers' density, which the multiple-scattering
+            // pass's linear interpolation between r rows overestimates (rows 0.57 km apart
+            // at 1 km over Earth, `hazy`'s aerosol scale height 1.5 km: up to +1.8 %); the
+            // ratio is smooth, and that pass multiplies by β_s at each ray sample.
+            for k in 0..n {
+                let total = beta[0][k] + beta[1][k];
+                for b in &mut beta {
+                    b[k] = if total > 0.0 { b[k] / total } else { 0.0 };
+                }
             }
             let mut radiance = vec![0.0; n];
             let mut tmp = vec![0.0; n];
