@@ -244,11 +244,7 @@ mod tests {
     use super::*;
     use crate::sky::bruneton4d::params::mu_s_from_x;
 
-    const EARTH: Radii = Radii {
-        bottom: 6_360_000.0,
-        top: 6_420_000.0,
-        mu_s_min: -0.2079116908177593,
-    };
+    const EARTH: Radii = crate::sky::bruneton4d::params::EARTH_RADII;
 
     #[test]
     fn the_twilight_cells_end_at_the_last_sample_below_the_horizon() {

@@ -135,11 +135,7 @@ impl MuSMap {
 mod tests {
     use super::*;
 
-    const G: Radii = Radii {
-        bottom: 6_360_000.0,
-        top: 6_420_000.0,
-        mu_s_min: -0.2079116908177593,
-    };
+    const G: Radii = crate::sky::bruneton4d::params::EARTH_RADII;
 
     #[test]
     fn mu_s_samples_below_the_joint_are_brunetons_32() {

@@ -439,15 +439,20 @@ pub(crate) fn clamp_nu(mu: f64, mu_s: f64, nu: f64) -> f64 {
     nu.clamp(mu * mu_s - spread, mu * mu_s + spread)
 }
 
+/// Earth's radii with μ_s,min = cos 102° (Bruneton 2017), for the unit tests of the table
+/// mappings.
+#[cfg(test)]
+pub(crate) const EARTH_RADII: Radii = Radii {
+    bottom: 6_360_000.0,
+    top: 6_420_000.0,
+    mu_s_min: -0.2079116908177593,
+};
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    const G: Radii = Radii {
-        bottom: 6_360_000.0,
-        top: 6_420_000.0,
-        mu_s_min: -0.2079116908177593,
-    };
+    const G: Radii = EARTH_RADII;
 
     #[test]
     fn transmittance_mapping_round_trips() {

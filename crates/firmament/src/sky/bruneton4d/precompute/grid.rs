@@ -98,11 +98,7 @@ impl MuSPositions {
 mod tests {
     use super::*;
 
-    const G: Radii = Radii {
-        bottom: 6_360_000.0,
-        top: 6_420_000.0,
-        mu_s_min: -0.2079116908177593,
-    };
+    const G: Radii = crate::sky::bruneton4d::params::EARTH_RADII;
 
     #[test]
     fn scattering_grid_is_scattering_texel() {
