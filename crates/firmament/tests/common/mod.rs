@@ -87,3 +87,27 @@ pub fn single_scattering_steps(
         s += h;
     }
 }
+
+/// The relative error of `view`'s sky radiance in direction `dir` (channel 0) against the
+/// reference cut at `max_bounces` scattering events with `samples` paths, and the
+/// reference's relative standard error: (table / reference − 1, σ / reference).
+pub fn error_against_cut_reference(
+    model: &Model,
+    view: &dyn firmament::sky::SkyView,
+    observer: Vec3,
+    sun: Vec3,
+    dir: Vec3,
+    max_bounces: usize,
+    samples: usize,
+) -> (f64, f64) {
+    let mut settings = firmament::reference::ReferenceSettings::with_samples(samples);
+    settings.max_bounces = max_bounces;
+    let reference = firmament::reference::sky_radiance(model, observer, dir, sun, &settings);
+    let n = model.channels();
+    let (mut l, mut t) = (vec![0.0; n], vec![0.0; n]);
+    view.sky_radiance(dir, firmament::sky::Shadow::None, &mut l, &mut t);
+    (
+        l[0] / reference.radiance[0] - 1.0,
+        reference.stderr[0] / reference.radiance[0],
+    )
+}
