@@ -50,6 +50,10 @@ struct Atmosphere {
     // Bruneton's coordinate at the joint of the μ_s mapping (params::MuSMap::joint_bruneton_x:
     // 26/31, or higher over a shell thin for its planet).
     mu_s_joint_bruneton_x: f32,
+    // Where the precomputation's view rays are sampled (in `data`, vec4s from here; 0 outside
+    // the precomputation): the interior ends of the RAY_INTERVALS / 2 pairs, as fractions of
+    // each (r, μ) row's ray length (firmament::sky::bruneton4d::precompute::ray_grading).
+    ray_fractions_offset: u32,
 }
 
 // Which radiance field a pass reads (0: single scattering, phase functions applied at lookup;

@@ -8,6 +8,7 @@ use firmament::atmosphere::groups::{AEROSOLS, MOLECULES};
 use firmament::atmosphere::{Model, ScatteringGroups};
 use firmament::math::sphere::distance_to_top_atmosphere_boundary;
 use firmament::medium::PhaseFunction;
+use firmament::sky::bruneton4d::precompute::ray_grading::{RayGrading, RAY_PAIRS};
 use firmament::sky::bruneton4d::{mu_s_blend, params, TableSizes};
 
 /// Wavelengths per channel group (one vec4).
@@ -17,6 +18,9 @@ pub const GROUP: usize = 4;
 pub fn groups(channels: usize) -> usize {
     channels.div_ceil(GROUP)
 }
+
+/// The index of `ray_fractions_offset` in the `Atmosphere` uniform (its last field).
+const RAY_FRACTIONS_OFFSET_FIELD: usize = 40;
 
 /// The packed atmosphere.
 pub struct Packed {
@@ -165,10 +169,33 @@ pub fn pack(model: &Model, sizes: &TableSizes) -> Packed {
         sizes.irradiance_mu_s,
     )));
     uniform.push(f(mu_s_map.joint_bruneton_x()));
+    // No ray placement outside the precomputation (pack_for_precompute).
+    debug_assert_eq!(uniform.len(), RAY_FRACTIONS_OFFSET_FIELD);
+    uniform.push(0);
     while !uniform.len().is_multiple_of(4) {
         uniform.push(0);
     }
     Packed { uniform, data }
+}
+
+/// [`pack`] with what only the precomputation reads: the placement of every (r, μ) row's
+/// view-ray samples (`ray.wgsl`, `ray_pair_end_km`), the interior ends of its pairs as
+/// fractions of the ray's length, `RAY_PAIRS − 1` per row padded to whole vec4s, computed
+/// by the CPU's own [`RayGrading`] so that both place the samples alike.
+pub fn pack_for_precompute(model: &Model, sizes: &TableSizes) -> Packed {
+    let mut packed = pack(model, sizes);
+    let grading = RayGrading::for_tables(model, sizes);
+    let per_row = (RAY_PAIRS - 1).div_ceil(GROUP) * GROUP;
+    let offset = packed.data.len() / 4;
+    let interior: Vec<f64> = grading.interior().collect();
+    for row in interior.chunks_exact(RAY_PAIRS - 1) {
+        packed.data.extend(row.iter().map(|&f| f as f32));
+        packed
+            .data
+            .extend(std::iter::repeat_n(0.0, per_row - row.len()));
+    }
+    packed.uniform[RAY_FRACTIONS_OFFSET_FIELD] = offset as u32;
+    packed
 }
 
 #[cfg(test)]
@@ -181,10 +208,29 @@ mod tests {
     fn uniform_has_the_shader_struct_size() {
         let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
         let p = pack(&model, &TableSizes::small());
-        // 39 fields of the WGSL `Atmosphere` struct, padded to 16 bytes.
-        assert_eq!(p.uniform.len(), 40);
+        // 41 fields of the WGSL `Atmosphere` struct, padded to 16 bytes.
+        assert_eq!(p.uniform.len(), 44);
+        assert_eq!(p.uniform[RAY_FRACTIONS_OFFSET_FIELD], 0);
         assert_eq!(p.data.len() % 4, 0);
         assert!(model.groups.present(MOLECULES));
+    }
+
+    #[test]
+    fn the_precomputation_gets_each_rows_ray_placement() {
+        let model = Atmosphere::earth().resolve(&Wavelengths::rgb()).unwrap();
+        let s = TableSizes::small();
+        let p = pack_for_precompute(&model, &s);
+        let offset = p.uniform[RAY_FRACTIONS_OFFSET_FIELD] as usize * 4;
+        let per_row = (RAY_PAIRS - 1).div_ceil(GROUP) * GROUP;
+        assert_eq!(
+            p.data.len(),
+            offset + s.scattering_r * s.scattering_mu * per_row
+        );
+        for row in p.data[offset..].chunks_exact(per_row) {
+            let ends = &row[..RAY_PAIRS - 1];
+            assert!(ends[0] > 0.0 && ends[RAY_PAIRS - 2] < 1.0);
+            assert!(ends.windows(2).all(|w| w[1] > w[0]), "{ends:?}");
+        }
     }
 
     #[test]

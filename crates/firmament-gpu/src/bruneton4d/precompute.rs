@@ -169,7 +169,7 @@ impl Precomputer {
             s_texels,
         )?;
 
-        let packed = atmosphere::pack(model, &s);
+        let packed = atmosphere::pack_for_precompute(model, &s);
         let max_dim = ctx.limits().max_compute_workgroups_per_dimension;
         let device = ctx.device();
 

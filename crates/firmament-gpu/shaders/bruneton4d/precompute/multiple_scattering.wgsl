@@ -1,6 +1,7 @@
 // Multiple scattering ΔS of order n from ΔJ (paper eq. 12, Bruneton 2017
 // `ComputeMultipleScattering`; Rust twin precompute/multiple_scattering.rs,
-// `compute_multiple_scattering`): RAY_INTERVALS intervals along the view ray with the
+// `compute_multiple_scattering`): RAY_INTERVALS intervals along the view ray (graded pairs,
+// ray.wgsl `ray_pair_end_km`) with the
 // exponentially fitted Simpson rule (ray.wgsl `exponential_simpson_weights`), pair of
 // intervals by pair. ΔJ is looked up at each sample with u_ν from (μ, μ_s) at that sample
 // (params::u_nu: the azimuth relative to the range of ν there). Adds ΔS, as radiance, to
@@ -67,20 +68,25 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     let k = gid.z;
     let t = scattering_texel_at(i);
-    let dx_km = ray_step_km(t);
+    let length_km = ray_length_km(t);
+    let row = i / scattering_width();
     var acc = vec4<f32>(0.0);
     // Samples 2p, 2p + 1, 2p + 2 of pair p; the last is the next pair's first.
     var s0 = multiple_sample(t, 0.0, k);
+    var d0_km = 0.0;
     for (var p = 0u; p < RAY_INTERVALS / 2u; p++) {
-        let s1 = multiple_sample(t, f32(2u * p + 1u) * dx_km, k);
-        let s2 = multiple_sample(t, f32(2u * p + 2u) * dx_km, k);
+        let d2_km = ray_pair_end_km(row, p + 1u, length_km);
+        let step_km = 0.5 * (d2_km - d0_km);
+        let s1 = multiple_sample(t, d0_km + step_km, k);
+        let s2 = multiple_sample(t, d2_km, k);
         let w = exponential_simpson_weights(s0.t, s1.t, s2.t, s0.f, s1.f, s2.f);
-        acc += w.w0 * s0.j + w.w1 * s1.j + w.w2 * s2.j;
+        acc += step_km * (w.w0 * s0.j + w.w1 * s1.j + w.w2 * s2.j);
         s0 = s2;
+        d0_km = d2_km;
     }
     // Clamped at 0 as on the CPU (a negative end weight can take a sum below zero).
     let o = i * atm.groups + k;
-    let delta = max(acc * dx_km, vec4<f32>(0.0));
+    let delta = max(acc, vec4<f32>(0.0));
     delta_multiple_out[o] = delta;
     multiple_sum[o] += delta;
 }

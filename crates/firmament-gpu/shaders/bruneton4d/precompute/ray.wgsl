@@ -1,5 +1,6 @@
-// Quadrature along view rays (Rust twin precompute/ray.rs): RAY_INTERVALS intervals,
-// integrated pair of intervals by pair with an exponentially fitted Simpson rule (a Filon-type product rule):
+// Quadrature along view rays (Rust twin precompute/ray.rs): RAY_INTERVALS intervals in pairs
+// of two equal ones, placed per (r, μ) row (ray_pair_end_km), integrated pair by pair with an
+// exponentially fitted Simpson rule (a Filon-type product rule):
 // ∫ g(d)·T(d) dd with the transmittance T factored out as an exponential over each pair and
 // g quadratic, exact for g quadratic and T exponential, Simpson's rule as Δτ → 0. Plain
 // Simpson on g·T overestimates optically thick intervals (horizontal rays near the ground
@@ -57,7 +58,7 @@ fn lagrange_exponential_moments(a_signed: vec4<f32>) -> Moments {
     return m;
 }
 
-// Weights (in units of the step) on the three samples of one pair of intervals, per lane,
+// Weights (in units of the pair's step) on the three samples of one pair of intervals, per lane,
 // from their transmittances T and the fitted quantity F = β·T (precompute/ray.rs,
 // `exponential_simpson_weights`, one pair): a = ln(F_0/F_2)/2 (ln(F_0/F_1) when F_2 = 0, 0
 // when F_1 = 0 too; from T the same way where F_0 = 0) clamped to [−30, 300], weights
@@ -98,14 +99,27 @@ fn exponential_simpson_weights(t0: vec4<f32>, t1: vec4<f32>, t2: vec4<f32>, f0: 
     return w;
 }
 
-// The step between the RAY_INTERVALS + 1 samples of a texel's view ray, to the ground or the
-// top (RaySamples::new).
-fn ray_step_km(t: ScatteringTexel) -> f32 {
-    var length_km: f32;
+// The length of a texel's view ray, to the ground or the top (RaySamples::new).
+fn ray_length_km(t: ScatteringTexel) -> f32 {
     if (t.ground) {
-        length_km = distance_to_bottom(t.r_km, t.rho_km, t.mu);
-    } else {
-        length_km = distance_to_top(t.r_km, t.rho_km, t.mu);
+        return distance_to_bottom(t.r_km, t.rho_km, t.mu);
     }
-    return length_km / f32(RAY_INTERVALS);
+    return distance_to_top(t.r_km, t.rho_km, t.mu);
+}
+
+// The end of pair p (0 to RAY_INTERVALS / 2) of the view ray of (r, μ) row `row`, of length
+// `length_km`: placed by the CPU's ray_grading (graded by the ray's optical depth) and read
+// from the atmosphere data as fractions of the length (bruneton4d/atmosphere.rs,
+// pack_for_precompute); pair p's samples are its two ends and their midpoint.
+fn ray_pair_end_km(row: u32, p: u32, length_km: f32) -> f32 {
+    let pairs = RAY_INTERVALS / 2u;
+    if (p == 0u) {
+        return 0.0;
+    }
+    if (p >= pairs) {
+        return length_km;
+    }
+    let per_row = (pairs - 1u + 3u) / 4u;
+    let q = p - 1u;
+    return data[atm.ray_fractions_offset + row * per_row + q / 4u][q % 4u] * length_km;
 }

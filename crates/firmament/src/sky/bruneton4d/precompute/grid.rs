@@ -2,6 +2,8 @@
 //! (r, μ, μ_s, ν) of every scattering texel from its separable parts, and the μ_s mapping as
 //! texel positions. Both give the values of the mappings in [`params`].
 
+use super::ray_grading::RayGrading;
+use crate::atmosphere::Model;
 use crate::sky::bruneton4d::params::{self, Radii, TableSizes};
 
 /// [`params::scattering_texel`] for every texel of the tables, from its separable parts computed
@@ -14,6 +16,9 @@ pub struct ScatteringGrid {
     mu: Vec<(f64, bool)>,
     mu_s: Vec<f64>,
     u_nu: Vec<f64>,
+    /// Where each (r, μ) row's view ray is sampled (even steps until
+    /// [`ScatteringGrid::with_graded_rays`]).
+    pub rays: RayGrading,
 }
 
 impl ScatteringGrid {
@@ -37,7 +42,15 @@ impl ScatteringGrid {
             u_nu: (0..s.scattering_nu)
                 .map(|i| params::texel_uvwz(s, i, 0, 0, 0)[0])
                 .collect(),
+            rays: RayGrading::even(),
         }
+    }
+
+    /// The same grid with its view rays' samples graded through `model`
+    /// ([`RayGrading::new`]).
+    pub fn with_graded_rays(mut self, model: &Model, s: &TableSizes) -> ScatteringGrid {
+        self.rays = RayGrading::new(model, &self, s);
+        self
     }
 
     /// Same as [`params::scattering_texel`].

@@ -70,7 +70,7 @@ impl PrecomputeJob {
             top: model.top_radius_m,
             mu_s_min: model.mu_s_min,
         };
-        let grid = ScatteringGrid::new(&radii, &s);
+        let grid = ScatteringGrid::new(&radii, &s).with_graded_rays(&model, &s);
         let units = plan(config, n, model.constituents.len());
         let total_weight = units.iter().map(|u| u.weight).sum();
         let multiple_orders = config.orders >= 2;

@@ -39,7 +39,7 @@ pub(super) fn multiple_scattering_slices(
         let row = first_row + i;
         let (z, y) = (row / s.scattering_mu, row % s.scattering_mu);
         let (r, mu, _, _, ground) = grid.texel(0, y, z);
-        let rays = RaySamples::new(lookup, r, mu, ground, n);
+        let rays = RaySamples::new(lookup, r, mu, ground, grid.rays.fractions(row), n);
         let count = rays.d.len();
         // ΔJ is the scattering coefficient times a smooth field: weights fitted to the
         // total β_s·T.
@@ -191,7 +191,7 @@ pub(super) fn multiple_scattering_slices(
             }
         }
         for (o, a) in o.iter_mut().zip(&acc) {
-            *o = (a * rays.dx).max(0.0) as f32;
+            *o = a.max(0.0) as f32;
         }
     });
 }

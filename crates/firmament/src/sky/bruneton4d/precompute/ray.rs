@@ -1,14 +1,16 @@
 //! Quadrature along view rays shared by the single- and multiple-scattering passes: the
-//! samples of one ray (distances, radii, zenith cosines, transmittances) and the
-//! exponentially fitted Simpson weights of the in-scattering integral.
+//! samples of one ray (distances, radii, zenith cosines, transmittances), placed in pairs of
+//! equal intervals by `ray_grading.rs`, and the exponentially fitted Simpson weights of the
+//! in-scattering integral.
 
-use super::RAY_INTERVALS;
+use super::ray_grading::RAY_PAIRS;
 use crate::math::sphere::distance_to_nearest_atmosphere_boundary;
 use crate::sky::bruneton4d::lookup::Lookup;
 
 /// Geometry of one view ray shared by every (μ_s, ν) texel of a table row.
 pub(super) struct RaySamples {
-    pub dx: f64,
+    /// The step of each pair of intervals (m).
+    pub step: Vec<f64>,
     pub d: Vec<f64>,
     pub r: Vec<f64>,
     pub mu: Vec<f64>,
@@ -17,22 +19,34 @@ pub(super) struct RaySamples {
 }
 
 impl RaySamples {
-    /// Quadrature weights × transmittance, per sample and channel, for an integrand
+    /// Quadrature weights × transmittance (m), per sample and channel, for an integrand
     /// β(h)·(smooth) with the scattering coefficient `beta` at the samples (per sample and
     /// channel; see [`exponential_simpson_weights`]).
     pub fn weights(&self, beta: &[f64], n: usize) -> Vec<f64> {
         let f: Vec<f64> = self.t.iter().zip(beta).map(|(t, b)| t * b).collect();
-        exponential_simpson_weights(&self.t, &f, n)
+        exponential_simpson_weights(&self.t, &f, &self.step, n)
     }
 
-    pub fn new(lookup: &Lookup, r: f64, mu: f64, ground: bool, n: usize) -> RaySamples {
+    /// The samples of the ray from radius `r` at zenith cosine `mu` to the ground
+    /// (`ground`) or the top, the pairs ending at `fractions` of its length
+    /// (`RAY_PAIRS + 1` of them, from 0 to 1: [`super::ray_grading::RayGrading`]).
+    pub fn new(
+        lookup: &Lookup,
+        r: f64,
+        mu: f64,
+        ground: bool,
+        fractions: &[f64],
+        n: usize,
+    ) -> RaySamples {
         let radii = &lookup.radii;
         let length =
             distance_to_nearest_atmosphere_boundary(r, mu, radii.bottom, radii.top, ground);
-        let dx = length / RAY_INTERVALS as f64;
-        let count = RAY_INTERVALS + 1;
+        let count = 2 * RAY_PAIRS + 1;
         let mut rs = RaySamples {
-            dx,
+            step: fractions
+                .windows(2)
+                .map(|f| 0.5 * (f[1] - f[0]) * length)
+                .collect(),
             d: Vec::with_capacity(count),
             r: Vec::with_capacity(count),
             mu: Vec::with_capacity(count),
@@ -40,7 +54,13 @@ impl RaySamples {
         };
         let t = &mut rs.t;
         for i in 0..count {
-            let d = i as f64 * dx;
+            // Even samples end the pairs, odd ones are their midpoints.
+            let f = if i % 2 == 0 {
+                fractions[i / 2]
+            } else {
+                0.5 * (fractions[i / 2] + fractions[i / 2 + 1])
+            };
+            let d = f * length;
             let (r_d, mu_d) = crate::math::sphere::advance(r, mu, d, radii.bottom, radii.top);
             rs.d.push(d);
             rs.r.push(r_d);
@@ -51,8 +71,8 @@ impl RaySamples {
     }
 }
 
-/// Quadrature weights (in units of the step) for ∫ g(d)·T(d) dd over the ray samples,
-/// per sample and channel, where g = β(h)·(smooth) and `f` = β·T at the samples:
+/// Quadrature weights (m) for ∫ g(d)·T(d) dd over the ray samples, per sample and channel,
+/// where g = β(h)·(smooth), `f` = β·T at the samples and `step` each pair's step (m):
 /// Simpson's rule with F = β·T factored out as an exponential over each pair of intervals
 /// (an exponentially fitted Simpson rule, a Filon-type product rule: exact for g/β
 /// quadratic and F exponential, Simpson as the decay → 0); the weight on g_j is
@@ -66,7 +86,7 @@ impl RaySamples {
 /// sky read +5.6 % against the reference, +2.6 % with the fit to β·T). For a pair with a
 /// decay > 2.9 the end weight is slightly negative (∫₀² e^{−a·s} s(s−1) ds < 0 for
 /// a > 1.43), so a sum can round below zero; the passes clamp their results at 0.
-fn exponential_simpson_weights(t: &[f64], f: &[f64], n: usize) -> Vec<f64> {
+fn exponential_simpson_weights(t: &[f64], f: &[f64], step: &[f64], n: usize) -> Vec<f64> {
     let count = t.len() / n;
     let mut w = vec![0.0; t.len()];
     // Decay rate per step of v_fit(s) = v_0·e^{−a·s} through a pair's end points (through
@@ -97,7 +117,7 @@ fn exponential_simpson_weights(t: &[f64], f: &[f64], n: usize) -> Vec<f64> {
                 .or_else(|| rate(t0, t1, t2))
                 .unwrap_or(0.0)
                 .clamp(-30.0, 300.0);
-            let m = lagrange_exponential_moments(a);
+            let m = lagrange_exponential_moments(a).map(|m| m * step[pair]);
             // g·T = (g·q)·T_fit with q = T/T_fit smooth, g·q interpolated quadratically:
             // the weight on g_j is T_0·q_j·M_j = T_j·e^{a·j}·M_j.
             w[i * n + k] += t0 * m[0];

@@ -114,7 +114,7 @@ pub(super) fn single_scattering_slices(
             let row = first_row + i;
             let (z, y) = (row / s.scattering_mu, row % s.scattering_mu);
             let (r, mu, _, _, ground) = grid.texel(0, y, z);
-            let rays = RaySamples::new(lookup, r, mu, ground, n);
+            let rays = RaySamples::new(lookup, r, mu, ground, grid.rays.fractions(row), n);
             // Group scattering coefficients at each sample.
             let count = rays.d.len();
             let mut beta = [vec![0.0; count * n], vec![0.0; count * n]];
@@ -168,7 +168,7 @@ pub(super) fn single_scattering_slices(
             }
             for x in 0..width {
                 for k in 0..n {
-                    let e = model.solar_irradiance[k] * rays.dx;
+                    let e = model.solar_irradiance[k];
                     out_r[x * n + k] = (acc_r[x * n + k] * e).max(0.0) as f32;
                     out_m[x * n + k] = (acc_m[x * n + k] * e).max(0.0) as f32;
                 }
