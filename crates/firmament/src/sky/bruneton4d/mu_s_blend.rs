@@ -1,5 +1,5 @@
 //! Interpolation of the scattering tables along μ_s: linear (Bruneton 2017) in daylight,
-//! a monotone cubic in log L in the twilight cells.
+//! a monotone cubic in log L in the twilight cells and those of a low sun (≤ 20°).
 //!
 //! Below the horizon the light the sun sends into the air falls near-exponentially with its
 //! depression (the shadow's height rises, the lit air above it thins: Rozenberg 1966,
@@ -19,10 +19,11 @@
 //! the texture coordinate where the chord is 6–17 % off. (A Catmull–Rom cubic, exact for
 //! such a quadratic, overshoots where the brightness has a kink at a sample, as it has
 //! where the shadow leaves the top of the air: 10 km, zenith, −7.2°.) Only the cells whose two
-//! samples both have the sun at or below the ground's horizon (μ_s ≤ 0) use it, so every
-//! daylight lookup is unchanged, bit for bit; it is continuous in μ_s (it passes through
-//! the samples), and where a sample is 0 (no light) it falls back to linear, where an
-//! outer neighbour is missing or 0 to the chord in log on that side.
+//! samples both have the sun at or below [`LOG_BLEND_MAX_SUN_ELEVATION_DEG`] use it: the
+//! twilight's, and the low sun's, whose light falls exponentially with the slant optical
+//! depth; above it every lookup is Bruneton's linear blend, bit for bit. It is continuous in
+//! μ_s (it passes through the samples), and where a sample is 0 (no light) it falls back to
+//! linear, where an outer neighbour is missing or 0 to the chord in log on that side.
 //!
 //! The blend is applied per texel of the other coordinates (r, μ, ν), before their linear
 //! filter, so that a [`super::Table4::slice`] at fixed (μ_s, r) equals the 4D lookup.
@@ -30,13 +31,25 @@
 use super::params::{x_mu_s, Radii};
 use super::table::lerp_weights;
 
+/// The highest sun elevation (degrees) of the cells that [`blend`] interpolates: the
+/// twilight and the low sun. Above the horizon a low sun's light falls exponentially with
+/// its slant optical depth, ∝ 1/μ_s, and the linear blend lies above it: `hazy`, single
+/// scattering from the ground under a 5° sun, read +3.2 % looking 3° up and +4.3 % 1° up
+/// (40 μ_s samples; the same with 120 samples or this blend: −0.1 to −1.0 %), +0.3 % under a
+/// 10° sun (−0.2 … +0.1 % with it). Under a 30° sun it changes nothing measurable (`earth`,
+/// `hazy`, < 0.02 %), so the cells above 20° keep Bruneton's linear blend (and its cost).
+/// `examples/order_by_order.rs`, docs/accuracy.md ("Haze: graded ray samples").
+pub const LOG_BLEND_MAX_SUN_ELEVATION_DEG: f64 = 20.0;
+
 /// The number of μ_s cells [i, i + 1], from i = 0, that [`blend`] interpolates for `n` μ_s
-/// samples: those whose upper sample has the sun at or below the
-/// horizon at the ground (μ_s ≤ 0). The GPU's uniform holds it (`mu_s_twilight_cells`).
+/// samples: those whose upper sample has the sun at or below
+/// [`LOG_BLEND_MAX_SUN_ELEVATION_DEG`] at the ground (all the twilight cells, μ_s ≤ 0, and
+/// the low sun's). The GPU's uniform holds it (`mu_s_twilight_cells`).
 pub fn twilight_cells(radii: &Radii, n: usize) -> usize {
-    // Sample i lies at x = i/(n − 1) (texcoord_from_unit); the last with μ_s ≤ 0 is the
-    // floor of x(0)·(n − 1), and every cell below it has both ends in the twilight.
-    let last = (x_mu_s(radii, 0.0) * (n - 1) as f64).floor();
+    // Sample i lies at x = i/(n − 1) (texcoord_from_unit); the last at or below the
+    // elevation is the floor of x(μ_s)·(n − 1), and every cell below it has both ends there.
+    let mu_s = LOG_BLEND_MAX_SUN_ELEVATION_DEG.to_radians().sin();
+    let last = (x_mu_s(radii, mu_s) * (n - 1) as f64).floor();
     (last.max(0.0) as usize).min(n - 1)
 }
 
@@ -247,20 +260,22 @@ mod tests {
     const EARTH: Radii = crate::sky::bruneton4d::params::EARTH_RADII;
 
     #[test]
-    fn the_twilight_cells_end_at_the_last_sample_below_the_horizon() {
+    fn the_log_blend_cells_end_at_the_last_sample_below_the_low_sun() {
+        let highest = LOG_BLEND_MAX_SUN_ELEVATION_DEG.to_radians().sin();
         for n in [20, 32, 40, 64] {
             let k = twilight_cells(&EARTH, n);
             let mu_s = |i: usize| mu_s_from_x(&EARTH, i as f64 / (n - 1) as f64);
-            assert!(mu_s(k) <= 0.0, "n {n}: sample {k} at μ_s {}", mu_s(k));
+            assert!(mu_s(k) <= highest, "n {n}: sample {k} at μ_s {}", mu_s(k));
             assert!(
-                mu_s(k + 1) > 0.0,
+                mu_s(k + 1) > highest,
                 "n {n}: sample {} at μ_s {}",
                 k + 1,
                 mu_s(k + 1)
             );
         }
-        // Earth's 40 samples: 11 cells, from −12° to −0.05°.
-        assert_eq!(twilight_cells(&EARTH, 40), 11);
+        // Earth's 40 samples: 26 cells, from −12° to 19.1° (the next sample is at 24.5°),
+        // the first 11 (to −0.05°) in the twilight.
+        assert_eq!(twilight_cells(&EARTH, 40), 26);
     }
 
     #[test]
