@@ -8,8 +8,8 @@
 //! ```
 //!
 //! Environment: `ORDERS=1,2,3,0` (the orders compared), `VIEWS=ELEVATION/AZIMUTH,...`
-//! (degrees, azimuth from the sun), `NMU`, `NNU` (the scattering table's μ and ν sizes, to
-//! see whether a resolution is the cause). docs/accuracy.md ("Haze") shows what it found.
+//! (degrees, azimuth from the sun), `NMU`, `NNU`, `NMUS`, `NR` (the scattering table's μ, ν,
+//! μ_s and r sizes, to see whether a resolution is the cause). docs/accuracy.md ("Haze") shows what it found.
 
 use firmament::atmosphere::Atmosphere;
 use firmament::math::{direction_from_zenith_azimuth, Vec3};
@@ -50,6 +50,8 @@ fn main() -> firmament::Result<()> {
             sizes: firmament::sky::bruneton4d::TableSizes {
                 scattering_mu: std::env::var("NMU").map_or(128, |v| v.parse().expect("NMU")),
                 scattering_nu: std::env::var("NNU").map_or(8, |v| v.parse().expect("NNU")),
+                scattering_mu_s: std::env::var("NMUS").map_or(40, |v| v.parse().expect("NMUS")),
+                scattering_r: std::env::var("NR").map_or(32, |v| v.parse().expect("NR")),
                 ..Default::default()
             },
             ..TableConfig::default()
