@@ -5,7 +5,8 @@
 //! planet's radius) the next row is 0.92 km up: from there, looking 3° down 30° from a 10°
 //! sun, the second order (tables of 2 orders, reference cut at 2 events, 550 nm) read
 //! −10.5 % with every ground texel at the nadir, −3.1 % with the ground row mended (10° down
-//! at 90°: −5.0 %), −2.6 % / −4.3 % since the sky rows and ΔJ/β_s of 2026-12-06.
+//! at 90°: −5.0 %), −2.6 % / −4.3 % since the sky rows and ΔJ/β_s of 2026-12-06, −2.3 % /
+//! −4.1 % with graded ray samples (2026-12-07).
 
 mod common;
 
