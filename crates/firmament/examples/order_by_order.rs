@@ -7,7 +7,8 @@
 //! cargo run --release -p firmament --example order_by_order -- PRESET SUN_ELEVATION_DEG [ALTITUDE_M] [PATHS]
 //! ```
 //!
-//! Environment: `ORDERS=1,2,3,0` (the orders compared), `VIEWS=ELEVATION/AZIMUTH,...`
+//! Environment: `ORDERS=1,2,3,0` (the orders compared), `TAIL_AFTER` (the orders before the
+//! tail of N = 0, default 4), `VIEWS=ELEVATION/AZIMUTH,...`
 //! (degrees, azimuth from the sun), `NMU`, `NNU`, `NMUS`, `NR` (the scattering table's μ, ν,
 //! μ_s and r sizes, to see whether a resolution is the cause). docs/accuracy.md ("Haze") shows what it found.
 
@@ -43,9 +44,10 @@ fn main() -> firmament::Result<()> {
         .split(',')
         .map(|s| s.parse().expect("orders"))
         .collect();
+    let tail_after: usize = std::env::var("TAIL_AFTER").map_or(4, |v| v.parse().expect("orders"));
     for orders in list {
         let config = TableConfig {
-            orders: if orders == 0 { 4 } else { orders },
+            orders: if orders == 0 { tail_after } else { orders },
             order_tail: orders == 0,
             sizes: firmament::sky::bruneton4d::TableSizes {
                 scattering_mu: std::env::var("NMU").map_or(128, |v| v.parse().expect("NMU")),
@@ -65,7 +67,7 @@ fn main() -> firmament::Result<()> {
         let mut line = format!(
             "orders {}:",
             if orders == 0 {
-                "4+tail".into()
+                format!("{tail_after}+tail")
             } else {
                 orders.to_string()
             }
