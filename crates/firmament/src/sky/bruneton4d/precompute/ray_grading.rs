@@ -29,6 +29,7 @@ use rayon::prelude::*;
 
 use super::grid::ScatteringGrid;
 use super::RAY_INTERVALS;
+use crate::atmosphere::density_table::DensityTable;
 use crate::atmosphere::Model;
 use crate::math::sphere::distance_to_nearest_atmosphere_boundary;
 use crate::sky::bruneton4d::params::{Radii, TableSizes};
@@ -106,53 +107,37 @@ impl RayGrading {
     }
 }
 
-/// Altitudes at which [`Extinction`] tabulates the mean extinction.
+/// Altitudes at which [`Extinction`] tabulates the constituents' densities.
 const EXTINCTION_SAMPLES: usize = 1024;
 
-/// The extinction coefficient averaged over the channels (m⁻¹), tabulated over altitude
-/// (linear interpolation: the placement need not be exact, and a lookup costs a few ns
-/// where the constituents' profiles cost an exponential each).
+/// The extinction coefficient averaged over the channels (m⁻¹) from the densities
+/// tabulated over altitude ([`DensityTable`], linear interpolation: the placement need not
+/// be exact, and a lookup costs a few ns where the profiles cost an exponential each).
 struct Extinction {
-    bottom_m: f64,
-    inv_step_m: f64,
-    values: Vec<f64>,
+    densities: DensityTable,
+    /// Each constituent's extinction per unit density averaged over the channels (m⁻¹).
+    weights: Vec<f64>,
 }
 
 impl Extinction {
     fn new(model: &Model) -> Extinction {
         let n = model.channels().max(1) as f64;
-        let weights: Vec<f64> = model
-            .constituents
-            .iter()
-            .map(|c| c.extinction.iter().sum::<f64>() / n)
-            .collect();
-        let height = model.top_radius_m - model.bottom_radius_m;
-        let step = height / (EXTINCTION_SAMPLES - 1) as f64;
-        let values = (0..EXTINCTION_SAMPLES)
-            .map(|i| {
-                let altitude = i as f64 * step;
-                model
-                    .constituents
-                    .iter()
-                    .zip(&weights)
-                    .map(|(c, w)| c.density.density(altitude) * w)
-                    .sum()
-            })
-            .collect();
         Extinction {
-            bottom_m: model.bottom_radius_m,
-            inv_step_m: 1.0 / step,
-            values,
+            densities: DensityTable::new(model, EXTINCTION_SAMPLES),
+            weights: model
+                .constituents
+                .iter()
+                .map(|c| c.extinction.iter().sum::<f64>() / n)
+                .collect(),
         }
     }
 
-    /// At radius `r` (m), clamped to the atmosphere.
+    /// At radius `r` (m), clamped to the atmosphere; `rho` is scratch, one per constituent.
     #[inline]
-    fn at(&self, r: f64) -> f64 {
-        let x = ((r - self.bottom_m) * self.inv_step_m).clamp(0.0, (EXTINCTION_SAMPLES - 1) as f64);
-        let i = (x as usize).min(EXTINCTION_SAMPLES - 2);
-        let t = x - i as f64;
-        self.values[i] + t * (self.values[i + 1] - self.values[i])
+    fn at(&self, r: f64, rho: &mut [f64]) -> f64 {
+        rho.iter_mut().for_each(|v| *v = 0.0);
+        self.densities.add_densities(r, 1.0, rho);
+        rho.iter().zip(&self.weights).map(|(d, w)| d * w).sum()
     }
 }
 
@@ -170,11 +155,11 @@ fn pair_fractions(
     let (bottom, top) = (model.bottom_radius_m, model.top_radius_m);
     let length = distance_to_nearest_atmosphere_boundary(r, mu, bottom, top, ground);
     let steps = RAY_PAIRS * FINE;
-    let extinction = |j: usize| {
+    let mut rho = vec![0.0; extinction.weights.len()];
+    let mut extinction = |j: usize| {
         let d = length * j as f64 / steps as f64;
-        extinction.at(crate::math::sphere::safe_sqrt(
-            d * d + 2.0 * r * mu * d + r * r,
-        ))
+        let r_d = crate::math::sphere::safe_sqrt(d * d + 2.0 * r * mu * d + r * r);
+        extinction.at(r_d, &mut rho)
     };
     // Cumulative optical depth (in units of the fine step) at each fine point.
     let mut tau = Vec::with_capacity(steps + 1);
