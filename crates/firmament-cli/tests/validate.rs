@@ -77,6 +77,67 @@ fn validate_quick_passes_and_writes_json() {
     assert!(y["p95"].as_f64().unwrap() <= 0.05);
     // The reference's own noise is reported and small.
     assert!(y["reference_median_relative_stderr"].as_f64().unwrap() <= 0.011);
+
+    // The same run against that file's reference (`--reference`): nothing traced, the
+    // very same estimates and errors, the 30° sun read and the 5° sun (not in the file)
+    // traced.
+    let again_path = dir.join("again.json");
+    let out = run(&[
+        "validate",
+        "--quick",
+        "--quiet",
+        "--sun-elevations",
+        "30,5",
+        "--reference",
+        json_path.to_str().unwrap(),
+        "--json",
+        again_path.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let w: Value = serde_json::from_str(&std::fs::read_to_string(&again_path).unwrap()).unwrap();
+    assert_eq!(w["reference_file"], json_path.to_str().unwrap());
+    let again = w["configurations"].as_array().unwrap();
+    assert_eq!(again.len(), 4);
+    for c in again {
+        let sun = c["sun_elevation_deg"].as_f64().unwrap();
+        assert_eq!(c["reference_from_file"], sun == 30.0, "sun {sun}");
+        if sun != 30.0 {
+            continue;
+        }
+        let first = configs
+            .iter()
+            .find(|f| f["altitude_m"] == c["altitude_m"] && f["sun_elevation_deg"] == 30.0)
+            .unwrap();
+        for (a, b) in first["views"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(c["views"].as_array().unwrap())
+        {
+            for key in ["radiance", "stderr", "samples"] {
+                assert_eq!(a["reference"][key], b["reference"][key]);
+            }
+            assert_eq!(a["tables"][0]["radiance"], b["tables"][0]["radiance"]);
+            let error = |v: &Value| v["tables"][0]["relative_error_luminance"].as_f64().unwrap();
+            assert!((error(a) - error(b)).abs() < 1e-12);
+        }
+    }
+    // Another wavelength set is refused, naming the flag and the file.
+    let out = run(&[
+        "validate",
+        "--quick",
+        "--quiet",
+        "--wavelengths",
+        "spectral",
+        "--reference",
+        json_path.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let e = stderr(&out);
+    assert!(
+        e.contains("--reference") && e.contains("wavelengths"),
+        "{e}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 

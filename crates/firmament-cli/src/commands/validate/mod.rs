@@ -26,6 +26,7 @@
 //! `--samples` fixes the count.
 
 mod compare;
+mod reuse;
 mod sampling;
 mod summary;
 mod views;
@@ -45,6 +46,7 @@ use crate::common::{
 };
 use crate::method::{CpuSky, HillaireArgs, Method};
 use compare::{compare_method, ViewRecord};
+use reuse::StoredReference;
 use sampling::{trace_views, SamplePlan, PILOT_SAMPLES};
 use summary::{RelativeErrors, Summaries};
 use views::{direction_from_elevation_deg, views};
@@ -118,6 +120,12 @@ pub struct ValidateArgs {
     /// Seed of the reference's random streams.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Reuse the reference of an earlier run: its `--json` file. Its configurations are
+    /// read, not traced (they must hold this run's views and wavelengths), so a method's
+    /// before and after are compared against the very same estimates in seconds; the
+    /// configurations it lacks are traced.
+    #[arg(long, value_name = "FILE")]
+    pub reference: Option<PathBuf>,
     /// Print nothing but the results and errors.
     #[arg(long, short)]
     pub quiet: bool,
@@ -330,6 +338,7 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
     // Earth daylight aggregates, one per candidate.
     let mut daylight: Vec<Option<RelativeErrors>> = candidates.iter().map(|_| None).collect();
     let mut configuration_index = 0u64;
+    let mut stored: Option<StoredReference> = None;
     println!("{}", selection.headline());
     for source in &selection.presets {
         let preset = source.label();
@@ -344,6 +353,16 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
             .collect::<Result<_>>()?;
         let model = skies[0].model();
         wavelengths_nm = model.wavelengths.nm().to_vec();
+        if let (Some(path), None) = (&args.reference, &stored) {
+            let read = StoredReference::read(path, &wavelengths_nm)?;
+            if !args.quiet {
+                println!(
+                    "reference read from {} where it has the configuration",
+                    read.path()
+                );
+            }
+            stored = Some(read);
+        }
         let colour = ColourMatrix::new(&wavelengths_nm);
         let configurations: Vec<(f64, f64)> = selection
             .altitudes_m
@@ -362,17 +381,28 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
             let reference_started = Instant::now();
             let sun = direction_from_elevation_deg(elevation, 0.0);
             let camera = Vec3::new(0.0, 0.0, model.bottom_radius_m + altitude);
-            let estimates = trace_views(
-                model,
-                &colour,
-                camera,
-                sun,
-                views,
-                &selection.samples,
-                args.seed,
-                configuration_index,
-                &bar,
-            )?;
+            let reused = match &stored {
+                Some(s) => s.estimates(&preset, altitude, elevation, views)?,
+                None => None,
+            };
+            let from_file = reused.is_some();
+            let estimates = match reused {
+                Some(estimates) => {
+                    bar.inc(views.len() as u64);
+                    estimates
+                }
+                None => trace_views(
+                    model,
+                    &colour,
+                    camera,
+                    sun,
+                    views,
+                    &selection.samples,
+                    args.seed,
+                    configuration_index,
+                    &bar,
+                )?,
+            };
             let reference_seconds = reference_started.elapsed().as_secs_f64();
             let samples: Vec<usize> = estimates.iter().map(|e| e.samples).collect();
             let mut records: Vec<ViewRecord> = views
@@ -393,12 +423,16 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
                 .collect();
             bar.suspend(|| {
                 println!(
-                    "{preset} altitude {altitude} m, sun elevation {elevation}°: {} views ({} skipped), {}–{} paths/λ, reference {:.1} s",
+                    "{preset} altitude {altitude} m, sun elevation {elevation}°: {} views ({} skipped), {}–{} paths/λ, reference {}",
                     views.len(),
                     skipped,
                     samples.iter().min().unwrap_or(&0),
                     samples.iter().max().unwrap_or(&0),
-                    reference_seconds
+                    if from_file {
+                        "read from --reference".to_string()
+                    } else {
+                        format!("{reference_seconds:.1} s")
+                    }
                 );
                 for (c, s) in candidates.iter().zip(&summaries) {
                     if candidates.len() > 1 {
@@ -420,6 +454,7 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
                 "sun_elevation_deg": elevation,
                 "views_skipped": skipped,
                 "reference_seconds": reference_seconds,
+                "reference_from_file": from_file,
                 "tables": candidates.iter().zip(&summaries).map(|(c, s)| json!({
                     "method": c.method.name(),
                     "orders": c.orders,
@@ -479,6 +514,7 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
             "table_size": selection.table_size,
             "wavelengths_nm": wavelengths_nm,
             "seed": args.seed,
+            "reference_file": args.reference.as_ref().map(|p| p.display().to_string()),
             "samples": match selection.samples {
                 SamplePlan::Fixed(n) => json!({ "fixed": n }),
                 SamplePlan::Adaptive { target, max } => json!({
