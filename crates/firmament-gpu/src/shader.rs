@@ -43,11 +43,12 @@ pub const COMMON: [Module; 5] = [
 ];
 
 /// The 4D tables' parameterisations, filters and lookups.
-pub const BRUNETON4D: [Module; 5] = [
+pub const BRUNETON4D: [Module; 6] = [
     module!("bruneton4d/params.wgsl"),
     module!("bruneton4d/mu_s_map.wgsl"),
     module!("bruneton4d/table.wgsl"),
     module!("bruneton4d/mu_s_blend.wgsl"),
+    module!("bruneton4d/r_blend.wgsl"),
     module!("bruneton4d/lookup.wgsl"),
 ];
 

@@ -93,40 +93,72 @@ fn delta_irradiance(altitude_km: f32, mu_s: f32, k: u32) -> vec4<f32> {
     return irradiance_at(irradiance_uv(altitude_km, mu_s), k);
 }
 
-// Σ over the four (ν, μ_s) columns of one (r, μ) row, channel group k; in a twilight cell
-// the twilight blend along μ_s of each ν column, then linear in ν.
-fn scattering_a_row(f: Filter4, row: u32, k: u32) -> vec4<f32> {
-    let g = atm.groups;
-    if (f.mu_s.twilight) {
-        let c0 = mu_s_blend_at(f.mu_s, scattering_a[(row + f.colb.x) * g + k], scattering_a[(row + f.col.x) * g + k],
-            scattering_a[(row + f.col.y) * g + k], scattering_a[(row + f.cola.x) * g + k]);
-        let c1 = mu_s_blend_at(f.mu_s, scattering_a[(row + f.colb.y) * g + k], scattering_a[(row + f.col.z) * g + k],
-            scattering_a[(row + f.col.w) * g + k], scattering_a[(row + f.cola.y) * g + k]);
-        return f.wnu.x * c0 + f.wnu.y * c1;
-    }
-    return f.wcol.x * scattering_a[(row + f.col.x) * g + k] + f.wcol.y * scattering_a[(row + f.col.y) * g + k]
-        + f.wcol.z * scattering_a[(row + f.col.z) * g + k] + f.wcol.w * scattering_a[(row + f.col.w) * g + k];
+// The two ν columns (ν0, ν1) of one (r, μ) row of a 4D lookup, blended along μ_s.
+struct Columns {
+    c0: vec4<f32>,
+    c1: vec4<f32>,
 }
 
-fn scattering_b_row(f: Filter4, row: u32, k: u32) -> vec4<f32> {
-    let g = atm.groups;
-    if (f.mu_s.twilight) {
-        let c0 = mu_s_blend_at(f.mu_s, scattering_b[(row + f.colb.x) * g + k], scattering_b[(row + f.col.x) * g + k],
-            scattering_b[(row + f.col.y) * g + k], scattering_b[(row + f.cola.x) * g + k]);
-        let c1 = mu_s_blend_at(f.mu_s, scattering_b[(row + f.colb.y) * g + k], scattering_b[(row + f.col.z) * g + k],
-            scattering_b[(row + f.col.w) * g + k], scattering_b[(row + f.cola.y) * g + k]);
-        return f.wnu.x * c0 + f.wnu.y * c1;
-    }
-    return f.wcol.x * scattering_b[(row + f.col.x) * g + k] + f.wcol.y * scattering_b[(row + f.col.y) * g + k]
-        + f.wcol.z * scattering_b[(row + f.col.z) * g + k] + f.wcol.w * scattering_b[(row + f.col.w) * g + k];
+// Table4::sample_rows_into from each row's columns (rows z0 y0, z0 y1, z1 y0, z1 y1): per
+// (μ, ν) texel the blend along r (r_blend.wgsl), then bilinear in (μ, ν).
+fn blend_rows(f: Filter4, z0y0: Columns, z0y1: Columns, z1y0: Columns, z1y1: Columns) -> vec4<f32> {
+    let y0 = f.wnu.x * r_blend(z0y0.c0, z1y0.c0, f.r) + f.wnu.y * r_blend(z0y0.c1, z1y0.c1, f.r);
+    let y1 = f.wnu.x * r_blend(z0y1.c0, z1y1.c0, f.r) + f.wnu.y * r_blend(z0y1.c1, z1y1.c1, f.r);
+    return f.wy.x * y0 + f.wy.y * y1;
 }
 
+// The columns of one row from the texels at s0 and s1 of its ν0 column (a0, a1) and its ν1
+// column (d0, d1): linear along μ_s.
+fn linear_columns(f: Filter4, a0: vec4<f32>, a1: vec4<f32>, d0: vec4<f32>, d1: vec4<f32>) -> Columns {
+    var c: Columns;
+    c.c0 = a0 + f.mu_s.t * (a1 - a0);
+    c.c1 = d0 + f.mu_s.t * (d1 - d0);
+    return c;
+}
+
+// In a twilight cell: each ν column's samples below s0, at s0, at s1 and above s1 blended
+// by mu_s_blend.wgsl.
+fn twilight_columns(f: Filter4, b0: vec4<f32>, a0: vec4<f32>, a1: vec4<f32>, c0: vec4<f32>,
+    b1: vec4<f32>, d0: vec4<f32>, d1: vec4<f32>, c1: vec4<f32>) -> Columns {
+    var c: Columns;
+    c.c0 = mu_s_blend_at(f.mu_s, b0, a0, a1, c0);
+    c.c1 = mu_s_blend_at(f.mu_s, b1, d0, d1, c1);
+    return c;
+}
+
+fn scattering_a_columns(f: Filter4, row: u32, k: u32) -> Columns {
+    let g = atm.groups;
+    let a0 = scattering_a[(row + f.col.x) * g + k];
+    let a1 = scattering_a[(row + f.col.y) * g + k];
+    let d0 = scattering_a[(row + f.col.z) * g + k];
+    let d1 = scattering_a[(row + f.col.w) * g + k];
+    if (f.mu_s.twilight) {
+        return twilight_columns(f, scattering_a[(row + f.colb.x) * g + k], a0, a1, scattering_a[(row + f.cola.x) * g + k],
+            scattering_a[(row + f.colb.y) * g + k], d0, d1, scattering_a[(row + f.cola.y) * g + k]);
+    }
+    return linear_columns(f, a0, a1, d0, d1);
+}
+
+fn scattering_b_columns(f: Filter4, row: u32, k: u32) -> Columns {
+    let g = atm.groups;
+    let a0 = scattering_b[(row + f.col.x) * g + k];
+    let a1 = scattering_b[(row + f.col.y) * g + k];
+    let d0 = scattering_b[(row + f.col.z) * g + k];
+    let d1 = scattering_b[(row + f.col.w) * g + k];
+    if (f.mu_s.twilight) {
+        return twilight_columns(f, scattering_b[(row + f.colb.x) * g + k], a0, a1, scattering_b[(row + f.cola.x) * g + k],
+            scattering_b[(row + f.colb.y) * g + k], d0, d1, scattering_b[(row + f.cola.y) * g + k]);
+    }
+    return linear_columns(f, a0, a1, d0, d1);
+}
+
+// The 4D lookup of the table at slot a (Table4::sample_into), channel group k.
 fn sample_scattering_a(f: Filter4, k: u32) -> vec4<f32> {
-    return f.wrow.x * scattering_a_row(f, f.row.x, k) + f.wrow.y * scattering_a_row(f, f.row.y, k)
-        + f.wrow.z * scattering_a_row(f, f.row.z, k) + f.wrow.w * scattering_a_row(f, f.row.w, k);
+    return blend_rows(f, scattering_a_columns(f, f.row.x, k), scattering_a_columns(f, f.row.y, k),
+        scattering_a_columns(f, f.row.z, k), scattering_a_columns(f, f.row.w, k));
 }
 
 fn sample_scattering_b(f: Filter4, k: u32) -> vec4<f32> {
-    return f.wrow.x * scattering_b_row(f, f.row.x, k) + f.wrow.y * scattering_b_row(f, f.row.y, k)
-        + f.wrow.z * scattering_b_row(f, f.row.z, k) + f.wrow.w * scattering_b_row(f, f.row.w, k);
+    return blend_rows(f, scattering_b_columns(f, f.row.x, k), scattering_b_columns(f, f.row.y, k),
+        scattering_b_columns(f, f.row.z, k), scattering_b_columns(f, f.row.w, k));
 }

@@ -19,15 +19,14 @@ fn lerp_weights(u: f32, n: u32) -> Lerp {
     return l;
 }
 
-// The 16 texels and weights of a 4D scattering lookup (Table4::sample_rows_into): trilinear
-// in (μ_s, μ, r) at the two nearest ν slices, then a lerp in ν. Texel (i, j) is
-// row[i] + col[j] with weight wrow[i]·wcol[j]: rows are the (r, μ) pairs (z0 y0, z0 y1,
-// z1 y0, z1 y1), columns the (ν, μ_s) pairs (ν0 s0, ν0 s1, ν1 s0, ν1 s1). Vectors, not
-// arrays: no dynamically indexed private memory (slow on software rasterisers).
-//
-// In a twilight cell along μ_s (mu_s_blend.wgsl) the columns are blended along μ_s with
-// their outer neighbours colb (ν0, ν1 at the sample below s0) and cola (above s1), then in ν
-// by wnu, instead of by wcol.
+// The 16 texels and weights of a 4D scattering lookup (Table4::sample_rows_into). Texel
+// (i, j) is row[i] + col[j]: rows are the (r, μ) pairs (z0 y0, z0 y1, z1 y0, z1 y1), columns
+// the (ν, μ_s) pairs (ν0 s0, ν0 s1, ν1 s0, ν1 s1). A lookup blends each row's ν columns along
+// μ_s (linearly by mu_s.t, or in a twilight cell by mu_s_blend.wgsl with their outer
+// neighbours colb (ν0, ν1 at the sample below s0) and cola (above s1)), then each (μ, ν)
+// texel along r (r_blend.wgsl, filter r), then bilinearly by wy and wnu. wrow·wcol are the
+// plain trilinear weights (Bruneton's), which the precomputation's ΔJ lookups keep. Vectors,
+// not arrays: no dynamically indexed private memory (slow on software rasterisers).
 struct Filter4 {
     row: vec4<u32>,
     col: vec4<u32>,
@@ -37,9 +36,11 @@ struct Filter4 {
     colb: vec2<u32>,
     cola: vec2<u32>,
     wnu: vec2<f32>,
+    wy: vec2<f32>,
+    r: RFilter,
 }
 
-fn scattering_filter_rows(u_nu: f32, u_mu_s: f32, ly: Lerp, lz: Lerp) -> Filter4 {
+fn scattering_filter_rows(u_nu: f32, u_mu_s: f32, ly: Lerp, r: RFilter) -> Filter4 {
     let nnu = atm.scattering_nu;
     let nmu_s = atm.scattering_mu_s;
     let tex_x = u_nu * f32(nnu - 1u);
@@ -52,24 +53,26 @@ fn scattering_filter_rows(u_nu: f32, u_mu_s: f32, ly: Lerp, lz: Lerp) -> Filter4
     ls.i1 = m.s1;
     ls.t = m.t;
     let width = scattering_width();
-    let z = vec4<u32>(lz.i0, lz.i0, lz.i1, lz.i1);
+    let z = vec4<u32>(r.z0, r.z0, r.z1, r.z1);
     let y = vec4<u32>(ly.i0, ly.i1, ly.i0, ly.i1);
     let n = vec4<u32>(nu0, nu0, nu1, nu1);
     let ms = vec4<u32>(ls.i0, ls.i1, ls.i0, ls.i1);
     var f: Filter4;
     f.row = (z * atm.scattering_mu + y) * width;
     f.col = n * nmu_s + ms;
-    f.wrow = vec4<f32>(1.0 - lz.t, 1.0 - lz.t, lz.t, lz.t) * vec4<f32>(1.0 - ly.t, ly.t, 1.0 - ly.t, ly.t);
+    f.wrow = vec4<f32>(1.0 - r.t, 1.0 - r.t, r.t, r.t) * vec4<f32>(1.0 - ly.t, ly.t, 1.0 - ly.t, ly.t);
     f.wcol = vec4<f32>(1.0 - tnu, 1.0 - tnu, tnu, tnu) * vec4<f32>(1.0 - ls.t, ls.t, 1.0 - ls.t, ls.t);
     f.mu_s = m;
     f.colb = vec2<u32>(nu0, nu1) * nmu_s + m.below;
     f.cola = vec2<u32>(nu0, nu1) * nmu_s + m.above;
     f.wnu = vec2<f32>(1.0 - tnu, tnu);
+    f.wy = vec2<f32>(1.0 - ly.t, ly.t);
+    f.r = r;
     return f;
 }
 
 fn scattering_filter(uvwz: vec4<f32>) -> Filter4 {
-    return scattering_filter_rows(uvwz.x, uvwz.y, lerp_weights(uvwz.z, atm.scattering_mu), lerp_weights(uvwz.w, atm.scattering_r));
+    return scattering_filter_rows(uvwz.x, uvwz.y, lerp_weights(uvwz.z, atm.scattering_mu), r_filter(uvwz.w, atm.scattering_r));
 }
 
 // Bilinear filter of a 2D table: the four texels (vec4 indices without the group) and weights.

@@ -207,45 +207,45 @@ fn sample_transmittance_between(f: TransmittanceFilters, k: u32) -> vec4<f32> {
 
 // Channel 0 of a red-only single Mie table: texel t at t (one vec4 per texel, from the CPU)
 // or at t·groups (the full layout of the GPU precomputation).
-fn mie_red_row(v: View, f: Filter4, row: u32) -> f32 {
+fn mie_red_columns(v: View, f: Filter4, row: u32) -> Columns {
     var g = atm.groups;
     if (v.mie_layout == 1u) {
         g = 1u;
     }
+    let a0 = vec4<f32>(scattering_b[(row + f.col.x) * g].x);
+    let a1 = vec4<f32>(scattering_b[(row + f.col.y) * g].x);
+    let d0 = vec4<f32>(scattering_b[(row + f.col.z) * g].x);
+    let d1 = vec4<f32>(scattering_b[(row + f.col.w) * g].x);
     if (f.mu_s.twilight) {
-        let c0 = mu_s_blend_at(f.mu_s, vec4<f32>(scattering_b[(row + f.colb.x) * g].x), vec4<f32>(scattering_b[(row + f.col.x) * g].x),
-            vec4<f32>(scattering_b[(row + f.col.y) * g].x), vec4<f32>(scattering_b[(row + f.cola.x) * g].x));
-        let c1 = mu_s_blend_at(f.mu_s, vec4<f32>(scattering_b[(row + f.colb.y) * g].x), vec4<f32>(scattering_b[(row + f.col.z) * g].x),
-            vec4<f32>(scattering_b[(row + f.col.w) * g].x), vec4<f32>(scattering_b[(row + f.cola.y) * g].x));
-        return f.wnu.x * c0.x + f.wnu.y * c1.x;
+        return twilight_columns(f, vec4<f32>(scattering_b[(row + f.colb.x) * g].x), a0, a1, vec4<f32>(scattering_b[(row + f.cola.x) * g].x),
+            vec4<f32>(scattering_b[(row + f.colb.y) * g].x), d0, d1, vec4<f32>(scattering_b[(row + f.cola.y) * g].x));
     }
-    return f.wcol.x * scattering_b[(row + f.col.x) * g].x + f.wcol.y * scattering_b[(row + f.col.y) * g].x
-        + f.wcol.z * scattering_b[(row + f.col.z) * g].x + f.wcol.w * scattering_b[(row + f.col.w) * g].x;
+    return linear_columns(f, a0, a1, d0, d1);
 }
 
 fn sample_mie_red(v: View, f: Filter4) -> f32 {
-    return f.wrow.x * mie_red_row(v, f, f.row.x) + f.wrow.y * mie_red_row(v, f, f.row.y)
-        + f.wrow.z * mie_red_row(v, f, f.row.z) + f.wrow.w * mie_red_row(v, f, f.row.w);
+    return blend_rows(f, mie_red_columns(v, f, f.row.x), mie_red_columns(v, f, f.row.y),
+        mie_red_columns(v, f, f.row.z), mie_red_columns(v, f, f.row.w)).x;
 }
 
 // Multiple scattering of channel group k at a 4D filter (Table4::sample_into on
 // Tables::multiple), as sample_scattering_a does for slot a.
-fn multiple_row(f: Filter4, row: u32, k: u32) -> vec4<f32> {
+fn multiple_columns(f: Filter4, row: u32, k: u32) -> Columns {
     let g = atm.groups;
+    let a0 = multiple_table[(row + f.col.x) * g + k];
+    let a1 = multiple_table[(row + f.col.y) * g + k];
+    let d0 = multiple_table[(row + f.col.z) * g + k];
+    let d1 = multiple_table[(row + f.col.w) * g + k];
     if (f.mu_s.twilight) {
-        let c0 = mu_s_blend_at(f.mu_s, multiple_table[(row + f.colb.x) * g + k], multiple_table[(row + f.col.x) * g + k],
-            multiple_table[(row + f.col.y) * g + k], multiple_table[(row + f.cola.x) * g + k]);
-        let c1 = mu_s_blend_at(f.mu_s, multiple_table[(row + f.colb.y) * g + k], multiple_table[(row + f.col.z) * g + k],
-            multiple_table[(row + f.col.w) * g + k], multiple_table[(row + f.cola.y) * g + k]);
-        return f.wnu.x * c0 + f.wnu.y * c1;
+        return twilight_columns(f, multiple_table[(row + f.colb.x) * g + k], a0, a1, multiple_table[(row + f.cola.x) * g + k],
+            multiple_table[(row + f.colb.y) * g + k], d0, d1, multiple_table[(row + f.cola.y) * g + k]);
     }
-    return f.wcol.x * multiple_table[(row + f.col.x) * g + k] + f.wcol.y * multiple_table[(row + f.col.y) * g + k]
-        + f.wcol.z * multiple_table[(row + f.col.z) * g + k] + f.wcol.w * multiple_table[(row + f.col.w) * g + k];
+    return linear_columns(f, a0, a1, d0, d1);
 }
 
 fn sample_multiple(f: Filter4, k: u32) -> vec4<f32> {
-    return f.wrow.x * multiple_row(f, f.row.x, k) + f.wrow.y * multiple_row(f, f.row.y, k)
-        + f.wrow.z * multiple_row(f, f.row.z, k) + f.wrow.w * multiple_row(f, f.row.w, k);
+    return blend_rows(f, multiple_columns(f, f.row.x, k), multiple_columns(f, f.row.y, k),
+        multiple_columns(f, f.row.z, k), multiple_columns(f, f.row.w, k));
 }
 
 // The bilinear (ν, μ) filter of a slice (Table4::sample_slice_channels_into); indices are
@@ -583,6 +583,41 @@ struct SliceCoordinates {
 
 @group(0) @binding(15) var<uniform> slice_coordinates: SliceCoordinates;
 
+// One r row of a slice entry: the three tables' texels at the row's ν column `base`,
+// blended along μ_s (mu_s_blend.wgsl in a twilight cell, else linear). Red-only Mie
+// (mie_layout 1) in .x of channel group 0.
+struct SliceRow {
+    scattering: vec4<f32>,
+    multiple: vec4<f32>,
+    mie: vec4<f32>,
+}
+
+fn mu_s_blend_row(m: MuSFilter, below: vec4<f32>, a: vec4<f32>, b: vec4<f32>, above: vec4<f32>) -> vec4<f32> {
+    if (m.twilight) {
+        return mu_s_blend_at(m, below, a, b, above);
+    }
+    return a + m.t * (b - a);
+}
+// (Outside a twilight cell the slice reads below = s0 and above = s1: no extra texels.)
+
+fn slice_row(m: MuSFilter, base: u32, k: u32, mie_layout: u32) -> SliceRow {
+    let g = atm.groups;
+    let below = select(m.s0, m.below, m.twilight);
+    let above = select(m.s1, m.above, m.twilight);
+    let t = vec4<u32>(base + below, base + m.s0, base + m.s1, base + above);
+    var s: SliceRow;
+    s.scattering = mu_s_blend_row(m, scattering_a[t.x * g + k], scattering_a[t.y * g + k], scattering_a[t.z * g + k], scattering_a[t.w * g + k]);
+    s.multiple = mu_s_blend_row(m, multiple_table[t.x * g + k], multiple_table[t.y * g + k], multiple_table[t.z * g + k], multiple_table[t.w * g + k]);
+    if (mie_layout == 0u) {
+        s.mie = mu_s_blend_row(m, scattering_b[t.x * g + k], scattering_b[t.y * g + k], scattering_b[t.z * g + k], scattering_b[t.w * g + k]);
+    } else if (k == 0u) {
+        let gm = select(g, 1u, mie_layout == 1u);
+        s.mie = vec4<f32>(mu_s_blend_row(m, vec4<f32>(scattering_b[t.x * gm].x), vec4<f32>(scattering_b[t.y * gm].x),
+            vec4<f32>(scattering_b[t.z * gm].x), vec4<f32>(scattering_b[t.w * gm].x)).x, 0.0, 0.0, 0.0);
+    }
+    return s;
+}
+
 @compute @workgroup_size(64)
 fn camera_slice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = invocation_index(gid, nwg);
@@ -598,51 +633,15 @@ fn camera_slice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     let nu = e % atm.scattering_nu;
     let at = slice_coordinates.at[light];
     let m = mu_s_filter(at.x, atm.scattering_mu_s, atm.mu_s_twilight_cells);
-    let lz = lerp_weights(at.y, atm.scattering_r);
+    let rf = r_filter(at.y, atm.scattering_r);
     let width = scattering_width();
-    let mie_layout = slice_coordinates.mie_layout;
-    var gm = g;
-    if (mie_layout == 1u) {
-        gm = 1u;
-    }
-    var scattering = vec4<f32>(0.0);
-    var multiple = vec4<f32>(0.0);
-    var mie = vec4<f32>(0.0);
-    if (m.twilight) {
-        // Table4::slice in a twilight cell: the twilight blend along μ_s per r row, then
-        // linear in r.
-        let rows = (vec2<u32>(lz.i0, lz.i1) * atm.scattering_mu + y) * width + nu * atm.scattering_mu_s;
-        let wz = vec2<f32>(1.0 - lz.t, lz.t);
-        for (var a = 0u; a < 2u; a++) {
-            let base = select(rows.x, rows.y, a == 1u);
-            let w = select(wz.x, wz.y, a == 1u);
-            let t = vec4<u32>(base + m.below, base + m.s0, base + m.s1, base + m.above);
-            scattering += w * mu_s_blend_at(m, scattering_a[t.x * g + k], scattering_a[t.y * g + k], scattering_a[t.z * g + k], scattering_a[t.w * g + k]);
-            multiple += w * mu_s_blend_at(m, multiple_table[t.x * g + k], multiple_table[t.y * g + k], multiple_table[t.z * g + k], multiple_table[t.w * g + k]);
-            if (mie_layout == 0u) {
-                mie += w * mu_s_blend_at(m, scattering_b[t.x * g + k], scattering_b[t.y * g + k], scattering_b[t.z * g + k], scattering_b[t.w * g + k]);
-            } else if (k == 0u) {
-                mie.x += w * mu_s_blend_at(m, vec4<f32>(scattering_b[t.x * gm].x), vec4<f32>(scattering_b[t.y * gm].x),
-                    vec4<f32>(scattering_b[t.z * gm].x), vec4<f32>(scattering_b[t.w * gm].x)).x;
-            }
-        }
-    } else {
-        // Texels (z_a, s_b) with weights wz·ws, as Table4::slice sums them.
-        let rows = (vec4<u32>(lz.i0, lz.i0, lz.i1, lz.i1) * atm.scattering_mu + y) * width;
-        let texels = rows + nu * atm.scattering_mu_s + vec4<u32>(m.s0, m.s1, m.s0, m.s1);
-        let w = vec4<f32>(1.0 - lz.t, 1.0 - lz.t, lz.t, lz.t) * vec4<f32>(1.0 - m.t, m.t, 1.0 - m.t, m.t);
-        scattering = w.x * scattering_a[texels.x * g + k] + w.y * scattering_a[texels.y * g + k]
-            + w.z * scattering_a[texels.z * g + k] + w.w * scattering_a[texels.w * g + k];
-        multiple = w.x * multiple_table[texels.x * g + k] + w.y * multiple_table[texels.y * g + k]
-            + w.z * multiple_table[texels.z * g + k] + w.w * multiple_table[texels.w * g + k];
-        if (mie_layout == 0u) {
-            mie = w.x * scattering_b[texels.x * g + k] + w.y * scattering_b[texels.y * g + k]
-                + w.z * scattering_b[texels.z * g + k] + w.w * scattering_b[texels.w * g + k];
-        } else if (k == 0u) {
-            mie.x = w.x * scattering_b[texels.x * gm].x + w.y * scattering_b[texels.y * gm].x
-                + w.z * scattering_b[texels.z * gm].x + w.w * scattering_b[texels.w * gm].x;
-        }
-    }
+    // Table4::slice: each r row blended along μ_s, then along r (r_blend.wgsl).
+    let rows = (vec2<u32>(rf.z0, rf.z1) * atm.scattering_mu + y) * width + nu * atm.scattering_mu_s;
+    let lower = slice_row(m, rows.x, k, slice_coordinates.mie_layout);
+    let upper = slice_row(m, rows.y, k, slice_coordinates.mie_layout);
+    let scattering = r_blend(lower.scattering, upper.scattering, rf);
+    let multiple = r_blend(lower.multiple, upper.multiple, rf);
+    let mie = r_blend(lower.mie, upper.mie, rf);
     let o = i * SLICE_TABLES * g;
     slice_table[o + k] = scattering;
     slice_table[o + g + k] = multiple;

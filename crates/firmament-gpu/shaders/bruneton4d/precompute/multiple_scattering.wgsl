@@ -28,7 +28,7 @@ fn multiple_sample(t: ScatteringTexel, d_km: f32, k: u32) -> MultipleSample {
     let mu_s_d = clamp_cosine((t.r_km * t.mu_s + d_km * t.nu) / r_d_km);
     let u_mu_s = texcoord_from_unit(x_mu_s(mu_s_d), atm.scattering_mu_s);
     let u_nu = u_nu_from_nu(mu_d, mu_s_d, t.nu);
-    let f = scattering_filter_rows(u_nu, u_mu_s, lerp_weights(uvwz.z, atm.scattering_mu), lerp_weights(uvwz.w, atm.scattering_r));
+    let f = scattering_filter_rows(u_nu, u_mu_s, lerp_weights(uvwz.z, atm.scattering_mu), r_filter_linear(uvwz.w, atm.scattering_r));
     var s: MultipleSample;
     s.t = transmittance(t.r_km, t.rho_km, t.mu, d_km, t.ground, k);
     let altitude_km = altitude_of(rho_d_km, r_d_km);
@@ -46,12 +46,13 @@ fn density_column(f: Filter4, col: u32, k: u32) -> vec4<f32> {
         + f.wrow.z * scattering_a[(f.row.z + col) * g + k] + f.wrow.w * scattering_a[(f.row.w + col) * g + k];
 }
 
-// ΔJ at a sample as compute_multiple_scattering filters it: in a twilight cell along μ_s
-// the (μ, r)-filtered columns blended along μ_s (mu_s_blend.wgsl), then in ν; else the
-// plain lookup.
+// ΔJ at a sample as compute_multiple_scattering filters it: the (μ, r)-filtered columns
+// (linear in r: ΔJ/β_s is smooth there), blended along μ_s (in a twilight cell by
+// mu_s_blend.wgsl) and ν.
 fn sample_density_rows_first(f: Filter4, k: u32) -> vec4<f32> {
     if (!f.mu_s.twilight) {
-        return sample_scattering_a(f, k);
+        return f.wcol.x * density_column(f, f.col.x, k) + f.wcol.y * density_column(f, f.col.y, k)
+            + f.wcol.z * density_column(f, f.col.z, k) + f.wcol.w * density_column(f, f.col.w, k);
     }
     let c0 = mu_s_blend_at(f.mu_s, density_column(f, f.colb.x, k), density_column(f, f.col.x, k),
         density_column(f, f.col.y, k), density_column(f, f.cola.x, k));

@@ -8,7 +8,7 @@
 
 use super::mu_s_blend::{irradiance_twilight_cells, twilight_cells};
 use super::params::{self, Radii, TableSizes};
-use super::table::{Table2, MAX_OPTICAL_DEPTH};
+use super::table::{LookupBlend, Table2, MAX_OPTICAL_DEPTH};
 use crate::atmosphere::Model;
 use crate::math::smoothstep;
 use crate::math::sphere::{advance, distance_to_enter_sphere, safe_sqrt};
@@ -51,6 +51,15 @@ impl<'a> Lookup<'a> {
             sizes,
             optical_depth,
             sun_angular_radius: model.sun_angular_radius_rad,
+        }
+    }
+
+    /// The blends of the 4D lookups ([`super::Table4::sample_into`]).
+    #[inline]
+    pub fn blend(&self) -> LookupBlend {
+        LookupBlend {
+            twilight_cells: self.twilight_cells,
+            bottom_over_h: self.radii.bottom / self.radii.h(),
         }
     }
 

@@ -13,6 +13,7 @@ pub mod mu_s_blend;
 pub mod mu_s_map;
 pub mod params;
 pub mod precompute;
+pub mod r_blend;
 pub mod shell;
 pub mod table;
 mod tables;

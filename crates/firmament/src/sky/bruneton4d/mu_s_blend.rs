@@ -119,8 +119,9 @@ impl MuSFilter {
     }
 }
 
-/// How close to a sample (in the fraction of a cell) a twilight lookup reads the sample.
-const SAMPLE_SNAP: f64 = 1e-5;
+/// How close to a sample (in the fraction of a cell) a twilight lookup reads the sample
+/// (and a lookup along r its row, [`super::r_blend`]).
+pub const SAMPLE_SNAP: f64 = 1e-5;
 
 /// The twilight blend at `t` of the cell's samples `a` (t = 0) and `b` (t = 1), with the
 /// outer neighbours `below` (of a) and `above` (of b), each `None` where the table has

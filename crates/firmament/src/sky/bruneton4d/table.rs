@@ -5,6 +5,18 @@
 
 use super::mu_s_blend::{blend_at, MuSFilter};
 use super::params::TableSizes;
+use super::r_blend::{self, RFilter};
+
+/// What a 4D lookup needs beyond its texture coordinates: the μ_s cells that take the
+/// log blend ([`super::mu_s_blend::twilight_cells`]) and the planet's radius over H =
+/// √(R_t² − R_g²) for the blend along r ([`super::r_blend`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LookupBlend {
+    /// The μ_s cells, from the first, of [`super::mu_s_blend`]'s blend.
+    pub twilight_cells: usize,
+    /// R_g / H.
+    pub bottom_over_h: f64,
+}
 
 /// Linear-filter weights for texture coordinate `u` over `n` texels: (i0, i1, t).
 #[inline]
@@ -193,18 +205,18 @@ impl Table4 {
     }
 
     /// Sample at (u_ν, u_μs, u_μ, u_r) into `out` (overwritten), Bruneton 2017's
-    /// `GetScattering`: trilinear in (μ_s, μ, r) at the two nearest ν slices, then a lerp;
-    /// the first `twilight_cells` cells along μ_s blend as twilight ([`mu_s_blend`]).
+    /// `GetScattering` with two blends of firmament's: per (μ, ν) texel, along μ_s (linear,
+    /// or in the first `blend.twilight_cells` cells [`mu_s_blend`]'s), then along r
+    /// ([`r_blend`]), then bilinear in (μ, ν).
     #[inline]
-    pub fn sample_into(&self, uvwz: [f64; 4], twilight_cells: usize, out: &mut [f64]) {
+    pub fn sample_into(&self, uvwz: [f64; 4], blend: &LookupBlend, out: &mut [f64]) {
         let (y0, y1, ty) = lerp_weights(uvwz[2], self.nmu);
-        let (z0, z1, tz) = lerp_weights(uvwz[3], self.nr);
-        let s = MuSFilter::new(uvwz[1], self.nmu_s, twilight_cells);
-        self.sample_rows_into(uvwz[0], s, [y0, y1], ty, [z0, z1], tz, out);
+        let r = RFilter::new(uvwz[3], self.nr, blend.bottom_over_h);
+        let s = MuSFilter::new(uvwz[1], self.nmu_s, blend.twilight_cells);
+        self.sample_rows_into(uvwz[0], s, [y0, y1], ty, &r, out);
     }
 
-    /// As [`Table4::sample_into`] with the μ_s filter and the (μ, r) filter weights already
-    /// known (rays whose samples share them).
+    /// As [`Table4::sample_into`] with the μ_s, μ and r filters already known.
     #[inline]
     pub fn sample_rows_into(
         &self,
@@ -212,95 +224,72 @@ impl Table4 {
         s: MuSFilter,
         y: [usize; 2],
         ty: f64,
-        z: [usize; 2],
-        tz: f64,
+        r: &RFilter,
         out: &mut [f64],
     ) {
         let tex_x = u_nu * (self.nnu - 1) as f64;
         let nu0 = (tex_x.max(0.0) as usize).min(self.nnu - 1);
         let nu1 = (nu0 + 1).min(self.nnu - 1);
         let tnu = tex_x - nu0 as f64;
-        let (s0, s1, ts) = (s.s0, s.s1, s.t);
         let c = self.channels;
         out[..c].iter_mut().for_each(|o| *o = 0.0);
         let wy = [1.0 - ty, ty];
-        let wz = [1.0 - tz, tz];
         let wn = [1.0 - tnu, tnu];
-        let ws = [1.0 - ts, ts];
-        for (a, &zz) in z.iter().enumerate() {
-            if wz[a] == 0.0 {
-                continue;
-            }
-            for (b, &yy) in y.iter().enumerate() {
-                let wzy = wz[a] * wy[b];
-                if wzy == 0.0 {
-                    continue;
-                }
-                let row = (zz * self.nmu + yy) * self.width();
-                for (e, &nn) in [nu0, nu1].iter().enumerate() {
-                    if s.geometric {
-                        let w = wzy * wn[e];
-                        if w == 0.0 {
-                            continue;
-                        }
-                        let base = (row + nn * self.nmu_s) * c;
-                        for k in 0..c {
-                            out[k] += w * blend_at(&self.data, base + k, c, &s);
-                        }
-                        continue;
-                    }
-                    for (f, &ss) in [s0, s1].iter().enumerate() {
-                        let w = wzy * wn[e] * ws[f];
-                        if w == 0.0 {
-                            continue;
-                        }
-                        let i = (row + nn * self.nmu_s + ss) * c;
-                        for k in 0..c {
-                            out[k] += w * self.data[i + k] as f64;
-                        }
-                    }
+        for (b, &yy) in y.iter().enumerate() {
+            for (e, &nn) in [nu0, nu1].iter().enumerate() {
+                let w = wy[b] * wn[e];
+                if w != 0.0 {
+                    self.add_texel(yy, nn, &s, r, w, &mut out[..c]);
                 }
             }
         }
     }
 
+    /// Adds `w` times the (μ, ν) texel (`y`, `nu`), every channel, blended along μ_s by
+    /// `s`, then along r by `r`, to `out`.
+    #[inline]
+    fn add_texel(&self, y: usize, nu: usize, s: &MuSFilter, r: &RFilter, w: f64, out: &mut [f64]) {
+        let lower = self.index(nu * self.nmu_s, y, r.z0);
+        if r.t == 0.0 {
+            for (k, o) in out.iter_mut().enumerate() {
+                *o += w * self.mu_s_value(lower + k, s);
+            }
+            return;
+        }
+        let upper = self.index(nu * self.nmu_s, y, r.z1);
+        for (k, o) in out.iter_mut().enumerate() {
+            let (a, b) = (self.mu_s_value(lower + k, s), self.mu_s_value(upper + k, s));
+            *o += w * r_blend::blend(a, b, r);
+        }
+    }
+
+    /// The value blended along μ_s by `s` of the μ_s column whose first sample is at
+    /// `base` (one channel).
+    #[inline]
+    fn mu_s_value(&self, base: usize, s: &MuSFilter) -> f64 {
+        let c = self.channels;
+        if s.geometric {
+            return blend_at(&self.data, base, c, s);
+        }
+        let a = self.data[base + s.s0 * c] as f64;
+        if s.t == 0.0 {
+            return a;
+        }
+        a + s.t * (self.data[base + s.s1 * c] as f64 - a)
+    }
+
     /// The table filtered at fixed (u_μs, u_r): a 2D (μ, ν) slice, `[(y·nnu + ν)·channels + c]`.
     /// Sampling the slice with [`Table4::sample_slice_into`] equals [`Table4::sample_into`]
-    /// at that (u_μs, u_r): the filter is separable, and the twilight cells' blend
-    /// ([`super::mu_s_blend`]) is made per texel before the linear filters in both. Used for every pixel of a
-    /// frame whose camera and sun are fixed.
-    pub fn slice(&self, u_mu_s: f64, u_r: f64, twilight_cells: usize) -> Vec<f64> {
-        let s = MuSFilter::new(u_mu_s, self.nmu_s, twilight_cells);
-        let (s0, s1, ts) = (s.s0, s.s1, s.t);
-        let (z0, z1, tz) = lerp_weights(u_r, self.nr);
+    /// at that (u_μs, u_r): the blends along μ_s and r are made per texel before the
+    /// linear filters in both. Used for every pixel of a frame whose camera and sun are
+    /// fixed.
+    pub fn slice(&self, u_mu_s: f64, u_r: f64, blend: &LookupBlend) -> Vec<f64> {
+        let s = MuSFilter::new(u_mu_s, self.nmu_s, blend.twilight_cells);
+        let r = RFilter::new(u_r, self.nr, blend.bottom_over_h);
         let c = self.channels;
         let mut out = vec![0.0; self.nmu * self.nnu * c];
-        for y in 0..self.nmu {
-            for nu in 0..self.nnu {
-                let o = &mut out[(y * self.nnu + nu) * c..(y * self.nnu + nu + 1) * c];
-                for (z, wz) in [(z0, 1.0 - tz), (z1, tz)] {
-                    if s.geometric {
-                        if wz == 0.0 {
-                            continue;
-                        }
-                        let base = self.index(nu * self.nmu_s, y, z);
-                        for k in 0..c {
-                            o[k] += wz * blend_at(&self.data, base + k, c, &s);
-                        }
-                        continue;
-                    }
-                    for (sx, wsx) in [(s0, 1.0 - ts), (s1, ts)] {
-                        let w = wz * wsx;
-                        if w == 0.0 {
-                            continue;
-                        }
-                        let i = self.index(nu * self.nmu_s + sx, y, z);
-                        for k in 0..c {
-                            o[k] += w * self.data[i + k] as f64;
-                        }
-                    }
-                }
-            }
+        for (i, o) in out.chunks_exact_mut(c).enumerate() {
+            self.add_texel(i / self.nnu, i % self.nnu, &s, &r, 1.0, o);
         }
         out
     }
@@ -349,5 +338,74 @@ impl Table4 {
         for (a, b) in self.data.iter_mut().zip(&other.data) {
             *a += *b;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A table whose texels rise or fall along r and μ_s by texel (a hash), all positive
+    /// but a few unlit texels.
+    fn table() -> Table4 {
+        let mut t = Table4::new(6, 5, 7, 4, 2);
+        for (i, v) in t.data.iter_mut().enumerate() {
+            let h = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 40;
+            *v = if h % 17 == 0 {
+                0.0
+            } else {
+                0.1 + (h % 1000) as f32 / 100.0
+            };
+        }
+        t
+    }
+
+    #[test]
+    fn a_slice_sampled_equals_the_4d_lookup() {
+        let t = table();
+        let c = t.channels;
+        for twilight_cells in [0, 3] {
+            let blend = LookupBlend {
+                twilight_cells,
+                bottom_over_h: 7.3,
+            };
+            for (j, &(u_mu_s, u_r)) in [(0.13, 0.41), (0.5, 0.08), (0.33, 0.97), (0.9, 0.5)]
+                .iter()
+                .enumerate()
+            {
+                let slice = t.slice(u_mu_s, u_r, &blend);
+                for (u_nu, u_mu) in [(0.0, 0.5), (0.37, 0.21), (0.8, 0.66), (1.0, 0.93)] {
+                    let (mut a, mut b) = (vec![0.0; c], vec![0.0; c]);
+                    t.sample_into([u_nu, u_mu_s, u_mu, u_r], &blend, &mut a);
+                    t.sample_slice_into(&slice, u_nu, u_mu, &mut b);
+                    for k in 0..c {
+                        assert!(
+                            (a[k] - b[k]).abs() <= 1e-12 * a[k].abs().max(1.0),
+                            "case {j}, twilight {twilight_cells}: {} vs {}",
+                            a[k],
+                            b[k]
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_lookup_blends_each_texel_along_r_by_its_trend() {
+        // One (μ, ν, μ_s) texel column, two r rows: falling 8 → 2 (geometric in r),
+        // rising 2 → 8 (linear in ρ), at u_r halfway between rows 0 and 1.
+        let mut t = Table4::new(2, 1, 1, 1, 2);
+        t.data = vec![8.0, 2.0, 2.0, 8.0];
+        let blend = LookupBlend {
+            twilight_cells: 0,
+            bottom_over_h: 7.3,
+        };
+        let mut out = [0.0; 2];
+        t.sample_into([0.0, 0.5, 0.5, 0.5], &blend, &mut out);
+        let f = RFilter::new(0.5, 2, 7.3);
+        assert!((f.t - 0.5).abs() < 1e-12 && f.w < 0.5);
+        assert!((out[0] - 8.0 * 0.25f64.powf(f.w)).abs() < 1e-9, "{out:?}");
+        assert!((out[1] - 5.0).abs() < 1e-12, "{out:?}");
     }
 }

@@ -169,12 +169,10 @@ impl<'a> Bruneton4dView<'a> {
                     let uvwz = params::scattering_uvwz(
                         &lk.radii, &lk.sizes, r, mu, mu_s, ray.nu, ray.ground,
                     );
-                    tables
-                        .single_rayleigh
-                        .sample_into(uvwz, lk.twilight_cells, scat);
+                    tables.single_rayleigh.sample_into(uvwz, &lk.blend(), scat);
                     tables
                         .multiple
-                        .sample_into(uvwz, lk.twilight_cells, &mut both[n..2 * n]);
+                        .sample_into(uvwz, &lk.blend(), &mut both[n..2 * n]);
                     At::Table(uvwz)
                 }
             };
@@ -193,7 +191,7 @@ impl<'a> Bruneton4dView<'a> {
         let single_mie = &tables.single_mie;
         let sample = |out: &mut [f64]| match at {
             At::Slice(s, u_nu, u_mu) => single_mie.sample_slice_into(&s.mie, u_nu, u_mu, out),
-            At::Table(uvwz) => single_mie.sample_into(uvwz, self.lookup.twilight_cells, out),
+            At::Table(uvwz) => single_mie.sample_into(uvwz, &self.lookup.blend(), out),
         };
         match (orders, tables.config.mie) {
             (Orders::Multiple, _) => mie.iter_mut().for_each(|v| *v = 0.0),
@@ -501,10 +499,8 @@ impl Slice {
         let n = sky.channels();
         let single = tables
             .single_rayleigh
-            .slice(uvwz[1], uvwz[3], lookup.twilight_cells);
-        let multiple = tables
-            .multiple
-            .slice(uvwz[1], uvwz[3], lookup.twilight_cells);
+            .slice(uvwz[1], uvwz[3], &lookup.blend());
+        let multiple = tables.multiple.slice(uvwz[1], uvwz[3], &lookup.blend());
         let mut scattering = Vec::with_capacity(2 * single.len());
         for (a, b) in single.chunks(n).zip(multiple.chunks(n)) {
             scattering.extend_from_slice(a);
@@ -512,9 +508,7 @@ impl Slice {
         }
         Slice {
             scattering,
-            mie: tables
-                .single_mie
-                .slice(uvwz[1], uvwz[3], lookup.twilight_cells),
+            mie: tables.single_mie.slice(uvwz[1], uvwz[3], &lookup.blend()),
         }
     }
 }

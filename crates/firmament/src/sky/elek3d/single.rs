@@ -128,7 +128,7 @@ mod tests {
                             let phi = PI * (j as f64 + 0.5) / m as f64;
                             let nu = mu * mu_s + spread * phi.cos();
                             let uvwz = scattering_uvwz(&radii, &sizes, r, mu, mu_s, nu, ground);
-                            table.sample_into(uvwz, lookup.twilight_cells, &mut out);
+                            table.sample_into(uvwz, &lookup.blend(), &mut out);
                             for k in 0..3 {
                                 mean[k] += out[k] / m as f64;
                             }

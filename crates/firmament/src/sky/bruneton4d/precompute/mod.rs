@@ -132,14 +132,14 @@ impl Previous<'_> {
                 mie,
                 groups,
             } => {
-                rayleigh.sample_into(uvwz, lookup.twilight_cells, out);
-                mie.sample_into(uvwz, lookup.twilight_cells, tmp);
+                rayleigh.sample_into(uvwz, &lookup.blend(), out);
+                mie.sample_into(uvwz, &lookup.blend(), tmp);
                 let (pr, pm) = (groups.phase[0].eval(nu), groups.phase[1].eval(nu));
                 for k in 0..out.len() {
                     out[k] = out[k] * pr + tmp[k] * pm;
                 }
             }
-            Previous::Multiple(t) => t.sample_into(uvwz, lookup.twilight_cells, out),
+            Previous::Multiple(t) => t.sample_into(uvwz, &lookup.blend(), out),
         }
     }
 }
