@@ -67,25 +67,29 @@ fn transmittance_to_sun(r_km: f32, rho_km: f32, mu_s: f32, k: u32) -> vec4<f32> 
 }
 
 // The irradiance table at slot 4 (ΔE in the precomputation, E when rendering) at texture
-// coordinates uv (Lookup::irradiance, Table2::sample_twilight_into): bilinear, or in a
-// twilight cell the twilight blend along μ_s per row and then linear in r.
+// coordinates uv (Lookup::irradiance, Table2::sample_irradiance_into): each row along μ_s
+// (linear, or in a twilight cell the twilight blend), then along r by r_blend.wgsl's rule
+// (rows even in altitude).
 fn irradiance_at(uv: vec2<f32>, k: u32) -> vec4<f32> {
     let w = atm.irradiance_mu_s;
     let m = mu_s_filter(uv.x, w, atm.irradiance_twilight_cells);
-    if (!m.twilight) {
-        let f = table2_filter(uv, w, atm.irradiance_r);
-        return f.weight.x * delta_irradiance_table[f.index.x + k] + f.weight.y * delta_irradiance_table[f.index.y + k]
-            + f.weight.z * delta_irradiance_table[f.index.z + k] + f.weight.w * delta_irradiance_table[f.index.w + k];
+    let rf = r_filter_altitude_rows(uv.y, atm.irradiance_r);
+    let e0 = irradiance_row(m, rf.z0 * w, k);
+    if (rf.t == 0.0) {
+        return e0;
     }
-    let ly = lerp_weights(uv.y, atm.irradiance_r);
+    return r_blend(e0, irradiance_row(m, rf.z1 * w, k), rf);
+}
+
+// One row of the irradiance table (first texel `base`) along μ_s, channel group k.
+fn irradiance_row(m: MuSFilter, base: u32, k: u32) -> vec4<f32> {
     let g = atm.groups;
-    let r0 = ly.i0 * w;
-    let r1 = ly.i1 * w;
-    let e0 = mu_s_blend_at(m, delta_irradiance_table[(r0 + m.below) * g + k], delta_irradiance_table[(r0 + m.s0) * g + k],
-        delta_irradiance_table[(r0 + m.s1) * g + k], delta_irradiance_table[(r0 + m.above) * g + k]);
-    let e1 = mu_s_blend_at(m, delta_irradiance_table[(r1 + m.below) * g + k], delta_irradiance_table[(r1 + m.s0) * g + k],
-        delta_irradiance_table[(r1 + m.s1) * g + k], delta_irradiance_table[(r1 + m.above) * g + k]);
-    return (1.0 - ly.t) * e0 + ly.t * e1;
+    let a = delta_irradiance_table[(base + m.s0) * g + k];
+    let b = delta_irradiance_table[(base + m.s1) * g + k];
+    if (m.twilight) {
+        return mu_s_blend_at(m, delta_irradiance_table[(base + m.below) * g + k], a, b, delta_irradiance_table[(base + m.above) * g + k]);
+    }
+    return a + m.t * (b - a);
 }
 
 // ΔE at (altitude, μ_s).

@@ -9,15 +9,30 @@ struct RFilter {
     z1: u32,
     t: f32,
     w: f32,
+    // The geometric blend applies (not into the top row: RFilter::log).
+    log: bool,
 }
 
 fn r_filter(u_r: f32, n: u32) -> RFilter {
-    let l = lerp_weights(u_r, n);
+    var f = r_filter_snapped(u_r, n);
+    f.w = altitude_fraction(f.z0, f.z1, f.t, n, atm.bottom_radius_km / atm.h_km);
+    return f;
+}
+
+// RFilter::altitude_rows: rows even in altitude (the irradiance table's), w = t.
+fn r_filter_altitude_rows(v: f32, n: u32) -> RFilter {
+    var f = r_filter_snapped(v, n);
+    f.w = f.t;
+    return f;
+}
+
+// The linear filter with t snapped to a row within MU_S_SAMPLE_SNAP of it (w unset).
+fn r_filter_snapped(u: f32, n: u32) -> RFilter {
+    let l = lerp_weights(u, n);
     var f: RFilter;
     f.z0 = l.i0;
     f.z1 = l.i1;
     f.t = l.t;
-    // At a row (within MU_S_SAMPLE_SNAP of it) the lookup is that row.
     if (l.t < MU_S_SAMPLE_SNAP) {
         f.z1 = l.i0;
         f.t = 0.0;
@@ -25,7 +40,7 @@ fn r_filter(u_r: f32, n: u32) -> RFilter {
         f.z0 = l.i1;
         f.t = 0.0;
     }
-    f.w = altitude_fraction(f.z0, f.z1, f.t, n, atm.bottom_radius_km / atm.h_km);
+    f.log = f.z1 + 1u < n;
     return f;
 }
 
@@ -38,6 +53,7 @@ fn r_filter_linear(u_r: f32, n: u32) -> RFilter {
     f.z1 = l.i1;
     f.t = l.t;
     f.w = l.t;
+    f.log = false;
     return f;
 }
 
@@ -63,7 +79,7 @@ fn altitude_fraction(z0: u32, z1: u32, t: f32, n: u32, bottom_over_h: f32) -> f3
 // r_blend::blend of the rows' values a (z0) and b (z1).
 fn r_blend(a: vec4<f32>, b: vec4<f32>, f: RFilter) -> vec4<f32> {
     let zero = vec4<f32>(0.0);
-    let falls = (b < a) & (b > zero);
+    let falls = (b < a) & (b > zero) & vec4<bool>(f.log);
     let tiny = vec4<f32>(1e-37);
     let geometric = a * exp(f.w * log(max(b, tiny) / max(a, tiny)));
     return select(a + f.t * (b - a), geometric, falls);

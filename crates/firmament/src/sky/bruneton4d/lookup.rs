@@ -186,7 +186,7 @@ impl<'a> Lookup<'a> {
 
     /// Irradiance-table lookup at (r, μ_s): for [`super::Tables::irradiance`], the sky's
     /// irradiance (W·m⁻²·nm⁻¹) on a horizontal surface at radius r; the twilight blend of
-    /// [`super::mu_s_blend`] for a sun below the horizon.
+    /// [`super::mu_s_blend`] for a sun below the horizon, [`super::r_blend`]'s along r.
     #[inline]
     pub fn irradiance(&self, table: &Table2, r: f64, mu_s: f64, out: &mut [f64]) {
         let (u, v) = params::irradiance_uv(
@@ -196,7 +196,7 @@ impl<'a> Lookup<'a> {
             self.sizes.irradiance_mu_s,
             self.sizes.irradiance_r,
         );
-        table.sample_twilight_into(u, v, self.irradiance_twilight_cells, out);
+        table.sample_irradiance_into(u, v, self.irradiance_twilight_cells, out);
     }
 }
 

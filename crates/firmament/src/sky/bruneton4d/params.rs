@@ -44,7 +44,11 @@ impl Default for TableSizes {
             scattering_mu_s: 40,
             scattering_nu: 8,
             irradiance_mu_s: 64,
-            irradiance_r: 16,
+            // 64 rows (0.94 km apart for `earth`; Bruneton's 16, 3.75 km apart, lit a
+            // surface at 1–3 km 23–32 % too brightly: the sky's irradiance falls ×0.55
+            // over the first 1.8 km with the haze; docs/accuracy.md, "The irradiance table
+            // along r").
+            irradiance_r: 64,
         }
     }
 }
@@ -60,7 +64,7 @@ impl TableSizes {
             scattering_mu_s: 20,
             scattering_nu: 8,
             irradiance_mu_s: 32,
-            irradiance_r: 8,
+            irradiance_r: 16,
         }
     }
 

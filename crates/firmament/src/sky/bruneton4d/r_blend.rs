@@ -40,6 +40,11 @@ pub struct RFilter {
     pub t: f64,
     /// Fraction of the way in r (altitude): the geometric blend's weight.
     pub w: f64,
+    /// Whether the rows take the geometric blend where the value falls: not into the top
+    /// row, where the boundary cuts the radiance of upward views to 0 (a column that ends,
+    /// not an exponential; there a value of 10⁻⁹ against 0 decided between the blends, and
+    /// the CPU's exact 0 and the GPU's f32 crumbs read 25 % apart a few km below the top).
+    pub log: bool,
 }
 
 impl RFilter {
@@ -47,20 +52,40 @@ impl RFilter {
     /// `bottom_over_h` times H = √(R_t² − R_g²) (row i at ρ = H·i/(n − 1)).
     #[inline]
     pub fn new(u_r: f64, n: usize, bottom_over_h: f64) -> RFilter {
-        let (z0, z1, t) = lerp_weights(u_r, n);
-        // At a row (the density pass reads the previous order at its texels' own r, t ≈
-        // 10⁻¹³) the lookup is that row: no blend to make, as along μ_s.
-        let (z0, z1, t) = match t {
-            t if t < SAMPLE_SNAP => (z0, z0, 0.0),
-            t if t > 1.0 - SAMPLE_SNAP => (z1, z1, 0.0),
-            t => (z0, z1, t),
-        };
+        let (z0, z1, t) = snapped(lerp_weights(u_r, n));
         RFilter {
             z0,
             z1,
             t,
             w: altitude_fraction(z0, z1, t, n, bottom_over_h),
+            log: z1 + 1 < n,
         }
+    }
+
+    /// The filter at texture coordinate `v` over `n` rows even in altitude (the irradiance
+    /// table's): the fraction in altitude is the linear weight.
+    #[inline]
+    pub fn altitude_rows(v: f64, n: usize) -> RFilter {
+        let (z0, z1, t) = snapped(lerp_weights(v, n));
+        RFilter {
+            z0,
+            z1,
+            t,
+            w: t,
+            log: z1 + 1 < n,
+        }
+    }
+}
+
+/// (z0, z1, t) with t snapped to a row within [`SAMPLE_SNAP`] of it.
+#[inline]
+fn snapped((z0, z1, t): (usize, usize, f64)) -> (usize, usize, f64) {
+    // At a row (the density pass reads the previous order at its texels' own r, t ≈
+    // 10⁻¹³) the lookup is that row: no blend to make, as along μ_s.
+    match t {
+        t if t < SAMPLE_SNAP => (z0, z0, 0.0),
+        t if t > 1.0 - SAMPLE_SNAP => (z1, z1, 0.0),
+        t => (z0, z1, t),
     }
 }
 
@@ -82,10 +107,10 @@ pub fn altitude_fraction(z0: usize, z1: usize, t: f64, n: usize, bottom_over_h: 
 }
 
 /// The blend of the rows' values `a` (z0) and `b` (z1): a·(b/a)^w where the radiance falls
-/// with altitude (0 < b < a), a + t·(b − a) otherwise.
+/// with altitude (0 < b < a) below the top row, a + t·(b − a) otherwise.
 #[inline]
 pub fn blend(a: f64, b: f64, f: &RFilter) -> f64 {
-    if b < a && b > 0.0 {
+    if f.log && b < a && b > 0.0 {
         a * exp(f.w * ln(b / a))
     } else {
         a + f.t * (b - a)
@@ -158,6 +183,7 @@ mod tests {
             z1: 4,
             t: 0.4,
             w: 0.37,
+            log: true,
         };
         assert_eq!(blend(2.0, 3.0, &f), 2.0 + 0.4 * 1.0);
         // Unlit rows: linear.
@@ -167,6 +193,9 @@ mod tests {
         let below = blend(2.0, 2.0 * (1.0 - 1e-9), &f);
         let above = blend(2.0, 2.0 * (1.0 + 1e-9), &f);
         assert!((below - 2.0).abs() < 1e-8 && (above - 2.0).abs() < 1e-8);
+        // Into the top row: linear.
+        let top = RFilter { log: false, ..f };
+        assert_eq!(blend(2.0, 1e-9, &top), 2.0 + 0.4 * (1e-9 - 2.0));
         // At the rows themselves: the rows.
         for (t, want) in [(0.0, 5.0), (1.0, 1.0)] {
             let g = RFilter { t, w: t, ..f };

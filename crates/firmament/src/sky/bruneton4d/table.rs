@@ -120,20 +120,30 @@ impl Table2 {
         }
     }
 
-    /// As [`Table2::sample_into`] for a table whose x axis is μ_s: the first
-    /// `twilight_cells` cells along x take the twilight blend ([`super::mu_s_blend`]) per
-    /// row, then the rows are blended linearly.
+    /// Sample of the irradiance table (x = μ_s, y = altitude, rows even in it) at (u, v)
+    /// into `out`: along x the twilight blend ([`super::mu_s_blend`]) in the first
+    /// `twilight_cells` cells, else linear; then along y [`super::r_blend`]'s rule
+    /// (geometric where the irradiance falls with altitude, whose fraction is the rows'
+    /// linear weight here).
     #[inline]
-    pub fn sample_twilight_into(&self, u: f64, v: f64, twilight_cells: usize, out: &mut [f64]) {
+    pub fn sample_irradiance_into(&self, u: f64, v: f64, twilight_cells: usize, out: &mut [f64]) {
         let s = MuSFilter::new(u, self.width, twilight_cells);
-        if !s.geometric {
-            return self.sample_into(u, v, out);
-        }
-        let (y0, y1, ty) = lerp_weights(v, self.height);
+        let r = RFilter::altitude_rows(v, self.height);
         let c = self.channels;
-        for k in 0..c {
-            let row = |y: usize| blend_at(&self.data, y * self.width * c + k, c, &s);
-            out[k] = (1.0 - ty) * row(y0) + ty * row(y1);
+        let row = |y: usize, k: usize| {
+            let base = y * self.width * c + k;
+            if s.geometric {
+                return blend_at(&self.data, base, c, &s);
+            }
+            let a = self.data[base + s.s0 * c] as f64;
+            a + s.t * (self.data[base + s.s1 * c] as f64 - a)
+        };
+        for (k, o) in out[..c].iter_mut().enumerate() {
+            *o = if r.t == 0.0 {
+                row(r.z0, k)
+            } else {
+                r_blend::blend(row(r.z0, k), row(r.z1, k), &r)
+            };
         }
     }
 
@@ -393,19 +403,25 @@ mod tests {
 
     #[test]
     fn the_lookup_blends_each_texel_along_r_by_its_trend() {
-        // One (μ, ν, μ_s) texel column, two r rows: falling 8 → 2 (geometric in r),
-        // rising 2 → 8 (linear in ρ), at u_r halfway between rows 0 and 1.
-        let mut t = Table4::new(2, 1, 1, 1, 2);
-        t.data = vec![8.0, 2.0, 2.0, 8.0];
+        // One (μ, ν, μ_s) texel column, three r rows: halfway between the lower two,
+        // falling 8 → 2 (geometric in r), rising 2 → 8 (linear in ρ); between the upper
+        // two (into the top row) linear either way.
+        let mut t = Table4::new(3, 1, 1, 1, 2);
+        t.data = vec![8.0, 2.0, 2.0, 8.0, 1.0, 9.0];
         let blend = LookupBlend {
             twilight_cells: 0,
             bottom_over_h: 7.3,
         };
         let mut out = [0.0; 2];
-        t.sample_into([0.0, 0.5, 0.5, 0.5], &blend, &mut out);
-        let f = RFilter::new(0.5, 2, 7.3);
-        assert!((f.t - 0.5).abs() < 1e-12 && f.w < 0.5);
+        t.sample_into([0.0, 0.5, 0.5, 0.5 / 1.5], &blend, &mut out);
+        let f = RFilter::new(0.5 / 1.5, 3, 7.3);
+        assert!((f.t - 0.5).abs() < 1e-12 && f.w < 0.5 && f.log, "{f:?}");
         assert!((out[0] - 8.0 * 0.25f64.powf(f.w)).abs() < 1e-9, "{out:?}");
         assert!((out[1] - 5.0).abs() < 1e-12, "{out:?}");
+        t.sample_into([0.0, 0.5, 0.5, 2.0 / 3.0], &blend, &mut out);
+        assert!(
+            (out[0] - 1.5).abs() < 1e-9 && (out[1] - 8.5).abs() < 1e-9,
+            "{out:?}"
+        );
     }
 }
