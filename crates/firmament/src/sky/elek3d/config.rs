@@ -16,8 +16,8 @@ pub struct Elek3dConfig {
     pub view_zenith: usize,
     /// Scattering texels along the sun's zenith cosine. Default 32.
     pub sun_zenith: usize,
-    /// Sky-irradiance (μ_s, r) texels, the 4D tables' mapping (linear in both). Default
-    /// (64, 16).
+    /// Sky-irradiance (μ_s, r) texels, the 4D tables' mapping (linear in both) and rows
+    /// (64: docs/accuracy.md, "The irradiance table along r"). Default (64, 64).
     pub irradiance: (usize, usize),
     /// Transmittance (μ, r) texels, the 4D tables' table and mapping. Default (256, 64).
     pub transmittance: (usize, usize),
@@ -61,7 +61,7 @@ impl Default for Elek3dConfig {
             altitude: 32,
             view_zenith: 128,
             sun_zenith: 32,
-            irradiance: (64, 16),
+            irradiance: (64, 64),
             transmittance: (256, 64),
             transmittance_segments: 32,
             orders: 4,
@@ -85,7 +85,7 @@ impl Elek3dConfig {
             altitude: 16,
             view_zenith: 64,
             sun_zenith: 16,
-            irradiance: (32, 8),
+            irradiance: (32, 16),
             transmittance: (128, 32),
             sun_cone: (64, 32),
             gather_nodes: 16,
