@@ -116,9 +116,13 @@ fn a_scattering_ball_matches_the_reference() {
             "ray {i}: {truth} vs clear {sky_only}"
         );
     }
-    // Measured: +0.4 to +1.3 % (the reference at 0.8 % noise).
+    // Measured: −1.6 to −3.4 % (the reference at 1.0 % noise): the marcher leaves out the
+    // ball's own multiple scattering of the sun. Until 2026-12-07 it read +0.4 to +1.3 %,
+    // its ambient term taken from an irradiance table 16 rows tall whose sky light 0.5–3 km
+    // up was 13–32 % too bright (docs/accuracy.md, "The irradiance table along r"), which
+    // hid that deficit.
     assert!(
-        worst < 0.03,
+        worst < 0.04,
         "largest luminance error {:.2} %",
         100.0 * worst
     );
