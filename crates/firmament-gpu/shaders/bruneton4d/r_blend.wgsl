@@ -28,16 +28,12 @@ fn r_filter_altitude_rows(v: f32, n: u32) -> RFilter {
 
 // The linear filter with t snapped to a row within MU_S_SAMPLE_SNAP of it (w unset).
 fn r_filter_snapped(u: f32, n: u32) -> RFilter {
-    let l = lerp_weights(u, n);
-    var f: RFilter;
-    f.z0 = l.i0;
-    f.z1 = l.i1;
-    f.t = l.t;
-    if (l.t < MU_S_SAMPLE_SNAP) {
-        f.z1 = l.i0;
+    var f = r_filter_linear(u, n);
+    if (f.t < MU_S_SAMPLE_SNAP) {
+        f.z1 = f.z0;
         f.t = 0.0;
-    } else if (l.t > 1.0 - MU_S_SAMPLE_SNAP) {
-        f.z0 = l.i1;
+    } else if (f.t > 1.0 - MU_S_SAMPLE_SNAP) {
+        f.z0 = f.z1;
         f.t = 0.0;
     }
     f.log = f.z1 + 1u < n;
