@@ -6,6 +6,11 @@ luminance error of each view (docs/accuracy.md, "Terrain").
     python3 tools/terrain_accuracy.py [--firmament target/release/firmament] [--tables earth.lut]
                                       [--samples 20000] [--scene sunset|noon]...
                                       [--set KEY=VALUE]...   # [terrain] keys, e.g. albedo=0
+                                      [--clouds]
+
+The scenes' clouds are left out (`query --no-clouds`): this measures the terrain, its
+shadows and shafts; `--clouds` keeps them (the default scene's cumulus, whose lighting
+docs/accuracy.md measures under "Clouds").
 
 `--set` runs a variant of the scenes with those `[terrain]` keys replaced (the decomposition
 in docs/accuracy.md: `albedo=0.1`, `albedo=0`, `albedo=0 --set height_scale_m=0 --set
@@ -86,17 +91,19 @@ def main() -> None:
     p.add_argument("--samples", type=int, default=20000)
     p.add_argument("--scene", action="append", choices=sorted(SCENES))
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    p.add_argument("--clouds", action="store_true", help="keep the scenes' clouds")
     args = p.parse_args()
     for name in args.scene or sorted(SCENES):
         scene, sz, sa, zeniths, azimuths = SCENES[name]
         scene = variant(scene, args.set)
         views = [(z, a) for z in zeniths for a in azimuths if angle(z, a, sz, sa) > 3.0]
-        lut = query(args.firmament, scene, views, args.tables, [])
+        extra = [] if args.clouds else ["--no-clouds"]
+        lut = query(args.firmament, scene, views, args.tables, extra)
         ref = query(args.firmament, scene, views, args.tables,
-                    ["--method", "reference", "--samples", str(args.samples)])
+                    extra + ["--method", "reference", "--samples", str(args.samples)])
         errors, noise = [], []
         print(f"== {name} ({scene} {' '.join(args.set)}), {len(views)} views, "
-              f"{args.samples} paths/wavelength")
+              f"{args.samples} paths/wavelength, clouds {'in' if args.clouds else 'out'}")
         print("zenith azimuth      lut_cd_m2      ref_cd_m2   error  ref_noise")
         for (z, a), l, r in zip(views, lut, ref):
             e = l["luminance_cd_m2"] / r["luminance_cd_m2"] - 1.0

@@ -133,6 +133,55 @@ fn query_scene_answers_the_terrain_with_the_tables_and_the_reference() {
 }
 
 #[test]
+fn query_scene_no_clouds_leaves_the_scene_clouds_out() {
+    let dir = tmp_subdir("terrain-query-clouds");
+    // A uniform deck (τ = 10, no noise to build) over the valley, added after [terrain].
+    let s = scene(
+        &dir,
+        "overcast",
+        "\n[[clouds]]\nkind = \"uniform\"\ncoverage = 1.0\nbottom_m = 3000.0\ntop_m = 4000.0",
+    );
+    let s = s.to_str().unwrap();
+    let args = [
+        "query",
+        "--scene",
+        s,
+        "--tables",
+        tables_arg(),
+        "-q",
+        "--view",
+        "30,240",
+    ];
+    let cloudy = query(&args);
+    let clear = query(&[&args[..], &["--no-clouds"]].concat());
+    assert_eq!(cloudy["cloud_layers"], 1, "{cloudy}");
+    assert_eq!(clear["cloud_layers"], 0, "{clear}");
+    // Looking up through 10 optical depths of cloud against the clear sky: the deck's base
+    // is no blue sky.
+    let lum = |v: &serde_json::Value| v["views"][0]["luminance_cd_m2"].as_f64().unwrap();
+    let blue = |v: &serde_json::Value| {
+        let r = &v["views"][0]["radiance"];
+        r[2].as_f64().unwrap() / r[0].as_f64().unwrap()
+    };
+    assert!(lum(&cloudy) > 0.0 && lum(&clear) > 0.0);
+    assert!(blue(&clear) > 1.3 * blue(&cloudy), "{clear} vs {cloudy}");
+    // --no-clouds belongs to --scene.
+    fails_with(
+        &run(&[
+            "query",
+            "--altitude-m",
+            "0",
+            "--sun-zenith-deg",
+            "30",
+            "--view",
+            "0,0",
+            "--no-clouds",
+        ]),
+        &["--no-clouds", "--scene"],
+    );
+}
+
+#[test]
 fn render_draws_a_terrain_and_refuses_bad_terrain_input() {
     let dir = tmp_subdir("terrain-render");
     let good = scene(&dir, "good", "");

@@ -29,6 +29,10 @@ pub struct QueryArgs {
     /// its atmosphere, sun and terrain (the camera's direction and image are not used).
     #[arg(long, value_name = "FILE", conflicts_with_all = ["altitude_m", "sun_zenith_deg", "sun_azimuth_deg", "time"])]
     pub scene: Option<std::path::PathBuf>,
+    /// With --scene: its `[[clouds]]` left out (the terrain's accuracy measured without the
+    /// clouds' lighting, which is measured on its own).
+    #[arg(long)]
+    pub no_clouds: bool,
     /// Observer altitude above the ground (m); above the atmosphere top is space.
     #[arg(long, allow_hyphen_values = true, required_unless_present = "scene")]
     pub altitude_m: Option<f64>,
@@ -197,6 +201,9 @@ pub fn run(args: &QueryArgs) -> Result<serde_json::Value> {
     };
     if args.scene.is_some() {
         return super::query_scene::run(args, reference);
+    }
+    if args.no_clouds {
+        anyhow::bail!("--no-clouds leaves a scene's clouds out: it needs --scene FILE");
     }
     let altitude_m = args
         .altitude_m

@@ -25,6 +25,9 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
     if let Some(w) = &args.atmosphere.wavelengths {
         scene.atmosphere.wavelengths = Some(w.clone());
     }
+    if args.no_clouds {
+        scene.clouds.clear();
+    }
     let views: Vec<(f64, f64)> = (args.views.iter())
         .map(|v| parse_view(v))
         .collect::<Result<_>>()?;
@@ -160,6 +163,8 @@ pub fn run(args: &QueryArgs, reference: Option<ReferenceSettings>) -> Result<ser
         "terrain_height_m": terrain.as_ref().map(|t| t.height_at(0.0, 0.0)),
         // The tables' ground above the planet's sphere (the terrain's floor), when lifted.
         "tables_ground_m": atmosphere.ground_lift_m,
+        // The scene's cloud layers in the views (none with --no-clouds).
+        "cloud_layers": clouds.len(),
         "sun": {
             "zenith_deg": up.acos().to_degrees(),
             "azimuth_deg": sun.direction.x.atan2(sun.direction.y).to_degrees().rem_euclid(360.0),
