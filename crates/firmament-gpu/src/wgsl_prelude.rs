@@ -166,6 +166,7 @@ fn clouds_prelude() -> String {
         ("LIGHT_MARCH_MAX_M", medium::LIGHT_MARCH_MAX_M),
         ("MIN_LIGHT_COSINE", medium::MIN_LIGHT_COSINE),
         ("SHADOW_HALF_EXTENT_M", cs::HALF_EXTENT_M),
+        ("MIN_SHADOW_HALF_EXTENT_M", cs::MIN_HALF_EXTENT_M),
         ("SHADOW_TRANSMITTANCE", cs::SHADOW_TRANSMITTANCE),
         ("SHADOW_MERGE_GAP_M", cs::MERGE_GAP_M),
         ("SHADOW_MAX_DISTANCE_M", cs::MAX_SHADOW_DISTANCE_M),

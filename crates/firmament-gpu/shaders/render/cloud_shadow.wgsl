@@ -1,6 +1,6 @@
 // The clouds' shadow below them (firmament::render::cloud_shadow::CloudShadow, computed on
 // the CPU and uploaded): each light's map of the layers' optical depth towards it over
-// their lowest base sphere, SHADOW_TEXELS² texels over ±SHADOW_HALF_EXTENT_M of planar
+// their lowest base sphere, SHADOW_TEXELS² texels over ±map_half_extent (40–80 km) of planar
 // coordinates around the observer's place, in cloud_data from clouds.shadow_at[light]; and
 // the stretches of a view ray the map puts in shadow, for the air's light shafts.
 
@@ -10,6 +10,19 @@ const MAX_SHADOWED: u32 = 16u;
 struct ShadowList {
     n: u32,
     s: array<vec2<f32>, MAX_SHADOWED>,
+}
+
+// cloud_shadow::map_half_extent_m: the mapped square's half side (m) for a light in `dir`
+// (local, z up) over the clouds' base: MIN_SHADOW_HALF_EXTENT_M + h_b / tan(elevation), at
+// most SHADOW_HALF_EXTENT_M; h_b above the tables' ground (which may be lifted to a
+// terrain's floor), as the CPU's map takes it.
+fn map_half_extent(dir: vec3<f32>) -> f32 {
+    if (dir.z <= 0.0) {
+        return SHADOW_HALF_EXTENT_M;
+    }
+    let h_b = clouds.planet_radius_m + clouds.shadow_base_m - 1000.0 * atm.bottom_radius_km;
+    let s = h_b * length(dir.xy) / dir.z;
+    return min(MIN_SHADOW_HALF_EXTENT_M + s, SHADOW_HALF_EXTENT_M);
 }
 
 // CloudShadow::entry_texel: where the ray from local `x` along `dir` enters the base sphere,
@@ -28,8 +41,9 @@ fn map_entry(x: vec3<f32>, dir: vec3<f32>, size: u32) -> vec3<f32> {
     if (ez <= 0.0) {
         return vec3<f32>(0.0, 0.0, -1.0);
     }
-    let step = 2.0 * SHADOW_HALF_EXTENT_M / f32(size);
-    return vec3<f32>((e.xy * (clouds.planet_radius_m / ez) + SHADOW_HALF_EXTENT_M) / step - 0.5, 1.0);
+    let half = map_half_extent(dir);
+    let step = 2.0 * half / f32(size);
+    return vec3<f32>((e.xy * (clouds.planet_radius_m / ez) + half) / step - 0.5, 1.0);
 }
 
 // CloudShadow::optical_depth: the layers' depth from local `x` towards light `l` (< 0: the

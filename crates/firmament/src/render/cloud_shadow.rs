@@ -7,7 +7,7 @@
 //! unlit, so the air beneath an overcast loses its single scattering and sunbeams fall
 //! through the gaps of a cumulus field (the terrain's light-shaft machinery).
 //!
-//! The map covers [`HALF_EXTENT_M`] around the observer's place in the layers' planar
+//! The map covers a square of half side [`map_half_extent_m`] (40–80 km) around the observer's place in the layers' planar
 //! coordinates (the gnomonic projection of the +z cube face, as the clouds' weather);
 //! beyond it, and for points at or above the base, the caller marches towards the light
 //! (the air's shadow far along a view ray takes a coarse map's mean, which extends beyond).
@@ -18,14 +18,30 @@ use crate::math::sphere::ray_sphere;
 use crate::math::Vec3;
 use crate::scene::{Ray, Scene, Volume};
 
-/// Half the side of the mapped square (m). Under a low sun a point's shadow lies where its
-/// ray to the light meets the clouds' base, h_b / tan(elevation) towards the light (33 km
-/// for a 3.2 km base and the sun 5.5° high), and the terrain seen to the horizon lies tens
-/// of km away: with 40 km (125 m texels) the default scene's golden-hour views against the
-/// reference (clouds in, 54 views, 2 000 paths) read 8.2 % median / 31.7 % p95, with 80 km
-/// (250 m texels, the same cost) 5.2 / 25.8 %, with 80 km at 125 m 4.9 / 23.4 % for 1.7×
-/// the frame's time (docs/accuracy.md, "The default scene's clouds").
+/// The smallest half side of the mapped square (m): under a high sun, 40 km around the
+/// observer at 125 m a texel.
+pub const MIN_HALF_EXTENT_M: f64 = 40_000.0;
+/// The largest half side of the mapped square (m), under a low sun ([`map_half_extent_m`]).
 pub const HALF_EXTENT_M: f64 = 80_000.0;
+
+/// The mapped square's half side (m) for a light in `light` (the observer's frame, z up)
+/// over a base `base_height_m` above the sky method's ground (lifted to a terrain's floor
+/// where the tables are): [`MIN_HALF_EXTENT_M`] + S, at most
+/// [`HALF_EXTENT_M`], S = h_b / tan(elevation). A point at height h below the base finds its
+/// shadow where its ray to the light meets the base, (h_b − h) / tan(elevation) towards the
+/// light: under a low sun tens of km (a 3.2 km base and the sun 5.5° high, the default
+/// scene: 33 km), and the terrain the views reach lies tens of km away. With 40 km whatever
+/// fell beyond stayed lit: the default scene's golden-hour views with its cumulus read
+/// 8.2 % median / 31.7 % p95 against the reference, 5.2 / 25.8 % with 80 km at 250 m;
+/// under a high sun the square keeps its 125 m texels (the cumulus field at 250 m read its
+/// gaps' bias −18 → −24 %). Shared with the GPU (`map_half_extent` in `cloud_shadow.wgsl`).
+pub fn map_half_extent_m(light: Vec3, base_height_m: f64) -> f64 {
+    let horizontal = (light.x * light.x + light.y * light.y).sqrt();
+    if light.z <= 0.0 {
+        return HALF_EXTENT_M;
+    }
+    (MIN_HALF_EXTENT_M + base_height_m * horizontal / light.z).min(HALF_EXTENT_M)
+}
 /// Texels per side.
 pub const TEXELS: usize = 640;
 /// Quadrature step through the volumes along the light (m).
@@ -52,7 +68,9 @@ pub struct CloudShadow {
     base_radius_m: f64,
     /// The planet's radius (m): planar coordinates are gnomonic at this radius.
     planet_radius_m: f64,
-    /// τ per texel, row-major from (−HALF, −HALF).
+    /// The mapped square's half side (m, [`map_half_extent_m`]).
+    half_m: f64,
+    /// τ per texel, row-major from (−half, −half).
     tau: Vec<f32>,
     /// The mean transmittance e^{−τ} per block of the coarse map, row-major.
     coarse: Vec<f32>,
@@ -74,12 +92,13 @@ impl CloudShadow {
             return None;
         }
         let planet = scene.sky.model().bottom_radius_m;
-        let step = 2.0 * HALF_EXTENT_M / TEXELS as f64;
+        let half = map_half_extent_m(light, base - planet);
+        let step = 2.0 * half / TEXELS as f64;
         let mut tau = vec![0.0f32; TEXELS * TEXELS];
         tau.par_chunks_mut(TEXELS).enumerate().for_each(|(j, row)| {
             for (i, t) in row.iter_mut().enumerate() {
-                let x = -HALF_EXTENT_M + (i as f64 + 0.5) * step;
-                let y = -HALF_EXTENT_M + (j as f64 + 0.5) * step;
+                let x = -half + (i as f64 + 0.5) * step;
+                let y = -half + (j as f64 + 0.5) * step;
                 let entry = Vec3::new(x, y, planet).normalize() * base;
                 let ray = Ray {
                     origin: entry,
@@ -109,6 +128,7 @@ impl CloudShadow {
             light,
             base_radius_m: base,
             planet_radius_m: planet,
+            half_m: half,
             tau,
             coarse,
             extends: scene.volumes.iter().all(|v| v.alike_everywhere()),
@@ -120,7 +140,7 @@ impl CloudShadow {
         self.base_radius_m
     }
 
-    /// τ per texel, [`TEXELS`]² row-major from (−[`HALF_EXTENT_M`], −[`HALF_EXTENT_M`]).
+    /// τ per texel, [`TEXELS`]² row-major from (−half, −half) ([`map_half_extent_m`]).
     pub fn texels(&self) -> &[f32] {
         &self.tau
     }
@@ -142,10 +162,10 @@ impl CloudShadow {
             return None;
         }
         let s = self.planet_radius_m / e.z;
-        let step = 2.0 * HALF_EXTENT_M / size as f64;
+        let step = 2.0 * self.half_m / size as f64;
         Some((
-            (e.x * s + HALF_EXTENT_M) / step - 0.5,
-            (e.y * s + HALF_EXTENT_M) / step - 0.5,
+            (e.x * s + self.half_m) / step - 0.5,
+            (e.y * s + self.half_m) / step - 0.5,
         ))
     }
 
@@ -298,6 +318,7 @@ mod tests {
             light,
             base_radius_m: planet + 3200.0,
             planet_radius_m: planet,
+            half_m: map_half_extent_m(light, 3200.0),
             tau: vec![1.0; TEXELS * TEXELS],
             coarse: vec![0.5; COARSE_TEXELS * COARSE_TEXELS],
             extends: true,
@@ -319,5 +340,20 @@ mod tests {
         assert!(map
             .optical_depth(Vec3::new(0.0, 0.0, planet + 3200.5))
             .is_none());
+    }
+
+    /// The square widens as the light sinks, from 40 km (125 m texels) under a high sun to
+    /// 80 km; below the horizon the widest.
+    #[test]
+    fn the_square_widens_as_the_light_sinks() {
+        let at = |elevation_deg: f64| {
+            let e = elevation_deg.to_radians();
+            map_half_extent_m(Vec3::new(0.0, e.cos(), e.sin()), 3200.0)
+        };
+        assert_eq!(at(90.0), MIN_HALF_EXTENT_M);
+        assert!((at(60.0) - (MIN_HALF_EXTENT_M + 3200.0 / 3f64.sqrt())).abs() < 1e-6);
+        assert!(at(30.0) < at(10.0) && at(10.0) < at(5.5) && at(5.5) < HALF_EXTENT_M);
+        assert_eq!(at(1.0), HALF_EXTENT_M);
+        assert_eq!(at(-1.0), HALF_EXTENT_M);
     }
 }
