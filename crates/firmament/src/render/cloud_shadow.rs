@@ -37,10 +37,10 @@ pub const HALF_EXTENT_M: f64 = 80_000.0;
 /// there); under a high sun it keeps its 125 m texels (a fixed 80 km at 250 m took the
 /// noon cumulus field's gaps from −18 to −24 % bias). Shared with the GPU (`map_half_extent` in `cloud_shadow.wgsl`).
 pub fn map_half_extent_m(light: Vec3, base_height_m: f64) -> f64 {
-    let horizontal = (light.x * light.x + light.y * light.y).sqrt();
     if light.z <= 0.0 {
         return HALF_EXTENT_M;
     }
+    let horizontal = (light.x * light.x + light.y * light.y).sqrt();
     (MIN_HALF_EXTENT_M + base_height_m * horizontal / light.z).min(HALF_EXTENT_M)
 }
 

@@ -52,13 +52,10 @@ impl RFilter {
     /// `bottom_over_h` times H = √(R_t² − R_g²) (row i at ρ = H·i/(n − 1)).
     #[inline]
     pub fn new(u_r: f64, n: usize, bottom_over_h: f64) -> RFilter {
-        let (z0, z1, t) = snapped(lerp_weights(u_r, n));
+        let f = RFilter::altitude_rows(u_r, n);
         RFilter {
-            z0,
-            z1,
-            t,
-            w: altitude_fraction(z0, z1, t, n, bottom_over_h),
-            log: z1 + 1 < n,
+            w: altitude_fraction(f.z0, f.z1, f.t, n, bottom_over_h),
+            ..f
         }
     }
 
