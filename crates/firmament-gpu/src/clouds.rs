@@ -193,9 +193,17 @@ impl GpuClouds {
                     let at = data.len() as u32;
                     data.extend(ts.sun_table().iter().flatten().map(|&v| v as f32));
                     data.extend(ts.diffuse_table().iter().flatten().map(|&v| v as f32));
-                    (at, [ts.scattering_scale, ts.extinction_scale, ts.asymmetry])
+                    (
+                        at,
+                        [
+                            ts.scattering_scale,
+                            ts.extinction_scale,
+                            ts.asymmetry,
+                            ts.forward_phase_cap,
+                        ],
+                    )
                 }
-                None => (NONE, [1.0, 1.0, 0.0]),
+                None => (NONE, [1.0, 1.0, 0.0, 0.0]),
             };
             let o = m.octaves();
             let [g1, g2, weight] = p.phase;
@@ -271,7 +279,7 @@ impl GpuClouds {
                 bits(o.scattering),
                 bits(o.extinction),
                 bits(o.eccentricity),
-                0,
+                bits(ts[3]),
                 // 28: the planet's weather's frame (east, north, up), offset and size.
                 bits(frame[0][0]),
                 bits(frame[0][1]),

@@ -157,6 +157,32 @@ fn the_energy_conserving_step_is_the_exact_integral() {
     assert_eq!(step_integral(2.0, 0.0, 3.0, 1.0), 6.0);
 }
 
+/// Energy through a conservative slab (δ-Eddington, Joseph et al. 1976): what its top
+/// reflects (F↑ = πI₀ + 2πI₁/3 there), the beam that crosses it unscattered, and what
+/// leaves its base (diffuse, and the light scattered into the phase's forward peak, which
+/// goes on with the beam) add up to the beam's flux μ₀ on the top. Without the peak's
+/// light at the base a slab of τ 2.9 would lose 6 % of μ₀.
+#[test]
+fn a_conservative_slab_sends_down_what_it_does_not_reflect() {
+    use firmament::scene::clouds::two_stream::{COSINES, MAX_THICKNESS, THICKNESSES};
+    // A thickness and a cosine on the tables' nodes (no interpolation error).
+    let tau = MAX_THICKNESS * (4.0 / (THICKNESSES - 1) as f64).powi(2);
+    let mu0 = 20.5 / COSINES as f64;
+    let medium = &media(slab(tau / 1000.0, 1.0))[0];
+    let radius = sky().model.bottom_radius_m;
+    let top = Vec3::new(0.0, 0.0, radius + 2000.0 - 1e-3);
+    let f = medium.diffuse_radiance(top, mu0, 0.0, 0).unwrap();
+    let pi = std::f64::consts::PI;
+    let reflected = pi * f.from_light[0] + 2.0 * pi / 3.0 * f.from_light[1];
+    let total = reflected + mu0 * f.base_direct + f.base_from_light;
+    assert!(
+        (total / mu0 - 1.0).abs() < 2e-3,
+        "reflected {reflected:.4} + direct {:.4} + base {:.4} = {total:.4}, μ₀ {mu0:.4}",
+        mu0 * f.base_direct,
+        f.base_from_light
+    );
+}
+
 #[test]
 fn octaves_never_scatter_more_than_they_extinguish() {
     let medium = &media(CloudLayerConfig {

@@ -39,7 +39,8 @@ struct CloudLayerParams {
     octave_scattering: f32,
     octave_extinction: f32,
     octave_eccentricity: f32,
-    pad0: u32,
+    // The phase the δ-scaling keeps, min(p, ts_forward_cap) (TwoStream::forward_phase_cap).
+    ts_forward_cap: f32,
     // The planet's weather (weather_wrap = "planet"; planetary.wgsl): the observer's east,
     // north and up in the planet-fixed frame, the map's offset (NONE: the tiled map's weather)
     // and size.

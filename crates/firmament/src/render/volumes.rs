@@ -408,7 +408,13 @@ fn light_sources(
                     }
                     let towards_eye = -dir.dot(up);
                     let radiance = (i0 + f.asymmetry * i1 * towards_eye).max(0.0);
-                    buf.source[1][k] += s_v[k] * f.scattering_scale * radiance;
+                    // The beam's light in the forward peak (δ-scaled minus unscattered),
+                    // scattered towards the eye with the phase the δ-scaling keeps.
+                    let tau = buf.tau_light[k];
+                    let peak = (-f.extinction_scale * tau).exp() - (-tau).exp();
+                    let p_kept = phase.eval(cos).min(f.forward_phase_cap);
+                    buf.source[1][k] +=
+                        s_v[k] * (f.scattering_scale * radiance + p_kept * beam * peak);
                 }
                 continue;
             }

@@ -171,7 +171,8 @@ pub struct DiffuseLight {
     /// Under the point's column through the volume: the fraction of the beam that crosses
     /// it unscattered,
     pub base_direct: f64,
-    /// the diffuse flux leaving its base per unit beam irradiance,
+    /// the diffuse flux leaving its base per unit beam irradiance (the light scattered
+    /// into the forward peak included),
     pub base_from_light: f64,
     /// and per unit hemispheric irradiance entering its top;
     pub base_from_above: f64,
@@ -184,6 +185,14 @@ pub struct DiffuseLight {
     /// renderer carries the diffuse light along the view in the octave slot 1, whose
     /// extinction gain the volume's [`Volume::octaves`] gives.
     pub scattering_scale: f64,
+    /// The δ-scaled optical depth per true one, 1 − ωf: the light's beam as the two
+    /// streams see it is e^{−(1 − ωf)τ}, of which e^{−τ} crosses unscattered and the rest
+    /// was scattered into the forward peak and goes on with the beam (the renderer
+    /// scatters it towards the eye with the phase that the δ-scaling keeps, min(p, cap),
+    /// Nakajima & Tanaka 1988's split of single scattering).
+    pub extinction_scale: f64,
+    /// That phase's cap (sr⁻¹; [`crate::medium::PhaseFunction::truncated_forward_value`]).
+    pub forward_phase_cap: f64,
 }
 
 /// Multiple scattering by octaves (Wrenninge 2015, "Art-directable multiple scattering";

@@ -274,6 +274,43 @@ impl PhaseFunction {
         }
     }
 
+    /// The forward peak cut off (Potter 1970, "The delta function approximation in
+    /// radiative transfer theory", J. Atmos. Sci. 27): the phase's value p(θ_c) at the cone
+    /// θ < θ_c inside which p − p(θ_c) holds the fraction `fraction` of the scattering, so
+    /// that min(p, p(θ_c)) is the phase of what a δ-scaling with f = `fraction` keeps
+    /// (integrating to 1 − f). `fraction` ≤ 0: p's forward value (nothing cut).
+    pub fn truncated_forward_value(&self, fraction: f64) -> f64 {
+        if fraction <= 0.0 {
+            return self.eval(1.0);
+        }
+        // 2π ∫_c^1 (p(μ) − p(c)) dμ, with 1 − μ = e^s so the peak is resolved.
+        let cut = |c: f64| {
+            let (lo, hi) = ((1e-9f64).ln(), (1.0 - c).max(1e-9).ln());
+            let n = 512;
+            let ds = (hi - lo) / n as f64;
+            let pc = self.eval(c);
+            (0..n)
+                .map(|i| {
+                    let e = (lo + (i as f64 + 0.5) * ds).exp();
+                    (self.eval(1.0 - e) - pc) * e * ds
+                })
+                .sum::<f64>()
+                * 2.0
+                * PI
+        };
+        // The cut grows as the cone widens (c falls) while p falls towards its minimum.
+        let (mut lo, mut hi) = (-1.0, 1.0);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if cut(mid) > fraction {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        self.eval(lo)
+    }
+
     /// Legendre moments χ_l = 2π ∫ p(μ) P_l(μ) dμ for l = 0 … n−1 (χ_0 = 1, χ_1 = mean
     /// cosine); p = Σ (2l+1) χ_l P_l / (4π). Exact for HG (χ_l = g^l) and its mixture,
     /// numerical (composite Gauss–Legendre in θ) otherwise.

@@ -404,3 +404,32 @@ fn phase_tabulated_refuses_bad_files() {
         other => panic!("{other:?}"),
     }
 }
+
+/// Potter's truncation keeps 1 − f of the phase: ∫ min(p, p(θ_c)) dΩ = 1 − f, for the
+/// clouds' dual lobe with f = g² (the δ-Eddington's) and for single lobes; nothing cut
+/// leaves p's forward value.
+#[test]
+fn truncated_forward_value_cuts_the_fraction_asked() {
+    let cases = [
+        PhaseFunction::DualLobeHg {
+            g1: 0.8,
+            g2: -0.5,
+            weight: 0.8,
+        },
+        PhaseFunction::HenyeyGreenstein { g: 0.85 },
+        PhaseFunction::HenyeyGreenstein { g: 0.3 },
+    ];
+    for p in cases {
+        let f = p.mean_cosine().powi(2);
+        let cap = p.truncated_forward_value(f);
+        let kept = sphere_integral(|mu| p.eval(mu).min(cap));
+        assert!(
+            (kept - (1.0 - f)).abs() < 2e-4,
+            "{p:?}: kept {kept}, 1 − f {}",
+            1.0 - f
+        );
+        assert!(cap < p.eval(1.0) && cap > p.eval(-1.0), "{p:?}: cap {cap}");
+    }
+    let hg = PhaseFunction::HenyeyGreenstein { g: 0.5 };
+    assert_eq!(hg.truncated_forward_value(0.0), hg.eval(1.0));
+}

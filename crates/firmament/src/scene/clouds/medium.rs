@@ -51,7 +51,7 @@ impl CloudMedium {
         let [g1, g2, weight] = layer.params.phase;
         let phase = PhaseFunction::DualLobeHg { g1, g2, weight };
         let two_stream = (layer.params.multiple_scattering == MultipleScattering::TwoStream)
-            .then(|| TwoStream::new(layer.params.albedo, phase.mean_cosine()));
+            .then(|| TwoStream::new(layer.params.albedo, &phase));
         CloudMedium {
             phase,
             layer,
@@ -199,6 +199,8 @@ impl Volume for CloudMedium {
             return Some(DiffuseLight {
                 base_direct: 1.0,
                 scattering_scale: ts.scattering_scale,
+                extinction_scale: ts.extinction_scale,
+                forward_phase_cap: ts.forward_phase_cap,
                 ..DiffuseLight::default()
             });
         } else {
@@ -221,6 +223,16 @@ impl Volume for CloudMedium {
             thickness
         };
         let two_pi = 2.0 * std::f64::consts::PI;
+        // The beam's light scattered into the phase's forward peak (δ-scaling: the beam
+        // the two streams see is dimmed by the δ-scaled depth (1 − ωf)τ, the light that
+        // crosses unscattered by τ) reaches the base as a beam too.
+        let peak_base = if mu_light > 0.0 {
+            mu_light
+                * ((-ts.extinction_scale * thickness / mu_light).exp()
+                    - (-thickness / mu_light).exp())
+        } else {
+            0.0
+        };
         Some(DiffuseLight {
             from_light: ts.sun(thickness, sun_depth, mu_slab),
             from_above: ts.diffuse(thickness, above, true),
@@ -231,13 +243,15 @@ impl Volume for CloudMedium {
                 0.0
             },
             // At a black base F↑ = 0, so F↓ = 2π·I₀.
-            base_from_light: two_pi * ts.sun(thickness, thickness, mu_light)[0],
+            base_from_light: two_pi * ts.sun(thickness, thickness, mu_light)[0] + peak_base,
             base_from_above: two_pi * ts.diffuse(thickness, thickness, true)[0],
             // Diffuse light from above: F↓(0) = 1, F↑(0) = 2π·I₀(0) − 1; the slab
             // reflects light from below alike.
             base_reflectance: (two_pi * ts.diffuse(thickness, 0.0, true)[0] - 1.0).clamp(0.0, 1.0),
             asymmetry: ts.asymmetry,
             scattering_scale: ts.scattering_scale,
+            extinction_scale: ts.extinction_scale,
+            forward_phase_cap: ts.forward_phase_cap,
         })
     }
 

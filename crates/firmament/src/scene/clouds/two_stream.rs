@@ -20,6 +20,8 @@
 //! diffuse light entering the top (the sky), I₀ per unit hemispheric irradiance, over the
 //! relative depth and the thickness (light from below is the same read upside down).
 
+use crate::medium::PhaseFunction;
+
 /// Relative depths (0 top … 1 base) in the tables.
 pub const DEPTHS: usize = 33;
 /// Slab optical thicknesses, τ* = MAX_THICKNESS·s², s uniform.
@@ -39,6 +41,10 @@ pub struct TwoStream {
     pub extinction_scale: f64,
     /// The δ-scaled asymmetry g′ = g/(1 + g).
     pub asymmetry: f64,
+    /// The phase of what the δ-scaling keeps, min(p, this) (sr⁻¹): p cut at the cone that
+    /// holds the forward peak's fraction f (Potter 1970,
+    /// [`PhaseFunction::truncated_forward_value`]).
+    pub forward_phase_cap: f64,
     /// (I₀, I₁)/E of the sun's light: [cosine][thickness][depth].
     sun: Vec<[f64; 2]>,
     /// (I₀, I₁)/E↓ of diffuse light entering the top: [thickness][depth].
@@ -124,9 +130,10 @@ fn flux_pairs(omega: f64, g: f64, tau: f64, mu0: f64, top: f64, depths: &[f64]) 
 }
 
 impl TwoStream {
-    /// The tables of a medium of single-scattering albedo `albedo` and phase asymmetry
-    /// (mean cosine) `g`.
-    pub fn new(albedo: f64, g: f64) -> TwoStream {
+    /// The tables of a medium of single-scattering albedo `albedo` and phase function
+    /// `phase` (its asymmetry, the mean cosine g, is what the two streams see).
+    pub fn new(albedo: f64, phase: &PhaseFunction) -> TwoStream {
+        let g = phase.mean_cosine();
         // ω = 1 exactly makes k = 0; the tables' albedo is kept just below.
         let (omega, g_scaled, scale) = delta_scaled(albedo.min(1.0 - 1e-6), g);
         let depths: Vec<f64> = (0..DEPTHS)
@@ -149,6 +156,7 @@ impl TwoStream {
         let f = g * g;
         TwoStream {
             asymmetry: g_scaled,
+            forward_phase_cap: phase.truncated_forward_value(f),
             scattering_scale: 1.0 - f,
             extinction_scale: 1.0 - albedo * f,
             sun,
@@ -316,7 +324,7 @@ mod tests {
         }
         // The tables' diffuse light vanishes without light and grows into the slab from a
         // lit top: in a thick slab the light near the top exceeds that near the base.
-        let ts = TwoStream::new(0.999, 0.54);
+        let ts = TwoStream::new(0.999, &PhaseFunction::HenyeyGreenstein { g: 0.54 });
         assert!(ts.sun(20.0, 1.0, 0.8)[0] > 3.0 * ts.sun(20.0, 19.0, 0.8)[0]);
         assert_eq!(ts.sun(20.0, 1.0, -0.1), [0.0; 2]);
         let (a, b) = (ts.diffuse(10.0, 3.0, true), ts.diffuse(10.0, 7.0, false));
