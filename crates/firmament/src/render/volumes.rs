@@ -384,6 +384,12 @@ fn light_sources(
                 // the ground below lit through the column.
                 let albedo = &scene.sky.model().ground_albedo;
                 let [_, ground_direct, ground_sky] = &buf.ambient;
+                // The phase the δ-scaling keeps, towards the eye; the forward peak's share of
+                // the beam (the same in every channel where the depth to the light is).
+                let p_kept = phase.eval(cos).min(f0.forward_phase_cap);
+                let peak_of =
+                    |tau: f64, f: &DiffuseLight| (-f.extinction_scale * tau).exp() - (-tau).exp();
+                let peak0 = peak_of(buf.tau_light[0], &f0);
                 for k in 0..n {
                     let f = if volume.is_grey() || k == 0 {
                         f0
@@ -410,9 +416,11 @@ fn light_sources(
                     let radiance = (i0 + f.asymmetry * i1 * towards_eye).max(0.0);
                     // The beam's light in the forward peak (δ-scaled minus unscattered),
                     // scattered towards the eye with the phase the δ-scaling keeps.
-                    let tau = buf.tau_light[k];
-                    let peak = (-f.extinction_scale * tau).exp() - (-tau).exp();
-                    let p_kept = phase.eval(cos).min(f.forward_phase_cap);
+                    let peak = if buf.tau_light[k] == buf.tau_light[0] {
+                        peak0
+                    } else {
+                        peak_of(buf.tau_light[k], &f)
+                    };
                     buf.source[1][k] +=
                         s_v[k] * (f.scattering_scale * radiance + p_kept * beam * peak);
                 }
