@@ -105,8 +105,10 @@ fn push_shadowed(list: ptr<function, ShadowList>, a: f32, b: f32) {
 }
 
 // CloudShadow::shadowed_intervals: the stretches of the ray from local `q` along `dir`
-// before `end_m` (and below the base) in light l's shadow, sampled every max(250 m, t/50):
-// by the map's texels to SHADOW_MAX_DISTANCE_M, by the coarse map's mean beyond.
+// before `end_m` (and below the base) in light l's shadow: to SHADOW_MAX_DISTANCE_M where the
+// map's texels' transmittance is below SHADOW_TRANSMITTANCE, sampled every max(250 m, t/50);
+// beyond, in pieces [a, SHADOW_FAR_PIECE_RATIO·a] each in shadow over the fraction 1 − T̄ of
+// its length (T̄ the coarse map's mean along it), at both ends, lit in the middle.
 fn shadowed_intervals(l: u32, light_dir: vec3<f32>, q: vec3<f32>, dir: vec3<f32>, end_m: f32) -> ShadowList {
     var list: ShadowList;
     list.n = 0u;
@@ -118,23 +120,17 @@ fn shadowed_intervals(l: u32, light_dir: vec3<f32>, q: vec3<f32>, dir: vec3<f32>
         return list;
     }
     let limit = min(far.y, end_m);
+    let near = min(limit, SHADOW_MAX_DISTANCE_M);
     var t = 0.0;
     var start = -1.0;
     loop {
-        if (t >= limit) {
+        if (t >= near) {
             break;
         }
-        let dt = max(0.02 * t, 250.0);
-        let mid = min(t + 0.5 * dt, limit);
-        let x = q + mid * dir;
-        var shadowed: bool;
-        if (mid <= SHADOW_MAX_DISTANCE_M) {
-            let tau = map_optical_depth(l, x, light_dir);
-            shadowed = tau >= 0.0 && exp(-tau) < SHADOW_TRANSMITTANCE;
-        } else {
-            let mean = map_mean_transmittance(l, x, light_dir);
-            shadowed = mean >= 0.0 && mean < SHADOW_TRANSMITTANCE;
-        }
+        let dt = min(max(0.02 * t, 250.0), near - t);
+        let x = q + (t + 0.5 * dt) * dir;
+        let tau = map_optical_depth(l, x, light_dir);
+        let shadowed = tau >= 0.0 && exp(-tau) < SHADOW_TRANSMITTANCE;
         if (shadowed && start < 0.0) {
             start = t;
         } else if (!shadowed && start >= 0.0) {
@@ -144,7 +140,39 @@ fn shadowed_intervals(l: u32, light_dir: vec3<f32>, q: vec3<f32>, dir: vec3<f32>
         t += dt;
     }
     if (start >= 0.0) {
-        push_shadowed(&list, start, limit);
+        push_shadowed(&list, start, near);
+    }
+    var a = near;
+    loop {
+        if (a >= limit) {
+            break;
+        }
+        let b = far_piece_end(a, limit);
+        // The mean transmittance along the piece (beyond the map and not extended: lit).
+        var s = a;
+        var sum = 0.0;
+        loop {
+            if (s >= b) {
+                break;
+            }
+            let dt = min(max(0.02 * s, 250.0), b - s);
+            let mean = map_mean_transmittance(l, q + (s + 0.5 * dt) * dir, light_dir);
+            sum += select(clamp(mean, 0.0, 1.0), 1.0, mean < 0.0) * dt;
+            s += dt;
+        }
+        let shade = 0.5 * (b - a - sum);
+        if (shade > 0.0) {
+            push_shadowed(&list, a, a + shade);
+            push_shadowed(&list, b - shade, b);
+        }
+        a = b;
     }
     return list;
+}
+
+// cloud_shadow::far_piece_end: SHADOW_FAR_PIECE_RATIO·a, or `limit` when less than half a
+// piece would remain after it.
+fn far_piece_end(a: f32, limit: f32) -> f32 {
+    let b = a * SHADOW_FAR_PIECE_RATIO;
+    return select(b, limit, b + 0.5 * (b - a) >= limit);
 }

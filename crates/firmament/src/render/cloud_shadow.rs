@@ -50,15 +50,23 @@ pub const TEXELS: usize = 640;
 const MAP_STEP_M: f64 = 80.0;
 /// A point is in shadow where the light's transmittance is below this.
 pub const SHADOW_TRANSMITTANCE: f64 = 0.5;
-/// Shadowed stretches closer than this (m) are merged, so that a ray across a field of
-/// cumulus asks the sky method for a few intervals rather than many.
-pub const MERGE_GAP_M: f64 = 800.0;
+/// Shadowed stretches closer than this (m), those that touch, are merged; every sampled
+/// lit gap (≥ 250 m) is kept. Merging gaps under 800 m, to ask the sky method for fewer
+/// intervals, took the many short gaps along a grazing ray through a cumulus field's shadows
+/// for shadow: dark blotches in the haze above the horizon (the 10 km near part and the
+/// far pieces keep the count low instead: 16 at most on the GPU).
+pub const MERGE_GAP_M: f64 = 1.0;
 /// The farthest along a view ray the air's shadow is looked for in the map's texels (m):
-/// beyond, the steps would alias the cumulus' shadows into streaks, and the air is in
-/// shadow where the mean transmittance of the light over [`COARSE_TEXELS`]² blocks is below
-/// [`SHADOW_TRANSMITTANCE`] (under an overcast; not under a broken field), the blocks at the
-/// map's edge standing for the clouds beyond it.
-pub const MAX_SHADOW_DISTANCE_M: f64 = 30_000.0;
+/// beyond, the steps (250 m, then t/50) would alias the cumulus' shadows into streaks and
+/// the stretches would be many (30 km before; the same golden-hour figures), and the air is in
+/// shadow over the fraction of each far piece that the light's mean transmittance over
+/// [`COARSE_TEXELS`]² blocks leaves unlit ([`CloudShadow::shadowed_intervals`]), the blocks
+/// at the map's edge standing for the clouds beyond it.
+pub const MAX_SHADOW_DISTANCE_M: f64 = 10_000.0;
+/// The ratio of a far piece's end to its start (beyond [`MAX_SHADOW_DISTANCE_M`], where the
+/// air's shadow is the fraction of each piece that the blocks' mean leaves unlit): from 30
+/// km to a 1.5 km base's horizon (138 km) four pieces.
+pub const FAR_PIECE_RATIO: f64 = 1.5;
 /// Blocks per side of the coarse map (of `TEXELS / COARSE_TEXELS` texels each).
 pub const COARSE_TEXELS: usize = 64;
 
@@ -214,8 +222,13 @@ impl CloudShadow {
     }
 
     /// Append the stretches of `ray` before `end` (and below the base) that the map puts
-    /// in shadow to `out`, sampled every max(250 m, t/50): by the texels to
-    /// [`MAX_SHADOW_DISTANCE_M`], by the blocks' mean beyond.
+    /// in shadow to `out`: to [`MAX_SHADOW_DISTANCE_M`] where the texels' transmittance is
+    /// below [`SHADOW_TRANSMITTANCE`], sampled every max(250 m, t/50); beyond, in pieces
+    /// [a, [`FAR_PIECE_RATIO`]·a], each in shadow over the fraction 1 − T̄ of its length, T̄
+    /// the blocks' mean transmittance averaged along it (sampled as near), the shadow at
+    /// both ends and the lit part in the middle: the expected single scattering of air
+    /// that sees the clouds' shadows too small to resolve (a broken field's far air partly
+    /// lit, an overcast's shadowed), with no blotches where T̄ hovers about ½.
     pub fn shadowed_intervals(&self, ray: &Ray, end: f64, out: &mut Vec<(f64, f64)>) {
         // Where the ray is below the base sphere.
         let limit = match ray_sphere(ray.origin, ray.dir, self.base_radius_m) {
@@ -223,18 +236,16 @@ impl CloudShadow {
             _ => return,
         };
         let first = out.len();
+        let step = |t: f64| (0.02 * t).max(250.0);
+        let near = limit.min(MAX_SHADOW_DISTANCE_M);
         let mut t = 0.0;
         let mut start: Option<f64> = None;
-        while t < limit {
-            let dt = (0.02 * t).max(250.0);
-            let mid = (t + 0.5 * dt).min(limit);
-            let x = ray.origin + mid * ray.dir;
-            let shadowed = match mid <= MAX_SHADOW_DISTANCE_M {
-                true => {
-                    (self.optical_depth(x)).is_some_and(|tau| (-tau).exp() < SHADOW_TRANSMITTANCE)
-                }
-                false => (self.mean_transmittance(x)).is_some_and(|t| t < SHADOW_TRANSMITTANCE),
-            };
+        while t < near {
+            let dt = step(t).min(near - t);
+            let x = ray.origin + (t + 0.5 * dt) * ray.dir;
+            let shadowed = self
+                .optical_depth(x)
+                .is_some_and(|tau| (-tau).exp() < SHADOW_TRANSMITTANCE);
             match (shadowed, start) {
                 (true, None) => start = Some(t),
                 (false, Some(s)) => {
@@ -246,9 +257,39 @@ impl CloudShadow {
             t += dt;
         }
         if let Some(s) = start {
-            out.push((s, limit));
+            out.push((s, near));
+        }
+        let mut a = near;
+        while a < limit {
+            let b = far_piece_end(a, limit);
+            // The mean transmittance along the piece (beyond the map and not extended: lit).
+            let (mut t, mut sum) = (a, 0.0);
+            while t < b {
+                let dt = step(t).min(b - t);
+                let x = ray.origin + (t + 0.5 * dt) * ray.dir;
+                sum += self.mean_transmittance(x).unwrap_or(1.0).clamp(0.0, 1.0) * dt;
+                t += dt;
+            }
+            let shade = 0.5 * (b - a - sum);
+            if shade > 0.0 {
+                out.push((a, a + shade));
+                out.push((b - shade, b));
+            }
+            a = b;
         }
         merge_close(out, first, MERGE_GAP_M);
+    }
+}
+
+/// The end of the far piece that starts at `a` (≥ [`MAX_SHADOW_DISTANCE_M`]) on a ray
+/// below the base to `limit`: [`FAR_PIECE_RATIO`]·a, or `limit` when less than half a
+/// piece would remain after it.
+pub fn far_piece_end(a: f64, limit: f64) -> f64 {
+    let b = a * FAR_PIECE_RATIO;
+    if b + 0.5 * (b - a) >= limit {
+        limit
+    } else {
+        b
     }
 }
 
@@ -342,6 +383,45 @@ mod tests {
         assert!(map
             .optical_depth(Vec3::new(0.0, 0.0, planet + 3200.5))
             .is_none());
+    }
+
+    /// Beyond [`MAX_SHADOW_DISTANCE_M`] the air is in shadow over the fraction of its
+    /// length that the blocks' mean transmittance leaves unlit (a broken field: half; an
+    /// overcast: all; clear: none), in a few stretches, and none of it nearer where the
+    /// texels are lit: no blotches where the mean hovers about ½ (the threshold at ½ drew
+    /// them near the horizon of the noon cumulus scene).
+    #[test]
+    fn the_far_air_is_shadowed_by_the_mean_fraction() {
+        let planet = 6_360_000.0;
+        let e = 50f64.to_radians();
+        let light = Vec3::new(0.0, e.cos(), e.sin());
+        let ray = Ray {
+            origin: Vec3::new(0.0, 0.0, planet + 2.0),
+            dir: Vec3::new(0.7, 0.7, 0.02).normalize(),
+        };
+        let limit = ray_sphere(ray.origin, ray.dir, planet + 1500.0).unwrap().1;
+        assert!(limit > 3.0 * MAX_SHADOW_DISTANCE_M);
+        for (mean, want) in [(0.5, 0.5), (0.0, 1.0), (1.0, 0.0), (0.2, 0.8)] {
+            let map = CloudShadow {
+                light,
+                base_radius_m: planet + 1500.0,
+                planet_radius_m: planet,
+                half_m: map_half_extent_m(light, 1500.0),
+                tau: vec![0.0; TEXELS * TEXELS],
+                coarse: vec![mean; COARSE_TEXELS * COARSE_TEXELS],
+                extends: true,
+            };
+            let mut out = Vec::new();
+            map.shadowed_intervals(&ray, f64::INFINITY, &mut out);
+            let shadowed: f64 = out.iter().map(|(a, b)| b - a).sum();
+            let far = limit - MAX_SHADOW_DISTANCE_M;
+            assert!(
+                (shadowed - want * far).abs() < 1e-3 * far,
+                "mean {mean}: {shadowed} of {far} m"
+            );
+            assert!(out.iter().all(|&(a, _)| a >= MAX_SHADOW_DISTANCE_M - 1e-6));
+            assert!(out.len() <= 8, "{} stretches", out.len());
+        }
     }
 
     /// The square widens as the light sinks, from 40 km (125 m texels) under a high sun to
