@@ -92,12 +92,15 @@ fn map_mean_transmittance(l: u32, x: vec3<f32>, dir: vec3<f32>) -> f32 {
     return mix(lo, hi, t.y);
 }
 
-// Append [a, b] to the list, merging it into the last stretch across a gap under
-// SHADOW_MERGE_GAP_M (CloudShadow's merge_close), or when the list is full.
+// Append [a, b] to the list, merging it with the last stretch across a gap under
+// SHADOW_MERGE_FRACTION of its distance (cloud_shadow::merge_close), or whatever the gap
+// when the list is full, keeping the lit length: the merged shadow shrinks by half the gap
+// at each end.
 fn push_shadowed(list: ptr<function, ShadowList>, a: f32, b: f32) {
     let n = (*list).n;
-    if (n > 0u && (a - (*list).s[n - 1u].y < SHADOW_MERGE_GAP_M || n == MAX_SHADOWED)) {
-        (*list).s[n - 1u].y = b;
+    if (n > 0u && (a - (*list).s[n - 1u].y <= SHADOW_MERGE_FRACTION * a || n == MAX_SHADOWED)) {
+        let g = max(a - (*list).s[n - 1u].y, 0.0);
+        (*list).s[n - 1u] = vec2<f32>((*list).s[n - 1u].x + 0.5 * g, b - 0.5 * g);
         return;
     }
     (*list).s[n] = vec2<f32>(a, b);

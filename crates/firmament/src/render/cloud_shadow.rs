@@ -50,12 +50,13 @@ pub const TEXELS: usize = 640;
 const MAP_STEP_M: f64 = 80.0;
 /// A point is in shadow where the light's transmittance is below this.
 pub const SHADOW_TRANSMITTANCE: f64 = 0.5;
-/// Shadowed stretches closer than this (m), those that touch, are merged; every sampled
-/// lit gap (≥ 250 m) is kept. Merging gaps under 800 m, to ask the sky method for fewer
-/// intervals, took the many short gaps along a grazing ray through a cumulus field's shadows
-/// for shadow: dark blotches in the haze above the horizon (the 10 km near part and the
-/// far pieces keep the count low instead: 16 at most on the GPU).
-pub const MERGE_GAP_M: f64 = 1.0;
+/// Shadowed stretches whose lit gap is under this fraction of its distance are merged into
+/// one, so that a ray across a field of cumulus asks the sky method for fewer intervals;
+/// the merge keeps the lit length (the shadow shrunk by half the gap at each end,
+/// [`merge_close`]), near the observer (gaps of 250 m kept within 6 km) none. Merging every
+/// gap under 800 m into shadow drew dark blotches in the haze above the horizon of a
+/// cumulus field (the many short gaps along a grazing ray taken for shadow).
+pub const MERGE_FRACTION: f64 = 0.04;
 /// The farthest along a view ray the air's shadow is looked for in the map's texels (m):
 /// beyond, the steps (250 m, then t/50) would alias the cumulus' shadows into streaks and
 /// the stretches would be many (30 km before; the same golden-hour figures), and the air is in
@@ -64,9 +65,10 @@ pub const MERGE_GAP_M: f64 = 1.0;
 /// at the map's edge standing for the clouds beyond it.
 pub const MAX_SHADOW_DISTANCE_M: f64 = 10_000.0;
 /// The ratio of a far piece's end to its start (beyond [`MAX_SHADOW_DISTANCE_M`], where the
-/// air's shadow is the fraction of each piece that the blocks' mean leaves unlit): from 30
-/// km to a 1.5 km base's horizon (138 km) four pieces.
-pub const FAR_PIECE_RATIO: f64 = 1.5;
+/// air's shadow is the fraction of each piece that the blocks' mean leaves unlit): from 10
+/// km to a 1.5 km base's horizon (138 km) four pieces (each adds up to two boundaries for
+/// the sky method to look up).
+pub const FAR_PIECE_RATIO: f64 = 2.0;
 /// Blocks per side of the coarse map (of `TEXELS / COARSE_TEXELS` texels each).
 pub const COARSE_TEXELS: usize = 64;
 
@@ -277,7 +279,7 @@ impl CloudShadow {
             }
             a = b;
         }
-        merge_close(out, first, MERGE_GAP_M);
+        merge_close(out, first, MERGE_FRACTION);
     }
 }
 
@@ -301,13 +303,17 @@ fn bilinear(grid: &[f32], size: usize, i: usize, j: usize, tx: f64, ty: f64) -> 
     lo + (hi - lo) * ty
 }
 
-/// Merge the intervals of `out[first..]` (increasing) whose gaps are under `gap`.
-fn merge_close(out: &mut Vec<(f64, f64)>, first: usize, gap: f64) {
+/// Merge the intervals of `out[first..]` (increasing) whose gaps are under `fraction` of
+/// their distance, keeping the lit length: two stretches [a₁, b₁], [a₂, b₂] with gap
+/// g = a₂ − b₁ become [a₁ + g/2, b₂ − g/2] (lit g/2 on either side).
+pub fn merge_close(out: &mut Vec<(f64, f64)>, first: usize, fraction: f64) {
     let mut w = first;
     for r in first..out.len() {
         let iv = out[r];
-        if w > first && iv.0 - out[w - 1].1 < gap {
-            out[w - 1].1 = iv.1;
+        let gap = iv.0 - if w > first { out[w - 1].1 } else { 0.0 };
+        if w > first && gap <= fraction * iv.0 {
+            let g = gap.max(0.0);
+            out[w - 1] = (out[w - 1].0 + 0.5 * g, iv.1 - 0.5 * g);
         } else {
             out[w] = iv;
             w += 1;
@@ -422,6 +428,35 @@ mod tests {
             assert!(out.iter().all(|&(a, _)| a >= MAX_SHADOW_DISTANCE_M - 1e-6));
             assert!(out.len() <= 8, "{} stretches", out.len());
         }
+    }
+
+    /// Merging keeps the lit length (the shadow shrunk by half the gap at each end) and
+    /// merges only gaps under [`MERGE_FRACTION`] of their distance: near the observer a
+    /// 250 m gap stays.
+    #[test]
+    fn merging_keeps_the_lit_length() {
+        let mut v = vec![
+            (500.0, 600.0),
+            (850.0, 900.0),
+            (2000.0, 2100.0),
+            (2150.0, 2400.0),
+            (20_000.0, 20_500.0),
+            (20_600.0, 21_000.0),
+            (21_000.0, 22_000.0),
+        ];
+        let shadow = |v: &[(f64, f64)]| v.iter().map(|(a, b)| b - a).sum::<f64>();
+        let before = shadow(&v);
+        merge_close(&mut v, 0, MERGE_FRACTION);
+        assert_eq!(
+            v,
+            vec![
+                (500.0, 600.0),
+                (850.0, 900.0),
+                (2025.0, 2375.0),
+                (20_075.0, 21_975.0)
+            ]
+        );
+        assert!((shadow(&v) - before).abs() < 1e-9);
     }
 
     /// The square widens as the light sinks, from 40 km (125 m texels) under a high sun to
