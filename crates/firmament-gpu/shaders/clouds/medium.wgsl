@@ -144,6 +144,13 @@ struct DiffuseLight {
     scattering_scale: f32,
 }
 
+// DiffuseLight::forward_peak: the share of the light's beam, after optical depth `tau`
+// towards it, that the δ-scaling (optical depth per true one `scale`) moved into the
+// forward peak.
+fn forward_peak(scale: f32, tau: f32) -> f32 {
+    return exp(-scale * tau) - exp(-tau);
+}
+
 // CloudMedium::diffuse_radiance of layer i (which has two-stream tables) above its top: the
 // light comes down unscattered.
 fn diffuse_above(i: u32) -> DiffuseLight {
@@ -185,13 +192,11 @@ fn diffuse_radiance(i: u32, depths: vec2<f32>, mu_light: f32, tau_light: f32) ->
     if (mu_light > 0.0) {
         f.base_direct = exp(-thickness / mu_light);
     }
-    // The beam's light in the forward peak reaches the base as a beam too (δ-scaled minus
-    // unscattered).
-    var peak_base = 0.0;
+    f.base_from_light = two_pi * ts_sun(at, thickness, thickness, mu_light).x;
+    // The beam's light in the forward peak reaches the base as a beam too.
     if (mu_light > 0.0) {
-        peak_base = mu_light * (exp(-l.ts_extinction_scale * thickness / mu_light) - exp(-thickness / mu_light));
+        f.base_from_light += mu_light * forward_peak(l.ts_extinction_scale, thickness / mu_light);
     }
-    f.base_from_light = two_pi * ts_sun(at, thickness, thickness, mu_light).x + peak_base;
     f.base_from_above = two_pi * ts_diffuse(at, thickness, thickness, true).x;
     f.base_reflectance = clamp(two_pi * ts_diffuse(at, thickness, 0.0, true).x - 1.0, 0.0, 1.0);
     return f;

@@ -121,7 +121,7 @@ fn light_sources(i: u32, sigma_t: f32, dir: vec3<f32>, p: CloudPoint, depths: ve
             let radiance = max(i0 + f.asymmetry * i1 * towards_eye, vec4<f32>(0.0));
             // The beam's light in the forward peak (δ-scaled minus unscattered), scattered
             // towards the eye with the phase the δ-scaling keeps.
-            let peak = exp(-l.ts_extinction_scale * s.tau) - exp(-s.tau);
+            let peak = forward_peak(l.ts_extinction_scale, s.tau);
             let p_kept = min(phase_eval(5u, 0u, 0u, l.g1, l.g2, l.weight, cos), l.ts_forward_cap);
             (*src)[1] += ss * (f.scattering_scale * radiance + p_kept * beam * peak);
         } else {

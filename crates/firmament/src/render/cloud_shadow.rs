@@ -350,6 +350,26 @@ fn optical_depth_coarse(volume: &dyn Volume, ray: &Ray) -> f64 {
 mod tests {
     use super::*;
 
+    /// A map over a base `base_height_m` up lit by `light`: every texel's depth `tau`, every
+    /// block's mean transmittance `mean`.
+    fn uniform_map(
+        light: Vec3,
+        planet: f64,
+        base_height_m: f64,
+        tau: f32,
+        mean: f32,
+    ) -> CloudShadow {
+        CloudShadow {
+            light,
+            base_radius_m: planet + base_height_m,
+            planet_radius_m: planet,
+            half_m: map_half_extent_m(light, base_height_m),
+            tau: vec![tau; TEXELS * TEXELS],
+            coarse: vec![mean; COARSE_TEXELS * COARSE_TEXELS],
+            extends: true,
+        }
+    }
+
     /// Under the default scene's low sun (5.5° high) and cumulus base (3.2 km), the ground
     /// and the air below the base within [`MAX_SHADOW_DISTANCE_M`] of the observer find
     /// their shadow in the map: their rays to the sun meet the base up to 33 km towards it
@@ -363,15 +383,7 @@ mod tests {
             e.cos() * 237f64.to_radians().cos(),
             e.sin(),
         );
-        let map = CloudShadow {
-            light,
-            base_radius_m: planet + 3200.0,
-            planet_radius_m: planet,
-            half_m: map_half_extent_m(light, 3200.0),
-            tau: vec![1.0; TEXELS * TEXELS],
-            coarse: vec![0.5; COARSE_TEXELS * COARSE_TEXELS],
-            extends: true,
-        };
+        let map = uniform_map(light, planet, 3200.0, 1.0, 0.5);
         let r = 0.999 * MAX_SHADOW_DISTANCE_M;
         for k in 0..16 {
             let a = k as f64 * std::f64::consts::TAU / 16.0;
@@ -408,15 +420,7 @@ mod tests {
         let limit = ray_sphere(ray.origin, ray.dir, planet + 1500.0).unwrap().1;
         assert!(limit > 3.0 * MAX_SHADOW_DISTANCE_M);
         for (mean, want) in [(0.5, 0.5), (0.0, 1.0), (1.0, 0.0), (0.2, 0.8)] {
-            let map = CloudShadow {
-                light,
-                base_radius_m: planet + 1500.0,
-                planet_radius_m: planet,
-                half_m: map_half_extent_m(light, 1500.0),
-                tau: vec![0.0; TEXELS * TEXELS],
-                coarse: vec![mean; COARSE_TEXELS * COARSE_TEXELS],
-                extends: true,
-            };
+            let map = uniform_map(light, planet, 1500.0, 0.0, mean);
             let mut out = Vec::new();
             map.shadowed_intervals(&ray, f64::INFINITY, &mut out);
             let shadowed: f64 = out.iter().map(|(a, b)| b - a).sum();

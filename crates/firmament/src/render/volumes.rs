@@ -387,9 +387,7 @@ fn light_sources(
                 // The phase the δ-scaling keeps, towards the eye; the forward peak's share of
                 // the beam (the same in every channel where the depth to the light is).
                 let p_kept = phase.eval(cos).min(f0.forward_phase_cap);
-                let peak_of =
-                    |tau: f64, f: &DiffuseLight| (-f.extinction_scale * tau).exp() - (-tau).exp();
-                let peak0 = peak_of(buf.tau_light[0], &f0);
+                let peak0 = f0.forward_peak(buf.tau_light[0]);
                 for k in 0..n {
                     let f = if volume.is_grey() || k == 0 {
                         f0
@@ -419,7 +417,7 @@ fn light_sources(
                     let peak = if buf.tau_light[k] == buf.tau_light[0] {
                         peak0
                     } else {
-                        peak_of(buf.tau_light[k], &f)
+                        f.forward_peak(buf.tau_light[k])
                     };
                     buf.source[1][k] +=
                         s_v[k] * (f.scattering_scale * radiance + p_kept * beam * peak);

@@ -195,6 +195,15 @@ pub struct DiffuseLight {
     pub forward_phase_cap: f64,
 }
 
+impl DiffuseLight {
+    /// The share of the light's beam, after optical depth `tau` towards it, that the
+    /// δ-scaling moved into the forward peak: e^{−(1 − ωf)τ} − e^{−τ}.
+    #[inline]
+    pub fn forward_peak(&self, tau: f64) -> f64 {
+        (-self.extinction_scale * tau).exp() - (-tau).exp()
+    }
+}
+
 /// Multiple scattering by octaves (Wrenninge 2015, "Art-directable multiple scattering";
 /// Hillaire 2016 §5.6): octave n scatters aⁿ·σ_s with the extinction towards the light
 /// bⁿ·σ_t and the phase asymmetry cⁿ·g, and the octaves are summed. With a ≤ b no octave's

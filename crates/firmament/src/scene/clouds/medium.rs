@@ -223,17 +223,7 @@ impl Volume for CloudMedium {
             thickness
         };
         let two_pi = 2.0 * std::f64::consts::PI;
-        // The beam's light scattered into the phase's forward peak (δ-scaling: the beam
-        // the two streams see is dimmed by the δ-scaled depth (1 − ωf)τ, the light that
-        // crosses unscattered by τ) reaches the base as a beam too.
-        let peak_base = if mu_light > 0.0 {
-            mu_light
-                * ((-ts.extinction_scale * thickness / mu_light).exp()
-                    - (-thickness / mu_light).exp())
-        } else {
-            0.0
-        };
-        Some(DiffuseLight {
+        let mut f = DiffuseLight {
             from_light: ts.sun(thickness, sun_depth, mu_slab),
             from_above: ts.diffuse(thickness, above, true),
             from_below: ts.diffuse(thickness, above, false),
@@ -243,7 +233,7 @@ impl Volume for CloudMedium {
                 0.0
             },
             // At a black base F↑ = 0, so F↓ = 2π·I₀.
-            base_from_light: two_pi * ts.sun(thickness, thickness, mu_light)[0] + peak_base,
+            base_from_light: two_pi * ts.sun(thickness, thickness, mu_light)[0],
             base_from_above: two_pi * ts.diffuse(thickness, thickness, true)[0],
             // Diffuse light from above: F↓(0) = 1, F↑(0) = 2π·I₀(0) − 1; the slab
             // reflects light from below alike.
@@ -252,7 +242,14 @@ impl Volume for CloudMedium {
             scattering_scale: ts.scattering_scale,
             extinction_scale: ts.extinction_scale,
             forward_phase_cap: ts.forward_phase_cap,
-        })
+        };
+        // The beam's light scattered into the phase's forward peak (the two streams see the
+        // beam dimmed by the δ-scaled depth, what crosses unscattered by the true one)
+        // reaches the base as a beam too.
+        if mu_light > 0.0 {
+            f.base_from_light += mu_light * f.forward_peak(thickness / mu_light);
+        }
+        Some(f)
     }
 
     fn octaves(&self) -> Octaves {
