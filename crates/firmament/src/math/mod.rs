@@ -1,7 +1,8 @@
 //! Mathematics shared by every part of firmament: 3-vectors (glam's `DVec3`, planet-centred
 //! metres or unit directions), ray geometry in a spherical atmosphere ([`sphere`]) and
-//! quadrature rules ([`quadrature`]).
+//! quadrature rules ([`quadrature`]), cheap elementary functions for the hot loops ([`fast`]).
 
+pub mod fast;
 pub mod hash;
 pub mod lattice;
 pub mod quadrature;

@@ -12,6 +12,7 @@ use rayon::prelude::*;
 use super::noise;
 use crate::atmosphere::model::fnv1a;
 use crate::io::write_atomic;
+use crate::math::fast::floor;
 use crate::Result;
 
 /// Which texture.
@@ -119,8 +120,8 @@ impl NoiseVolume {
         let mut i1 = [0usize; 3];
         let mut f = [0.0f64; 3];
         for a in 0..3 {
-            let x = (p[a] - p[a].floor()) * n as f64 - 0.5;
-            let c = x.floor();
+            let x = (p[a] - floor(p[a])) * n as f64 - 0.5;
+            let c = floor(x);
             f[a] = x - c;
             let c = if c < 0.0 { n - 1 } else { c as usize };
             i0[a] = c;

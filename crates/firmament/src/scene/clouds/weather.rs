@@ -16,6 +16,7 @@ use std::path::Path;
 
 use super::noise::perlin2;
 use super::profile::CloudKind;
+use crate::math::fast::floor;
 use crate::{Error, Result};
 
 /// Texels per side of the procedural map's tile.
@@ -172,9 +173,9 @@ impl WeatherMap {
         let u = x / self.tile_m;
         let v = y / self.tile_m;
         // Into [0, 1) tiles, then texels (centres at ½).
-        let fx = (u - u.floor()) * w as f64 - 0.5;
-        let fy = (v - v.floor()) * h as f64 - 0.5;
-        let (cx, cy) = (fx.floor(), fy.floor());
+        let fx = (u - floor(u)) * w as f64 - 0.5;
+        let fy = (v - floor(v)) * h as f64 - 0.5;
+        let (cx, cy) = (floor(fx), floor(fy));
         let (tx, ty) = (fx - cx, fy - cy);
         let i0 = if cx < 0.0 { w - 1 } else { cx as usize };
         let j0 = if cy < 0.0 { h - 1 } else { cy as usize };

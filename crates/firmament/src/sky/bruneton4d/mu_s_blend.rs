@@ -30,6 +30,7 @@
 
 use super::params::{x_mu_s, Radii};
 use super::table::lerp_weights;
+use crate::math::fast::{exp, ln};
 
 /// The highest sun elevation (degrees) of the cells that [`blend`] interpolates: the
 /// twilight and the low sun. Above the horizon a low sun's light falls exponentially with
@@ -179,62 +180,6 @@ pub fn hermite_exp(l0: f64, l1: f64, m0: f64, m1: f64, t: f64) -> f64 {
     exp(l0 + t * (chord + u * ((m0 - chord) * u - (m1 - chord) * t)))
 }
 
-/// e^x to 3·10⁻¹⁰ relative (the tables hold f32), several times cheaper than libm's: the
-/// blend runs in the precomputation's hottest loop. e^x = 2^i·e^f with i = round(x·log₂e),
-/// |f| ≤ ln 2 / 2, e^f by its Taylor series to degree 9. 0 below e^{−708}, ∞ above e^{709}.
-#[inline]
-pub fn exp(x: f64) -> f64 {
-    if !(-708.0..=709.0).contains(&x) {
-        return if x > 0.0 {
-            f64::INFINITY
-        } else if x < 0.0 {
-            0.0
-        } else {
-            f64::NAN
-        };
-    }
-    // Round to nearest by the 1.5·2⁵² trick (`f64::round` is a libm call on baseline x86-64).
-    const ROUND: f64 = 6_755_399_441_055_744.0;
-    let i = (x * std::f64::consts::LOG2_E + ROUND) - ROUND;
-    let f = x - i * std::f64::consts::LN_2;
-    let mut p = 1.0 / 362_880.0;
-    for c in [40_320.0, 5_040.0, 720.0, 120.0, 24.0, 6.0, 2.0, 1.0, 1.0] {
-        p = p * f + 1.0 / c;
-    }
-    p * f64::from_bits(((i as i64 + 1023) as u64) << 52)
-}
-
-/// ln x to 10⁻¹¹ absolute for normal positive x, several times cheaper than libm's; −∞
-/// at 0 and NaN below (as `f64::ln`), also for subnormals (never a table's radiance). x =
-/// 2^e·m with m ∈ [√½, √2), ln m = 2 atanh z, z = (m − 1)/(m + 1), |z| < 0.172, by its
-/// series to z¹³.
-#[inline]
-pub fn ln(x: f64) -> f64 {
-    if x.is_nan() || x < 0.0 {
-        return f64::NAN;
-    }
-    if x < f64::MIN_POSITIVE {
-        return f64::NEG_INFINITY;
-    }
-    if x == f64::INFINITY {
-        return x;
-    }
-    let bits = x.to_bits();
-    let mut e = ((bits >> 52) & 0x7ff) as i64 - 1023;
-    let mut m = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3ff0_0000_0000_0000);
-    if m > std::f64::consts::SQRT_2 {
-        m *= 0.5;
-        e += 1;
-    }
-    let z = (m - 1.0) / (m + 1.0);
-    let z2 = z * z;
-    let mut p = 1.0 / 13.0;
-    for c in [11.0, 9.0, 7.0, 5.0, 3.0, 1.0] {
-        p = p * z2 + 1.0 / c;
-    }
-    e as f64 * std::f64::consts::LN_2 + 2.0 * z * p
-}
-
 /// [`blend`] of the samples of `filter` in `data` at the offsets `base + sample·stride`.
 #[inline]
 pub fn blend_at<T: Copy + Into<f64>>(
@@ -277,28 +222,6 @@ mod tests {
         // Earth's 40 samples: 26 cells, from −12° to 19.1° (the next sample is at 24.5°),
         // the first 11 (to −0.05°) in the twilight.
         assert_eq!(twilight_cells(&EARTH, 40), 26);
-    }
-
-    #[test]
-    fn the_fast_exponential_and_logarithm_match_libm() {
-        let mut worst: f64 = 0.0;
-        for j in -70_000..=70_000 {
-            let x = j as f64 * 0.01;
-            worst = worst.max((exp(x) / x.exp() - 1.0).abs());
-        }
-        assert!(worst < 3e-10, "exp: worst relative error {worst}");
-        let mut worst: f64 = 0.0;
-        for j in -3000..=3000 {
-            let x = 10f64.powf(j as f64 * 0.1) * 1.2345;
-            worst = worst.max((ln(x) - x.ln()).abs());
-        }
-        assert!(worst < 1e-11, "ln: worst absolute error {worst}");
-        assert_eq!(exp(-800.0), 0.0);
-        assert_eq!(exp(800.0), f64::INFINITY);
-        assert!(exp(f64::NAN).is_nan());
-        assert_eq!(ln(0.0), f64::NEG_INFINITY);
-        assert!(ln(-1.0).is_nan() && ln(f64::NAN).is_nan());
-        assert_eq!(ln(1.0), 0.0);
     }
 
     #[test]

@@ -25,8 +25,9 @@
 //! linear filters in μ and ν, so that a [`super::Table4::slice`] at fixed (μ_s, r) equals
 //! the 4D lookup.
 
-use super::mu_s_blend::{exp, ln, SAMPLE_SNAP};
+use super::mu_s_blend::SAMPLE_SNAP;
 use super::table::lerp_weights;
+use crate::math::fast::{exp_in_range, ln_normal};
 
 /// The filter along r at one texture coordinate: the two rows, the fraction of the way
 /// in the table's coordinate (ρ) and in altitude.
@@ -107,10 +108,42 @@ pub fn altitude_fraction(z0: usize, z1: usize, t: f64, n: usize, bottom_over_h: 
 /// with altitude (0 < b < a) below the top row, a + t·(b − a) otherwise.
 #[inline]
 pub fn blend(a: f64, b: f64, f: &RFilter) -> f64 {
-    if f.log && b < a && b > 0.0 {
-        a * exp(f.w * ln(b / a))
-    } else {
-        a + f.t * (b - a)
+    let mut out = [0.0];
+    add_blended(&[a], &[b], f, 1.0, &mut out);
+    out[0]
+}
+
+/// Adds `weight` times [`blend`] of each channel's rows `a[k]`, `b[k]` to `out[k]`: one
+/// texel's channels at once. The lookups of a cloudy frame spent 30 % of it here when each
+/// channel took its own call and branches; now, per chunk of channels, the geometric blend
+/// of every channel (ratio 1 where the linear one applies), then the choice, in loops free
+/// of branches that the compiler vectorises.
+#[inline]
+pub fn add_blended(a: &[f64], b: &[f64], f: &RFilter, weight: f64, out: &mut [f64]) {
+    const N: usize = 16;
+    for ((out, a), b) in out.chunks_mut(N).zip(a.chunks(N)).zip(b.chunks(N)) {
+        let n = out.len().min(a.len()).min(b.len());
+        let (out, a, b) = (&mut out[..n], &a[..n], &b[..n]);
+        let mut geometric = [false; N];
+        let mut g = [0.0; N];
+        for k in 0..n {
+            geometric[k] = f.log & (b[k] < a[k]) & (b[k] > 0.0);
+            // In range for the cores: the ratio is normal and ≤ 1 (rows are f32 values,
+            // b/a ≥ 10⁻⁸³), its log times w ∈ [0, 1] ≥ −708.
+            let ratio = if geometric[k] { b[k] / a[k] } else { 1.0 };
+            g[k] = ln_normal(if ratio < f64::MIN_POSITIVE {
+                f64::MIN_POSITIVE
+            } else {
+                ratio
+            });
+        }
+        for k in 0..n {
+            g[k] = a[k] * exp_in_range(f.w * g[k]);
+        }
+        for k in 0..n {
+            let l = a[k] + f.t * (b[k] - a[k]);
+            out[k] += weight * if geometric[k] { g[k] } else { l };
+        }
     }
 }
 

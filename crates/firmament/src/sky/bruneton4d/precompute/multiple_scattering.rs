@@ -8,8 +8,9 @@ use rayon::prelude::*;
 use super::ray::RaySamples;
 use super::ScatteringGrid;
 use crate::atmosphere::Model;
+use crate::math::fast::ln;
 use crate::sky::bruneton4d::lookup::Lookup;
-use crate::sky::bruneton4d::mu_s_blend::{hermite_exp, ln, tangent, MuSFilter};
+use crate::sky::bruneton4d::mu_s_blend::{hermite_exp, tangent, MuSFilter};
 use crate::sky::bruneton4d::params;
 use crate::sky::bruneton4d::table::{lerp_weights, Table4};
 
