@@ -66,11 +66,7 @@ pub fn pack(model: &Model, sizes: &TableSizes) -> Packed {
     let d_min = top - bottom;
     let big_d = distance_to_top_atmosphere_boundary(bottom, model.mu_s_min, top);
     let big_a = (big_d - d_min) / (h - d_min);
-    let mu_s_map = params::MuSMap::new(&params::Radii {
-        bottom,
-        top,
-        mu_s_min: model.mu_s_min,
-    });
+    let mu_s_map = params::MuSMap::new(&params::Radii::of(model));
     let theta_joint = mu_s_map.theta_joint();
 
     let mut data: Vec<f32> = Vec::new();
@@ -159,11 +155,7 @@ pub fn pack(model: &Model, sizes: &TableSizes) -> Packed {
     uniform.push(groups_info.present(AEROSOLS) as u32);
     // The μ_s cells of the scattering and irradiance tables that take the twilight blend
     // (mu_s_blend.wgsl), counted in f64 as on the CPU.
-    let radii = params::Radii {
-        bottom,
-        top,
-        mu_s_min: model.mu_s_min,
-    };
+    let radii = params::Radii::of(model);
     uniform.push(u(mu_s_blend::twilight_cells(&radii, sizes.scattering_mu_s)));
     uniform.push(u(mu_s_blend::irradiance_twilight_cells(
         sizes.irradiance_mu_s,

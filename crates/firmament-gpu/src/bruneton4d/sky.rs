@@ -191,11 +191,7 @@ impl GpuSky {
             tables,
             mie_layout,
             channels: n,
-            radii: Radii {
-                bottom: model.bottom_radius_m,
-                top: model.top_radius_m,
-                mu_s_min: model.mu_s_min,
-            },
+            radii: Radii::of(model),
             sizes,
             solar_irradiance: model.solar_irradiance.clone(),
             balance: colour.white_balance(&model.solar_irradiance, true),

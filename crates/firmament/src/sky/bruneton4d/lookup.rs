@@ -39,11 +39,7 @@ pub struct Lookup<'a> {
 impl<'a> Lookup<'a> {
     /// Lookup context for a model.
     pub fn new(model: &Model, sizes: TableSizes, optical_depth: &'a Table2) -> Self {
-        let radii = Radii {
-            bottom: model.bottom_radius_m,
-            top: model.top_radius_m,
-            mu_s_min: model.mu_s_min,
-        };
+        let radii = Radii::of(model);
         Lookup {
             radii,
             twilight_cells: twilight_cells(&radii, sizes.scattering_mu_s),

@@ -4,6 +4,7 @@
 //! minimum sun elevation, and `u_ν` by the azimuth from the sun (see [`u_nu`]). All in f64;
 //! (r, μ) as in [`crate::math::sphere`].
 
+use crate::atmosphere::model::Model;
 use crate::math::sphere::{clamp_cosine, distance_to_top_atmosphere_boundary, safe_sqrt};
 
 pub use super::mu_s_map::{
@@ -134,6 +135,15 @@ pub struct Radii {
 }
 
 impl Radii {
+    /// The radii and lowest sun of `model`'s tables.
+    pub fn of(model: &Model) -> Radii {
+        Radii {
+            bottom: model.bottom_radius_m,
+            top: model.top_radius_m,
+            mu_s_min: model.mu_s_min,
+        }
+    }
+
     /// H = sqrt(R_t² − R_g²) (m): the distance to the top along the horizon from the ground.
     #[inline]
     pub fn h(&self) -> f64 {

@@ -88,11 +88,7 @@ impl Params {
             t_min: (model.mu_s_min * tan_t_max).atan(),
             tan_t_max,
             sun_mapping: config.sun_zenith_mapping,
-            tables4d: MuSMap::new(&Radii {
-                bottom: model.bottom_radius_m,
-                top: model.top_radius_m,
-                mu_s_min: model.mu_s_min,
-            }),
+            tables4d: MuSMap::new(&Radii::of(model)),
         }
     }
 

@@ -65,11 +65,7 @@ impl PrecomputeJob {
         let n = model.channels();
         crate::spectrum::check_channels(n, "the precomputed tables")?;
         let s = config.sizes;
-        let radii = Radii {
-            bottom: model.bottom_radius_m,
-            top: model.top_radius_m,
-            mu_s_min: model.mu_s_min,
-        };
+        let radii = Radii::of(&model);
         let grid = ScatteringGrid::new(&radii, &s).with_graded_rays(&model, &s);
         let units = plan(config, n, model.constituents.len());
         let total_weight = units.iter().map(|u| u.weight).sum();

@@ -62,11 +62,7 @@ impl RayGrading {
 
     /// The rows of tables of sizes `s` through `model`.
     pub fn for_tables(model: &Model, s: &TableSizes) -> RayGrading {
-        let radii = Radii {
-            bottom: model.bottom_radius_m,
-            top: model.top_radius_m,
-            mu_s_min: model.mu_s_min,
-        };
+        let radii = Radii::of(model);
         RayGrading::new(model, &ScatteringGrid::new(&radii, s), s)
     }
 

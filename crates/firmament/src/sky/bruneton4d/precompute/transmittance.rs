@@ -45,11 +45,7 @@ pub(super) fn optical_depth_rows(
     out: &mut [f32],
 ) {
     let n = model.channels();
-    let radii = Radii {
-        bottom: model.bottom_radius_m,
-        top: model.top_radius_m,
-        mu_s_min: model.mu_s_min,
-    };
+    let radii = Radii::of(model);
     let width = s.transmittance_mu;
     debug_assert_eq!(out.len(), rows.len() * width * n);
     out.par_chunks_mut(width * n)
