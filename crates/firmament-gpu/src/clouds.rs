@@ -232,6 +232,7 @@ impl GpuClouds {
             // The view's filter: the mean density's table and χ, the camera and its pixels.
             let (mut mean_at, mut eye, mut pixel_angle) = (NONE, [0.0f64; 3], 0.0);
             if let Some((view, mean)) = &l.filter {
+                let mean = mean.get();
                 if mean.table.len() != TYPES * COVERAGES * HEIGHTS
                     || mean.chi.len() != TYPES * COVERAGES
                 {

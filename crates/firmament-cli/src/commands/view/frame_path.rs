@@ -192,7 +192,7 @@ impl FramePath {
             .map(|(m, mean)| {
                 let mut layer = m.layer.clone();
                 layer.set_view(view, mean.clone());
-                *mean = layer.filter.as_ref().map(|(_, a)| a.clone());
+                *mean = layer.filter.as_ref().map(|(_, a)| a.get().clone());
                 CloudMedium::new(layer)
             })
             .collect()

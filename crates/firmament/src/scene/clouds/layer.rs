@@ -22,7 +22,7 @@
 use std::sync::Arc;
 
 use super::config::{CloudLayerConfig, LayerParams, WeatherWrap};
-use super::lod::{filter_weight, MeanDensity};
+use super::lod::{filter_weight, LazyMeanDensity, MeanDensity};
 use super::noise::remap;
 use super::noise_volume::NoiseVolume;
 use super::planetary::PlanetaryWeather;
@@ -78,7 +78,7 @@ pub struct CloudLayer {
     pub noise: Option<[Arc<NoiseVolume>; 2]>,
     /// The camera's footprint and the mean density it filters towards (None: the noise's
     /// density everywhere, as the reference and point queries take it).
-    pub filter: Option<(ViewFootprint, Arc<MeanDensity>)>,
+    pub filter: Option<(ViewFootprint, Arc<LazyMeanDensity>)>,
 }
 
 /// How far the planetary weather moves the local coverage about the layer's (c_loc = c +
@@ -155,24 +155,27 @@ impl CloudLayer {
     }
 
     /// Filter the density over the footprint of `view`'s pixels ([`super::lod`]), with
-    /// `mean` (None: tabulated here, about 0.1 s) for the layer's kind.
+    /// `mean` (None: tabulated when a sample first needs it, [`LazyMeanDensity`]) for the
+    /// layer's kind.
     pub fn set_view(&mut self, view: ViewFootprint, mean: Option<Arc<MeanDensity>>) {
         let Some([base, detail]) = &self.noise else {
             return;
         };
-        let mean = mean.unwrap_or_else(|| {
-            let [_, shape_tile, detail_tile] = self.params.tiles_m;
-            let z = (self.radii_m[1] - self.radii_m[0]) * self.params.kind.horizontal_stretch();
-            Arc::new(MeanDensity::new(
-                self.params.kind,
-                base,
-                detail,
-                [z / shape_tile, z / detail_tile],
-                self.params.extinction_per_m * (self.radii_m[1] - self.radii_m[0]),
-                1.0 - self.phase_mean_cosine(),
-            ))
-        });
-        self.filter = Some((view, mean));
+        let mean = match mean {
+            Some(mean) => LazyMeanDensity::ready(mean),
+            None => {
+                let [_, shape_tile, detail_tile] = self.params.tiles_m;
+                let z = (self.radii_m[1] - self.radii_m[0]) * self.params.kind.horizontal_stretch();
+                LazyMeanDensity::new(
+                    self.params.kind,
+                    [base.clone(), detail.clone()],
+                    [z / shape_tile, z / detail_tile],
+                    self.params.extinction_per_m * (self.radii_m[1] - self.radii_m[0]),
+                    1.0 - self.phase_mean_cosine(),
+                )
+            }
+        };
+        self.filter = Some((view, Arc::new(mean)));
     }
 
     /// The mean cosine of the layer's phase function.
@@ -287,17 +290,14 @@ impl CloudLayer {
             return 0.0;
         }
         let (weight, mean) = match &self.filter {
-            Some((_, mean)) => (
-                filter_weight(self.footprint(point), self.cell_m()),
-                mean.as_ref(),
-            ),
+            Some((_, mean)) => (filter_weight(self.footprint(point), self.cell_m()), mean),
             None => return gain * self.noise_density(&local, profile, base, detail, eroded),
         };
         if weight <= 0.0 {
             return gain * self.noise_density(&local, profile, base, detail, eroded);
         }
         // The noise's density blended towards the mean scaled by χ (lod::MeanDensity).
-        let mean = mean.effective(local.h, local.c, local.t);
+        let mean = mean.get().effective(local.h, local.c, local.t);
         gain * if weight >= 1.0 {
             mean
         } else {
