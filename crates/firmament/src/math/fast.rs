@@ -14,8 +14,8 @@ use std::f64::consts::{LN_2, LOG2_E};
 const ROUND: f64 = 6_755_399_441_055_744.0;
 
 /// e^x to 10⁻¹³ relative (libm's 10⁻¹⁶; the tables it serves hold f32), several times
-/// cheaper than libm's: the blends run in the precomputation's hottest loop. 0 below e^{−708}, ∞ above e^{709}, NaN
-/// for NaN.
+/// cheaper than libm's: the blends run in the precomputation's hottest loop. 0 below
+/// e^{−708}, ∞ above e^{709}, NaN for NaN.
 #[inline]
 pub fn exp(x: f64) -> f64 {
     if !(-708.0..=709.0).contains(&x) {
