@@ -385,6 +385,16 @@ mod tests {
         assert_eq!(filter_weight(2500.0, 1000.0), 1.0);
     }
 
+    /// A default cumulus layer over a 6 360 km planet with noise textures of these sizes.
+    fn cumulus_layer(base_size: usize, detail_size: usize) -> CloudLayer {
+        let noise = [
+            Arc::new(NoiseVolume::generate(NoiseKind::BaseShape, base_size, 1)),
+            Arc::new(NoiseVolume::generate(NoiseKind::Erosion, detail_size, 2)),
+        ];
+        let config = CloudLayerConfig::of_kind(CloudKind::Cumulus);
+        CloudLayer::new(&config, 6.36e6, noise, (0.0, 0.0), "c").unwrap()
+    }
+
     #[test]
     fn a_layer_seen_from_afar_reflects_as_its_columns_do() {
         // The same vertical columns of a cumulus layer through the noise's density and
@@ -392,13 +402,8 @@ mod tests {
         // filter's end): their mean two-stream reflectance agrees (what χ is made for, here
         // through the layer's own weather and sampling), while the mean optical depth of
         // the filtered columns is lower (χ < 1: the reflectance is concave in τ).
-        let noise = [
-            Arc::new(NoiseVolume::generate(NoiseKind::BaseShape, 32, 1)),
-            Arc::new(NoiseVolume::generate(NoiseKind::Erosion, 16, 2)),
-        ];
-        let radius = 6.36e6;
-        let config = CloudLayerConfig::of_kind(CloudKind::Cumulus);
-        let near = CloudLayer::new(&config, radius, noise.clone(), (0.0, 0.0), "c").unwrap();
+        let near = cumulus_layer(32, 16);
+        let radius = near.planet_radius_m;
         let mut far = near.clone();
         far.set_view(
             ViewFootprint {
@@ -443,13 +448,8 @@ mod tests {
 
     #[test]
     fn the_mean_density_is_made_only_when_a_sample_needs_it() {
-        let noise = [
-            Arc::new(NoiseVolume::generate(NoiseKind::BaseShape, 16, 1)),
-            Arc::new(NoiseVolume::generate(NoiseKind::Erosion, 8, 2)),
-        ];
-        let radius = 6.36e6;
-        let config = CloudLayerConfig::of_kind(CloudKind::Cumulus);
-        let plain = CloudLayer::new(&config, radius, noise.clone(), (0.0, 0.0), "c").unwrap();
+        let plain = cumulus_layer(16, 8);
+        let radius = plain.planet_radius_m;
         let mut layer = plain.clone();
         // From the ground, pixels of 1 mrad: a quarter of a cell per pixel only 300 km away.
         layer.set_view(
