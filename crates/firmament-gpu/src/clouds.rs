@@ -318,8 +318,8 @@ impl GpuClouds {
         }
         layer_words.resize(MAX_CLOUD_LAYERS * LAYER_WORDS, 0);
         // The shadow maps, from the CPU's shader: per light the texels, the coarse map's
-        // blocks and the shadowed air's weights (channel groups of 4 per texel, padded
-        // with 1), one after another from shadow_at[light].
+        // blocks and the shadowed air's weights w and the ground's g (channel groups of 4
+        // per texel, padded with 1), one after another from shadow_at[light].
         let mut shadow_at = [NONE; MAX_LIGHTS];
         let mut shadow_base_m = 0.0;
         let maps = shader.cloud_shadows().iter().zip(shader.shadowed_air());
@@ -337,9 +337,11 @@ impl GpuClouds {
                         format!("the tables' {} channels", sky.channels),
                     ));
                 }
-                for texel in air.texels().chunks(n) {
-                    data.extend_from_slice(texel);
-                    data.extend(std::iter::repeat_n(1.0, padded - n));
+                for table in [air.texels(), air.ground_texels()] {
+                    for texel in table.chunks(n) {
+                        data.extend_from_slice(texel);
+                        data.extend(std::iter::repeat_n(1.0, padded - n));
+                    }
                 }
                 shadow_base_m = map.base_radius_m() - planet;
             }

@@ -280,7 +280,9 @@ fn shade_clouds(dir: vec3<f32>) -> vec4<f32> {
                     s.direct = select(vec4<f32>(0.0), e.direct * light_irradiance(light, k), lit_at_end);
                     s.sky = e.sky * scale;
                     let t_air = sample_transmittance(g.to_light, k) * g.fraction;
+                    let clear = s.sky;
                     s = dim_surface_light(light, x, up, surface.normal, vl.direction, k, t_air, s);
+                    s.sky = ground_sky(light, x, k, clear, s.sky);
                     if (domes) {
                         // The sky's light under the horizon, weighted by its radiance, in
                         // place of the open plane's (1 + n·up)/2 (after the clouds' dimming,

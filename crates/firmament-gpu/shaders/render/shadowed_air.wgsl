@@ -1,22 +1,39 @@
-// The air under the clouds keeps w of its multiple scattering
-// (firmament::render::shadowed_air, whose weights the CPU tabulates and uploads after each
-// light's shadow map and coarse map: AIR_TEXELS² texels of channel groups over the same
-// square); render/cloud_frame.wgsl's clouded_air takes it out over the stretches.
+// The air under the clouds keeps w of its multiple scattering and the ground takes g of
+// the clear sky's light (firmament::render::shadowed_air, whose tables the CPU tabulates
+// and uploads after each light's shadow map and coarse map: AIR_TEXELS² texels of channel
+// groups over the same square, w's then g's); render/cloud_frame.wgsl's clouded_air takes
+// the multiple scattering out over the stretches and its surface shading calls ground_sky.
 
 // ShadowedAir::weight: w over the ground below local `x` for light l, channel group k (the
 // edge texels beyond the square).
 fn air_weight(l: u32, x: vec3<f32>, k: u32) -> vec4<f32> {
+    return air_sample(l, 0u, x, k);
+}
+
+// ShadowedAir::ground_sky: the sky's light on the ground at local `x` under light l's
+// clouds, `clear` (the sky method's, before the clouds) times the neighbourhood's g, in
+// place of `sky` (dim_surface_light's column-local estimate); `sky` at or above the base or
+// without the light's map.
+fn ground_sky(l: u32, x: vec3<f32>, k: u32, clear: vec4<f32>, sky: vec4<f32>) -> vec4<f32> {
+    if (clouds.shadow_at[l] == NONE || cloud_point(x).alt_m >= clouds.shadow_base_m) {
+        return sky;
+    }
+    return clear * air_sample(l, 1u, x, k);
+}
+
+// ShadowedAir::sample: table `which` (0: w, 1: g, one after the other) below local `x`.
+fn air_sample(l: u32, which: u32, x: vec3<f32>, k: u32) -> vec4<f32> {
     let z = clouds.planet_radius_m + x.z;
     if (z <= 0.0) {
         return vec4<f32>(1.0);
     }
-    let at = clouds.shadow_at[l] + SHADOW_TEXELS * SHADOW_TEXELS + COARSE_TEXELS * COARSE_TEXELS;
+    let stride = 4u * atm.groups;
+    let at = clouds.shadow_at[l] + SHADOW_TEXELS * SHADOW_TEXELS + COARSE_TEXELS * COARSE_TEXELS + which * AIR_TEXELS * AIR_TEXELS * stride;
     let step = 2.0 * SHADOW_HALF_EXTENT_M / f32(AIR_TEXELS);
     let max_f = f32(AIR_TEXELS - 1u);
     let f = clamp((x.xy * (clouds.planet_radius_m / z) + SHADOW_HALF_EXTENT_M) / step - 0.5, vec2<f32>(0.0), vec2<f32>(max_f));
     let i = min(vec2<u32>(f), vec2<u32>(AIR_TEXELS - 2u));
     let t = f - vec2<f32>(i);
-    let stride = 4u * atm.groups;
     let p00 = at + (i.y * AIR_TEXELS + i.x) * stride + 4u * k;
     let p10 = p00 + stride;
     let p01 = p00 + AIR_TEXELS * stride;

@@ -293,6 +293,8 @@ impl<'s> Shader<'s> {
                     }
                     if !scene.volumes.is_empty() {
                         let light = view.light();
+                        let mut clear = [0.0; MAX_CHANNELS];
+                        clear[..n].copy_from_slice(sky);
                         view.transmittance_to_light(hit.position, share);
                         volumes::dim_surface_light(
                             scene,
@@ -305,6 +307,10 @@ impl<'s> Shader<'s> {
                             direct,
                             sky,
                         );
+                        // The diffuse light under the clouds is the neighbourhood's.
+                        if let Some(Some(air)) = self.shadowed_air.get(j) {
+                            air.ground_sky(hit.position, &clear[..n], sky);
+                        }
                     }
                     if let Some(domes) = domes {
                         // The sky's light under the horizon, weighted by its radiance, in
