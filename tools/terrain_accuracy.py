@@ -6,7 +6,7 @@ luminance error of each view (docs/accuracy.md, "Terrain").
     python3 tools/terrain_accuracy.py [--firmament target/release/firmament] [--tables earth.lut]
                                       [--samples 20000] [--scene sunset|noon]...
                                       [--set KEY=VALUE]...   # [terrain] keys, e.g. albedo=0
-                                      [--clouds]
+                                      [--clouds] [--reference-cache DIR]
 
 The scenes' clouds are left out (`query --no-clouds`): this measures the terrain, its
 shadows and shafts; `--clouds` keeps them (the default scene's cumulus, whose lighting
@@ -16,12 +16,18 @@ docs/accuracy.md measures under "Clouds").
 in docs/accuracy.md: `albedo=0.1`, `albedo=0`, `albedo=0 --set height_scale_m=0 --set
 floor_m=0`).
 
+`--reference-cache DIR` keeps each reference query's answer in DIR, named by a hash of its
+scene file's text, views, samples and options, and reuses it: a change to the fast path is
+measured against the same reference estimates (the reference's own code must not change
+meanwhile).
+
 Views within 3 degrees of the sun are left out (its aureole is steeper than a view's
 footprint). Standard library only.
 """
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import math
 import os
@@ -49,6 +55,24 @@ def angle(z1, a1, z2, a2):
                       math.cos(math.radians(z)))
     u, v = d(z1, a1), d(z2, a2)
     return math.degrees(math.acos(max(-1.0, min(1.0, sum(p * q for p, q in zip(u, v))))))
+
+
+def cached_query(cache, binary, scene, views, tables, extra):
+    """`query`, its answer kept in the directory `cache` (None: not kept)."""
+    if cache is None:
+        return query(binary, scene, views, tables, extra)
+    key = hashlib.sha256(json.dumps([open(scene, encoding="utf-8").read(), views,
+                                     tables or "", extra]).encode()).hexdigest()[:16]
+    path = os.path.join(cache, f"terrain-reference-{key}.json")
+    if os.path.exists(path):
+        with open(path, encoding="utf-8") as f:
+            return json.load(f)
+    out = query(binary, scene, views, tables, extra)
+    os.makedirs(cache, exist_ok=True)
+    with open(path + ".tmp", "w", encoding="utf-8") as f:
+        json.dump(out, f)
+    os.replace(path + ".tmp", path)
+    return out
 
 
 def query(binary, scene, views, tables, extra):
@@ -92,6 +116,8 @@ def main() -> None:
     p.add_argument("--scene", action="append", choices=sorted(SCENES))
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     p.add_argument("--clouds", action="store_true", help="keep the scenes' clouds")
+    p.add_argument("--reference-cache", metavar="DIR",
+                   help="keep and reuse the reference's answers in DIR")
     args = p.parse_args()
     for name in args.scene or sorted(SCENES):
         scene, sz, sa, zeniths, azimuths = SCENES[name]
@@ -99,8 +125,8 @@ def main() -> None:
         views = [(z, a) for z in zeniths for a in azimuths if angle(z, a, sz, sa) > 3.0]
         extra = [] if args.clouds else ["--no-clouds"]
         lut = query(args.firmament, scene, views, args.tables, extra)
-        ref = query(args.firmament, scene, views, args.tables,
-                    extra + ["--method", "reference", "--samples", str(args.samples)])
+        ref = cached_query(args.reference_cache, args.firmament, scene, views, args.tables,
+                           extra + ["--method", "reference", "--samples", str(args.samples)])
         errors, noise = [], []
         print(f"== {name} ({scene} {' '.join(args.set)}), {len(views)} views, "
               f"{args.samples} paths/wavelength, clouds {'in' if args.clouds else 'out'}")

@@ -144,6 +144,7 @@ fn clouds_prelude() -> String {
         ("DETAILED_LIGHT_SAMPLES", medium::DETAILED_LIGHT_SAMPLES),
         ("AMBIENT_SAMPLES", medium::AMBIENT_SAMPLES),
         ("SHADOW_TEXELS", cs::TEXELS),
+        ("PENUMBRA_TAPS", cs::PENUMBRA_TAPS),
         ("COARSE_TEXELS", cs::COARSE_TEXELS),
         ("AIR_TEXELS", sa::AIR_TEXELS),
         ("EMPTY_BEFORE_LEAP", rv::EMPTY_BEFORE_LEAP),

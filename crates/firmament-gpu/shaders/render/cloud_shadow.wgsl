@@ -29,14 +29,20 @@ fn map_half_extent(dir: vec3<f32>) -> f32 {
 // in texels of a map of `size` per side (fractional, centred; z < 0: x lies at or above the
 // base, or the ray does not reach it).
 fn map_entry(x: vec3<f32>, dir: vec3<f32>, size: u32) -> vec3<f32> {
+    return map_entry_along(x, dir, dir, size);
+}
+
+// CloudShadow::entry_texel_along: as map_entry for the ray along `ray_dir` (a direction in
+// the disk of the light in `dir`, whose map it is).
+fn map_entry_along(x: vec3<f32>, ray_dir: vec3<f32>, dir: vec3<f32>, size: u32) -> vec3<f32> {
     if (cloud_point(x).alt_m >= clouds.shadow_base_m) {
         return vec3<f32>(0.0, 0.0, -1.0);
     }
-    let far = shell_sphere(x, dir, clouds.shadow_base_m).y;
+    let far = shell_sphere(x, ray_dir, clouds.shadow_base_m).y;
     if (far <= 0.0) {
         return vec3<f32>(0.0, 0.0, -1.0);
     }
-    let e = x + far * dir;
+    let e = x + far * ray_dir;
     let ez = clouds.planet_radius_m + e.z;
     if (ez <= 0.0) {
         return vec3<f32>(0.0, 0.0, -1.0);
@@ -49,11 +55,61 @@ fn map_entry(x: vec3<f32>, dir: vec3<f32>, size: u32) -> vec3<f32> {
 // CloudShadow::optical_depth: the layers' depth from local `x` towards light `l` (< 0: the
 // map does not cover the point, or it lies at or above the base).
 fn map_optical_depth(l: u32, x: vec3<f32>, dir: vec3<f32>) -> f32 {
-    let at = clouds.shadow_at[l];
-    if (at == NONE) {
+    if (clouds.shadow_at[l] == NONE) {
         return -1.0;
     }
-    let e = map_entry(x, dir, SHADOW_TEXELS);
+    return map_texel_depth(l, map_entry(x, dir, SHADOW_TEXELS));
+}
+
+// CloudShadow::disk_optical_depth: the layers' depth from a surface at local `x` towards
+// light l's whole disk (angular radius `alpha`), −ln of the transmittance averaged over
+// the disk: the map read along the light's azimuth where the disk's directions tilted by
+// u·α towards the zenith enter the base (quadratic through u = −1, 0, 1), one read more
+// than the texels they span (at most PENUMBRA_TAPS), by the midpoint rule weighted by
+// √(1 − u²) (< 0: as map_optical_depth).
+fn map_disk_optical_depth(l: u32, x: vec3<f32>, dir: vec3<f32>, alpha: f32) -> f32 {
+    if (clouds.shadow_at[l] == NONE) {
+        return -1.0;
+    }
+    let c = map_entry(x, dir, SHADOW_TEXELS);
+    if (c.z < 0.0) {
+        return -1.0;
+    }
+    let up = normalize(vec3<f32>(x.xy, clouds.planet_radius_m + x.z));
+    let towards = up - dir * dot(dir, up);
+    let len = length(towards);
+    if (len <= 0.0) {
+        return map_texel_depth(l, c);
+    }
+    let t = towards / len;
+    let a = map_entry_along(x, dir * cos(alpha) + t * sin(alpha), dir, SHADOW_TEXELS);
+    let b = map_entry_along(x, dir * cos(alpha) - t * sin(alpha), dir, SHADOW_TEXELS);
+    let spread = length(a.xy - b.xy);
+    if (a.z < 0.0 || b.z < 0.0 || spread < 1.0) {
+        return map_texel_depth(l, c);
+    }
+    let taps = min(u32(ceil(spread)) + 1u, PENUMBRA_TAPS);
+    var sum = 0.0;
+    var weights = 0.0;
+    for (var i = 0u; i < taps; i++) {
+        let u = -1.0 + f32(2u * i + 1u) / f32(taps);
+        let f = c.xy + 0.5 * u * (a.xy - b.xy) + u * u * (0.5 * (a.xy + b.xy) - c.xy);
+        let tau = map_texel_depth(l, vec3<f32>(f, 1.0));
+        if (tau >= 0.0) {
+            let w = sqrt(max(1.0 - u * u, 0.0));
+            sum += w * exp(-tau);
+            weights += w;
+        }
+    }
+    if (weights <= 0.0) {
+        return map_texel_depth(l, c);
+    }
+    return -log(max(sum / weights, 1e-30));
+}
+
+// CloudShadow::texel_depth: light l's map at the entry `e` (map_entry's; bilinear), < 0
+// outside the map.
+fn map_texel_depth(l: u32, e: vec3<f32>) -> f32 {
     let f = e.xy;
     let max_f = f32(SHADOW_TEXELS - 1u);
     if (e.z < 0.0 || f.x < 0.0 || f.y < 0.0 || f.x >= max_f || f.y >= max_f) {
@@ -61,7 +117,7 @@ fn map_optical_depth(l: u32, x: vec3<f32>, dir: vec3<f32>) -> f32 {
     }
     let i = vec2<u32>(f);
     let t = f - vec2<f32>(i);
-    let row0 = at + i.y * SHADOW_TEXELS + i.x;
+    let row0 = clouds.shadow_at[l] + i.y * SHADOW_TEXELS + i.x;
     let row1 = row0 + SHADOW_TEXELS;
     let lo = mix(cloud_data[row0], cloud_data[row0 + 1u], t.x);
     let hi = mix(cloud_data[row1], cloud_data[row1 + 1u], t.x);

@@ -278,7 +278,7 @@ struct SurfaceLight {
 
 fn dim_surface_light(j: u32, x: vec3<f32>, up: vec3<f32>, normal: vec3<f32>, light_dir: vec3<f32>, k: u32, t_air: vec4<f32>, e_in: SurfaceLight) -> SurfaceLight {
     let mu = dot(light_dir, up);
-    let mapped = map_optical_depth(j, x, light_dir);
+    let mapped = map_disk_optical_depth(j, x, light_dir, lights.direction[j].w);
     let p = cloud_point(x);
     let albedo = ground_albedo(k);
     var beam = 1.0;

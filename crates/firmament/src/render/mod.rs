@@ -236,7 +236,7 @@ impl<'s> Shader<'s> {
         let cloud_shadows: Vec<_> = match probe || scene.volumes.is_empty() {
             true => Vec::new(),
             false => (scene.lights.iter())
-                .map(|l| cloud_shadow::CloudShadow::new(scene, l.direction))
+                .map(|l| cloud_shadow::CloudShadow::new(scene, l))
                 .collect(),
         };
         let shadowed_air = (cloud_shadows.iter().zip(views.iter()))

@@ -491,9 +491,9 @@ fn albedo_of(scene: &Scene, k: usize) -> f64 {
 /// the ground), for a light in `direction` of irradiance `e_light` (W·m⁻²·nm⁻¹ at the top
 /// of the atmosphere) with transmittance `t_air` through the air to it: `direct` (the beam
 /// on the surface, as the sky method gave it) is dimmed by the volumes' transmittance
-/// towards the light e^{−τ_l} (from the shadow `map` where it covers `x`, else the march
-/// towards the light: the shadows' shapes), and the
-/// beam the volumes scatter forward reaches the surface as diffuse light, added to `sky`
+/// towards the light e^{−τ_l} (from the shadow `map` where it covers `x`, averaged over
+/// the light's disk: the penumbra; else the march towards the light), and the beam the
+/// volumes scatter forward reaches the surface as diffuse light, added to `sky`
 /// (the sky's irradiance, itself dimmed by the volumes above), on a tilted surface by
 /// (1 + n·up)/2 like the sky's:
 ///
@@ -531,7 +531,7 @@ pub(super) fn dim_surface_light(
     let mut bounce = [1.0f64; MAX_CHANNELS];
     // The shadow map's depth towards the light (all volumes together; grey), where it
     // covers the point, in place of each volume's march.
-    let mapped = map.and_then(|m| m.optical_depth(x));
+    let mapped = map.and_then(|m| m.disk_optical_depth(x));
     let shells = scene
         .volumes
         .iter()
