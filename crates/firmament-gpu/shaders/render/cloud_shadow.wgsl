@@ -164,9 +164,9 @@ fn push_shadowed(list: ptr<function, ShadowList>, a: f32, b: f32) {
 }
 
 // CloudShadow::shadowed_intervals: the stretches of the ray from local `q` along `dir`
-// before `end_m` (and below the base) in light l's shadow: to SHADOW_MAX_DISTANCE_M where the
-// map's texels' transmittance is below SHADOW_TRANSMITTANCE, sampled every max(250 m, t/50);
-// beyond, in pieces [a, SHADOW_FAR_PIECE_RATIO·a] each in shadow over the fraction 1 − T̄ of
+// before `end_m` (and below the base) in light l's shadow: to SHADOW_MAX_DISTANCE_M in steps
+// of max(250 m, t/50), the first 1 − T of each (T the texels' transmittance at its middle,
+// snapped to 0 or 1 within SHADOW_SNAP); beyond, in pieces [a, SHADOW_FAR_PIECE_RATIO·a] each in shadow over the fraction 1 − T̄ of
 // its length (T̄ the coarse map's mean along it), at both ends, lit in the middle.
 fn shadowed_intervals(l: u32, light_dir: vec3<f32>, q: vec3<f32>, dir: vec3<f32>, end_m: f32) -> ShadowList {
     var list: ShadowList;
@@ -181,6 +181,7 @@ fn shadowed_intervals(l: u32, light_dir: vec3<f32>, q: vec3<f32>, dir: vec3<f32>
     let limit = min(far.y, end_m);
     let near = min(limit, SHADOW_MAX_DISTANCE_M);
     var t = 0.0;
+    // The start of a shadowed stretch reaching t (< 0: none).
     var start = -1.0;
     loop {
         if (t >= near) {
@@ -189,10 +190,24 @@ fn shadowed_intervals(l: u32, light_dir: vec3<f32>, q: vec3<f32>, dir: vec3<f32>
         let dt = min(max(0.02 * t, 250.0), near - t);
         let x = q + (t + 0.5 * dt) * dir;
         let tau = map_optical_depth(l, x, light_dir);
-        let shadowed = tau >= 0.0 && exp(-tau) < SHADOW_TRANSMITTANCE;
-        if (shadowed && start < 0.0) {
-            start = t;
-        } else if (!shadowed && start >= 0.0) {
+        var lit = 1.0;
+        if (tau >= 0.0) {
+            lit = exp(-tau);
+        }
+        var dark = (1.0 - lit) * dt;
+        if (lit < SHADOW_SNAP) {
+            dark = dt;
+        } else if (lit > 1.0 - SHADOW_SNAP) {
+            dark = 0.0;
+        }
+        if (dark >= dt) {
+            if (start < 0.0) {
+                start = t;
+            }
+        } else if (dark > 0.0) {
+            push_shadowed(&list, select(t, start, start >= 0.0), t + dark);
+            start = -1.0;
+        } else if (start >= 0.0) {
             push_shadowed(&list, start, t);
             start = -1.0;
         }
