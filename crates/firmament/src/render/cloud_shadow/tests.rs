@@ -51,13 +51,9 @@ fn the_map_covers_the_near_air_under_a_low_sun() {
         .is_none());
 }
 
-/// Beyond [`MAX_SHADOW_DISTANCE_M`] the air is in shadow over the fraction of its
-/// length that the blocks' mean transmittance leaves unlit (a broken field: half; an
-/// overcast: all; clear: none), in a few stretches, and none of it nearer where the
-/// texels are lit: no blotches where the mean hovers about ½ (the threshold at ½ drew
-/// them near the horizon of the noon cumulus scene).
-#[test]
-fn the_far_air_is_shadowed_by_the_mean_fraction() {
+/// A ray from 2 m above the ground rising 1.1° (below a 1.5 km base for 60 km), under a
+/// light 50° high: (the planet's radius, the light, the ray).
+fn skimming_ray() -> (f64, Vec3, Ray) {
     let planet = 6_360_000.0;
     let e = 50f64.to_radians();
     let light = Vec3::new(0.0, e.cos(), e.sin());
@@ -65,6 +61,17 @@ fn the_far_air_is_shadowed_by_the_mean_fraction() {
         origin: Vec3::new(0.0, 0.0, planet + 2.0),
         dir: Vec3::new(0.7, 0.7, 0.02).normalize(),
     };
+    (planet, light, ray)
+}
+
+/// Beyond [`MAX_SHADOW_DISTANCE_M`] the air is in shadow over the fraction of its
+/// length that the blocks' mean transmittance leaves unlit (a broken field: half; an
+/// overcast: all; clear: none), in a few stretches, and none of it nearer where the
+/// texels are lit: no blotches where the mean hovers about ½ (the threshold at ½ drew
+/// them near the horizon of the noon cumulus scene).
+#[test]
+fn the_far_air_is_shadowed_by_the_mean_fraction() {
+    let (planet, light, ray) = skimming_ray();
     let limit = ray_sphere(ray.origin, ray.dir, planet + 1500.0).unwrap().1;
     assert!(limit > 3.0 * MAX_SHADOW_DISTANCE_M);
     for (mean, want) in [(0.5, 0.5), (0.0, 1.0), (1.0, 0.0), (0.2, 0.8)] {
@@ -88,13 +95,7 @@ fn the_far_air_is_shadowed_by_the_mean_fraction() {
 /// (a shadow wherever T < ½).
 #[test]
 fn the_near_air_keeps_its_lit_share() {
-    let planet = 6_360_000.0;
-    let e = 50f64.to_radians();
-    let light = Vec3::new(0.0, e.cos(), e.sin());
-    let ray = Ray {
-        origin: Vec3::new(0.0, 0.0, planet + 2.0),
-        dir: Vec3::new(0.7, 0.7, 0.02).normalize(),
-    };
+    let (planet, light, ray) = skimming_ray();
     let share = |tau: f64| 1.0 - (-tau).exp();
     for (tau, want) in [
         (1.0, share(1.0)),
