@@ -368,7 +368,7 @@ mod tests {
         let mut t = Table4::new(6, 5, 7, 4, 2);
         for (i, v) in t.data.iter_mut().enumerate() {
             let h = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 40;
-            *v = if h % 17 == 0 {
+            *v = if h.is_multiple_of(17) {
                 0.0
             } else {
                 0.1 + (h % 1000) as f32 / 100.0
