@@ -51,12 +51,14 @@ fn picture(name: &str, frame: &Frame) {
     }
 }
 
+/// What a frame takes besides the sky, for its lights (the clouds' or the terrain's uploads
+/// are per light).
+type Inputs<'a> = Box<dyn Fn(&[Light]) -> RenderInputs<'a> + 'a>;
+
 struct Setup<'a> {
     gpu: &'static Gpu,
     sky: &'a GpuSky,
-    /// What a frame takes besides the sky, for its lights (the clouds' or the terrain's
-    /// uploads are per light).
-    inputs: Box<dyn Fn(&[Light]) -> RenderInputs<'a> + 'a>,
+    inputs: Inputs<'a>,
 }
 
 impl Setup<'_> {
