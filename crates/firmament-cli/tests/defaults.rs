@@ -256,8 +256,9 @@ fn the_default_scene_has_a_few_cumulus_and_no_clouds_leaves_them_out() {
     assert!(!said.contains("clouds:"), "{said}");
     // Per pixel, |ΔL|/L: the cluster's rectangle (the upper right, x 38–61 and y 6–17 of
     // 64×36) changes from sky to cloud pixel by pixel; the valley (the lower third, under the
-    // ridges' shadow, dimmed a little by the clouds' shadows in the air) less (11.5 % and
-    // 4.8 % when written).
+    // ridges' shadow, dimmed by the clouds' shadows in the air) less (11.5 % and 4.8 % when
+    // written; 12.0 % and 8.5 % since the air in a cloud's shadow keeps its lit share T of
+    // each step instead of all of it where T > ½, docs/accuracy.md).
     let change = |xs: std::ops::Range<usize>, ys: std::ops::Range<usize>| {
         let l = |p: [f32; 3]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
         let mut sum = 0.0;
@@ -280,7 +281,7 @@ fn the_default_scene_has_a_few_cumulus_and_no_clouds_leaves_them_out() {
         "the clouds changed the sky by {cluster} only"
     );
     assert!(
-        valley < 0.5 * cluster,
+        valley < 0.8 * cluster,
         "the valley changed by {valley}, the sky by {cluster}"
     );
 }
