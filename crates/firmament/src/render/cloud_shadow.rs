@@ -246,7 +246,7 @@ impl CloudShadow {
         if sin_e > 0.0 && 2.0 * h * self.angular_radius_rad < 0.5 * texel * sin_e * sin_e {
             return self.texel_depth(c);
         }
-        let towards_up = (up - self.light * self.light.dot(up)).normalize_or_zero();
+        let towards_up = (up - self.light * sin_e).normalize_or_zero();
         let alpha = self.angular_radius_rad;
         let tilted = |delta: f64| self.light * delta.cos() + towards_up * delta.sin();
         let (Some(a), Some(b)) = (
