@@ -281,7 +281,7 @@ impl AmortisedTables {
             return;
         };
         let (model, tables) = update.job.finish();
-        self.front = Arc::new(Bruneton4d { model, tables });
+        self.front = Arc::new(Bruneton4d::pair(model, tables));
         self.generation += 1;
         if let Some(job) = self.queued.take() {
             self.start(job);

@@ -10,6 +10,7 @@ pub mod compact;
 pub mod file;
 pub mod lookup;
 pub mod mu_s_blend;
+pub mod mu_s_logs;
 pub mod mu_s_map;
 pub mod params;
 pub mod precompute;
@@ -23,6 +24,7 @@ pub mod view;
 
 pub use amortised::AmortisedTables;
 pub use lookup::Lookup;
+use mu_s_logs::MuSLogs;
 pub use params::TableSizes;
 pub use table::{Table2, Table4};
 pub use tables::{MieStorage, TableConfig, Tables};
@@ -38,21 +40,42 @@ use crate::Result;
 pub struct Bruneton4d {
     /// The resolved atmosphere.
     pub model: Model,
-    /// Its tables.
+    /// Its tables. They must not change once a view has looked them up: `logs` is made
+    /// from them.
     pub tables: Tables,
+    /// The μ_s log blend's logarithms of the single Rayleigh, single Mie and multiple
+    /// scattering tables ([`mu_s_logs`]), each sample's made on first use.
+    logs: [MuSLogs; 3],
 }
 
 impl Bruneton4d {
     /// Pair a model with tables computed for it (refused if they do not match).
     pub fn new(model: Model, tables: Tables) -> Result<Bruneton4d> {
         tables.check_matches(&model, "(in memory)")?;
-        Ok(Bruneton4d { model, tables })
+        Ok(Bruneton4d::pair(model, tables))
+    }
+
+    /// The model and its tables, with the (empty) log stores.
+    fn pair(model: Model, tables: Tables) -> Bruneton4d {
+        let sizes = tables.config.sizes;
+        let cells = mu_s_blend::twilight_cells(&params::Radii::of(&model), sizes.scattering_mu_s);
+        let logs = || MuSLogs::new(cells, sizes.scattering_mu_s);
+        Bruneton4d {
+            model,
+            tables,
+            logs: [logs(), logs(), logs()],
+        }
+    }
+
+    /// The log stores of the single Rayleigh, single Mie and multiple scattering tables.
+    pub(crate) fn logs(&self) -> &[MuSLogs; 3] {
+        &self.logs
     }
 
     /// Precompute the tables for `model` (no progress report) and pair them.
     pub fn compute(model: Model, config: &TableConfig) -> Result<Bruneton4d> {
         let tables = Tables::compute(&model, config)?;
-        Ok(Bruneton4d { model, tables })
+        Ok(Bruneton4d::pair(model, tables))
     }
 
     /// Number of wavelengths.

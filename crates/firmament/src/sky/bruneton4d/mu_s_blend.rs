@@ -171,13 +171,22 @@ pub fn tangent(ln_prev: f64, ln_s: f64, ln_next: f64) -> f64 {
     }
 }
 
-/// e^h(t) of the cubic Hermite h with h(0) = l0, h(1) = l1, h′(0) = m0, h′(1) = m1, in the
-/// form l0 + t·(c + (1 − t)·((m0 − c)(1 − t) − (m1 − c)t)), c = l1 − l0.
+/// e^h(t) of the cubic Hermite h with h(0) = l0, h(1) = l1, h′(0) = m0, h′(1) = m1
+/// ([`hermite`]).
 #[inline]
 pub fn hermite_exp(l0: f64, l1: f64, m0: f64, m1: f64, t: f64) -> f64 {
+    exp(hermite(l0, l1, m0, m1, t))
+}
+
+/// The cubic Hermite h(t) with h(0) = l0, h(1) = l1, h′(0) = m0, h′(1) = m1, in the form
+/// l0 + t·(c + (1 − t)·((m0 − c)(1 − t) − (m1 − c)t)), c = l1 − l0. With [`tangent`]'s
+/// tangents (at most twice the cell's chord, of its sign) it is monotone: between l0
+/// and l1 (Fritsch & Carlson 1980).
+#[inline]
+pub fn hermite(l0: f64, l1: f64, m0: f64, m1: f64, t: f64) -> f64 {
     let chord = l1 - l0;
     let u = 1.0 - t;
-    exp(l0 + t * (chord + u * ((m0 - chord) * u - (m1 - chord) * t)))
+    l0 + t * (chord + u * ((m0 - chord) * u - (m1 - chord) * t))
 }
 
 /// [`blend`] of the samples of `filter` in `data` at the offsets `base + sample·stride`.

@@ -4,6 +4,7 @@
 //! manual lerp along ν), so CPU and GPU tables compare texel by texel.
 
 use super::mu_s_blend::{blend_at, MuSFilter};
+use super::mu_s_logs::{CellLogs, MuSLogs};
 use super::params::TableSizes;
 use super::r_blend::{self, RFilter};
 
@@ -220,14 +221,31 @@ impl Table4 {
     /// ([`r_blend`]), then bilinear in (μ, ν).
     #[inline]
     pub fn sample_into(&self, uvwz: [f64; 4], blend: &LookupBlend, out: &mut [f64]) {
+        self.sample_logs_into(uvwz, blend, None, out)
+    }
+
+    /// [`Table4::sample_into`] with the log blend's logarithms and tangents read from
+    /// `logs` ([`MuSLogs`], made for this table) where it has them: the same values to
+    /// ~10⁻⁷, at one exp per value instead of four logarithms and an exp.
+    #[inline]
+    pub fn sample_logs_into(
+        &self,
+        uvwz: [f64; 4],
+        blend: &LookupBlend,
+        logs: Option<&MuSLogs>,
+        out: &mut [f64],
+    ) {
         let (y0, y1, ty) = lerp_weights(uvwz[2], self.nmu);
         let r = RFilter::new(uvwz[3], self.nr, blend.bottom_over_h);
         let s = MuSFilter::new(uvwz[1], self.nmu_s, blend.twilight_cells);
-        self.sample_rows_into(uvwz[0], s, [y0, y1], ty, &r, out);
+        let cell = logs.and_then(|l| l.cell(self, &s));
+        self.sample_rows_into(uvwz[0], s, [y0, y1], ty, &r, cell, out);
     }
 
-    /// As [`Table4::sample_into`] with the μ_s, μ and r filters already known.
+    /// As [`Table4::sample_logs_into`] with the μ_s, μ and r filters already known, and
+    /// the μ_s cell's logarithms where made.
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     pub fn sample_rows_into(
         &self,
         u_nu: f64,
@@ -235,6 +253,7 @@ impl Table4 {
         y: [usize; 2],
         ty: f64,
         r: &RFilter,
+        cell: Option<CellLogs>,
         out: &mut [f64],
     ) {
         let tex_x = u_nu * (self.nnu - 1) as f64;
@@ -249,34 +268,75 @@ impl Table4 {
             for (e, &nn) in [nu0, nu1].iter().enumerate() {
                 let w = wy[b] * wn[e];
                 if w != 0.0 {
-                    self.add_texel(yy, nn, &s, r, w, &mut out[..c]);
+                    self.add_texel(yy, nn, &s, r, cell, w, &mut out[..c]);
                 }
             }
         }
     }
 
     /// Adds `w` times the (μ, ν) texel (`y`, `nu`), every channel, blended along μ_s by
-    /// `s`, then along r by `r`, to `out`.
+    /// `s` (with `cell`'s logarithms where given), then along r by `r`, to `out`.
     #[inline]
-    fn add_texel(&self, y: usize, nu: usize, s: &MuSFilter, r: &RFilter, w: f64, out: &mut [f64]) {
-        let lower = self.index(nu * self.nmu_s, y, r.z0);
+    #[allow(clippy::too_many_arguments)]
+    fn add_texel(
+        &self,
+        y: usize,
+        nu: usize,
+        s: &MuSFilter,
+        r: &RFilter,
+        cell: Option<CellLogs>,
+        w: f64,
+        out: &mut [f64],
+    ) {
+        // A value's index in the table and in the cell's logarithms, for row z.
+        let at = |z: usize| {
+            (
+                self.index(nu * self.nmu_s, y, z),
+                ((z * self.nmu + y) * self.nnu + nu) * self.channels,
+            )
+        };
+        const CHUNK: usize = 16;
+        let lower = at(r.z0);
         if r.t == 0.0 {
-            for (k, o) in out.iter_mut().enumerate() {
-                *o += w * self.mu_s_value(lower + k, s);
+            let mut a = [0.0; CHUNK];
+            for (start, out) in (0..out.len()).step_by(CHUNK).zip(out.chunks_mut(CHUNK)) {
+                let a = &mut a[..out.len()];
+                self.mu_s_values(lower.0 + start, lower.1 + start, s, cell, a);
+                for (o, a) in out.iter_mut().zip(a.iter()) {
+                    *o += w * a;
+                }
             }
             return;
         }
-        let upper = self.index(nu * self.nmu_s, y, r.z1);
+        let upper = at(r.z1);
         // The rows' values a chunk of channels at a time, then blended together.
-        const CHUNK: usize = 16;
         let (mut a, mut b) = ([0.0; CHUNK], [0.0; CHUNK]);
         for (start, out) in (0..out.len()).step_by(CHUNK).zip(out.chunks_mut(CHUNK)) {
             let n = out.len();
-            for k in 0..n {
-                a[k] = self.mu_s_value(lower + start + k, s);
-                b[k] = self.mu_s_value(upper + start + k, s);
-            }
+            self.mu_s_values(lower.0 + start, lower.1 + start, s, cell, &mut a[..n]);
+            self.mu_s_values(upper.0 + start, upper.1 + start, s, cell, &mut b[..n]);
             r_blend::add_blended(&a[..n], &b[..n], r, w, out);
+        }
+    }
+
+    /// The values blended along μ_s by `s` of the consecutive channels whose μ_s columns
+    /// start at `base` (their index in `cell`'s logarithms: `column`), into `out`.
+    #[inline]
+    fn mu_s_values(
+        &self,
+        base: usize,
+        column: usize,
+        s: &MuSFilter,
+        cell: Option<CellLogs>,
+        out: &mut [f64],
+    ) {
+        match cell {
+            Some(cell) => cell.values(self, base, column, s, out),
+            None => {
+                for (k, o) in out.iter_mut().enumerate() {
+                    *o = self.mu_s_value(base + k, s);
+                }
+            }
         }
     }
 
@@ -300,13 +360,20 @@ impl Table4 {
     /// at that (u_μs, u_r): the blends along μ_s and r are made per texel before the
     /// linear filters in both. Used for every pixel of a frame whose camera and sun are
     /// fixed.
-    pub fn slice(&self, u_mu_s: f64, u_r: f64, blend: &LookupBlend) -> Vec<f64> {
+    pub fn slice(
+        &self,
+        u_mu_s: f64,
+        u_r: f64,
+        blend: &LookupBlend,
+        logs: Option<&MuSLogs>,
+    ) -> Vec<f64> {
         let s = MuSFilter::new(u_mu_s, self.nmu_s, blend.twilight_cells);
         let r = RFilter::new(u_r, self.nr, blend.bottom_over_h);
+        let cell = logs.and_then(|l| l.cell(self, &s));
         let c = self.channels;
         let mut out = vec![0.0; self.nmu * self.nnu * c];
         for (i, o) in out.chunks_exact_mut(c).enumerate() {
-            self.add_texel(i / self.nnu, i % self.nnu, &s, &r, 1.0, o);
+            self.add_texel(i / self.nnu, i % self.nnu, &s, &r, cell, 1.0, o);
         }
         out
     }
@@ -390,7 +457,7 @@ mod tests {
                 .iter()
                 .enumerate()
             {
-                let slice = t.slice(u_mu_s, u_r, &blend);
+                let slice = t.slice(u_mu_s, u_r, &blend, None);
                 for (u_nu, u_mu) in [(0.0, 0.5), (0.37, 0.21), (0.8, 0.66), (1.0, 0.93)] {
                     let (mut a, mut b) = (vec![0.0; c], vec![0.0; c]);
                     t.sample_into([u_nu, u_mu_s, u_mu, u_r], &blend, &mut a);

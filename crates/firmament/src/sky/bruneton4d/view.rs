@@ -169,10 +169,19 @@ impl<'a> Bruneton4dView<'a> {
                     let uvwz = params::scattering_uvwz(
                         &lk.radii, &lk.sizes, r, mu, mu_s, ray.nu, ray.ground,
                     );
-                    tables.single_rayleigh.sample_into(uvwz, &lk.blend(), scat);
-                    tables
-                        .multiple
-                        .sample_into(uvwz, &lk.blend(), &mut both[n..2 * n]);
+                    let [rayleigh, _, multiple] = sky.logs();
+                    (tables.single_rayleigh).sample_logs_into(
+                        uvwz,
+                        &lk.blend(),
+                        Some(rayleigh),
+                        scat,
+                    );
+                    tables.multiple.sample_logs_into(
+                        uvwz,
+                        &lk.blend(),
+                        Some(multiple),
+                        &mut both[n..2 * n],
+                    );
                     At::Table(uvwz)
                 }
             };
@@ -191,7 +200,10 @@ impl<'a> Bruneton4dView<'a> {
         let single_mie = &tables.single_mie;
         let sample = |out: &mut [f64]| match at {
             At::Slice(s, u_nu, u_mu) => single_mie.sample_slice_into(&s.mie, u_nu, u_mu, out),
-            At::Table(uvwz) => single_mie.sample_into(uvwz, &self.lookup.blend(), out),
+            At::Table(uvwz) => {
+                let logs = Some(&sky.logs()[1]);
+                single_mie.sample_logs_into(uvwz, &self.lookup.blend(), logs, out)
+            }
         };
         match (orders, tables.config.mie) {
             (Orders::Multiple, _) => mie.iter_mut().for_each(|v| *v = 0.0),
@@ -497,10 +509,10 @@ impl Slice {
         let tables = &sky.tables;
         let uvwz = params::scattering_uvwz(&lookup.radii, &lookup.sizes, r, 0.0, mu_s, 0.0, false);
         let n = sky.channels();
-        let single = tables
-            .single_rayleigh
-            .slice(uvwz[1], uvwz[3], &lookup.blend());
-        let multiple = tables.multiple.slice(uvwz[1], uvwz[3], &lookup.blend());
+        let [rayleigh, mie, multiple] = sky.logs().each_ref().map(Some);
+        let (u_mu_s, u_r, blend) = (uvwz[1], uvwz[3], &lookup.blend());
+        let single = tables.single_rayleigh.slice(u_mu_s, u_r, blend, rayleigh);
+        let multiple = tables.multiple.slice(u_mu_s, u_r, blend, multiple);
         let mut scattering = Vec::with_capacity(2 * single.len());
         for (a, b) in single.chunks(n).zip(multiple.chunks(n)) {
             scattering.extend_from_slice(a);
@@ -508,7 +520,7 @@ impl Slice {
         }
         Slice {
             scattering,
-            mie: tables.single_mie.slice(uvwz[1], uvwz[3], &lookup.blend()),
+            mie: tables.single_mie.slice(u_mu_s, u_r, blend, mie),
         }
     }
 }
