@@ -169,19 +169,25 @@ impl<'a> Bruneton4dView<'a> {
                     let uvwz = params::scattering_uvwz(
                         &lk.radii, &lk.sizes, r, mu, mu_s, ray.nu, ray.ground,
                     );
+                    // Only the tables of the orders asked for (the shafts ask for the
+                    // single and the multiple scattering apart).
                     let [rayleigh, _, multiple] = sky.logs();
-                    (tables.single_rayleigh).sample_logs_into(
-                        uvwz,
-                        &lk.blend(),
-                        Some(rayleigh),
-                        scat,
-                    );
-                    tables.multiple.sample_logs_into(
-                        uvwz,
-                        &lk.blend(),
-                        Some(multiple),
-                        &mut both[n..2 * n],
-                    );
+                    if orders != Orders::Multiple {
+                        (tables.single_rayleigh).sample_logs_into(
+                            uvwz,
+                            &lk.blend(),
+                            Some(rayleigh),
+                            scat,
+                        );
+                    }
+                    if orders != Orders::Single {
+                        tables.multiple.sample_logs_into(
+                            uvwz,
+                            &lk.blend(),
+                            Some(multiple),
+                            &mut both[n..2 * n],
+                        );
+                    }
                     At::Table(uvwz)
                 }
             };
