@@ -76,7 +76,7 @@ impl RenderSettings<'_> {
 /// A scene prepared for one frame from one observer: the sky method's view of each light.
 pub struct Shader<'s> {
     scene: &'s Scene<'s>,
-    views: Vec<Box<dyn SkyView + 's>>,
+    views: Vec<Arc<dyn SkyView + 's>>,
     /// The lights whose disks images show, with the cosine of their angular radius.
     disks: Vec<(usize, f64)>,
     channels: usize,
@@ -214,21 +214,52 @@ impl<'s> Shader<'s> {
         Shader::with_views(scene, observer, true)
     }
 
+    /// [`Shader::probe`] of `scene`, a scene of the same sky and lights as this shader's
+    /// (the terrain's air field shades each of its points with and without the relief), with
+    /// this shader's views: their tables' slices made once for the two.
+    pub fn probe_of<'t>(&self, scene: &'t Scene<'t>) -> Result<Shader<'t>>
+    where
+        's: 't,
+    {
+        debug_assert!(
+            std::ptr::addr_eq(scene.sky, self.scene.sky)
+                && (scene.lights.iter().map(|l| l.direction)).eq(self
+                    .scene
+                    .lights
+                    .iter()
+                    .map(|l| l.direction)),
+            "probe_of: another sky or other lights"
+        );
+        let views = (self.views.iter())
+            .map(|v| Arc::clone(v) as Arc<dyn SkyView + 't>)
+            .collect();
+        Shader::assemble(scene, views, true)
+    }
+
     fn with_views(
         scene: &'s Scene<'s>,
         observer: crate::math::Vec3,
         probe: bool,
     ) -> Result<Shader<'s>> {
-        let channels = scene.sky.model().channels();
-        crate::spectrum::check_channels(channels, "rendering")?;
-        let views: Vec<Box<dyn SkyView + 's>> = scene
-            .lights
-            .iter()
+        let views = (scene.lights.iter())
             .map(|light| match probe {
                 true => scene.sky.probe(observer, light),
                 false => scene.sky.view(observer, light),
             })
+            .map(Arc::from)
             .collect();
+        Shader::assemble(scene, views, probe)
+    }
+
+    /// The shader of `scene` with its lights' `views`: without the volumes' shadows for a
+    /// `probe`.
+    fn assemble(
+        scene: &'s Scene<'s>,
+        views: Vec<Arc<dyn SkyView + 's>>,
+        probe: bool,
+    ) -> Result<Shader<'s>> {
+        let channels = scene.sky.model().channels();
+        crate::spectrum::check_channels(channels, "rendering")?;
         let disks = (scene.lights.iter().enumerate())
             .filter(|(_, light)| light.visible_disk)
             .map(|(i, light)| (i, light.angular_radius_rad.cos()))

@@ -137,7 +137,7 @@ pub fn scattering_change(
     let n = model.channels();
     let smooth = smooth_scene(scene);
     let with = Shader::probe(scene, x)?.without_disks().with_sky_domes();
-    let without = Shader::probe(&smooth, x)?;
+    let without = with.probe_of(&smooth)?;
     let directions: Vec<Vec3> = dirs.iter().map(|d| d.0).collect();
     let mut dl = vec![0.0; directions.len() * n];
     radiance_change(&with, &without, x, &directions, &mut dl);
@@ -219,7 +219,7 @@ impl<'a> AirField<'a> {
                 let with = Shader::probe(scene, x)?
                     .without_disks()
                     .with_domes(domes.clone());
-                let without = Shader::probe(&smooth, x)?;
+                let without = with.probe_of(&smooth)?;
                 let mut dl = vec![0.0; per_point];
                 radiance_change(&with, &without, x, &directions, &mut dl);
                 for (o, d) in out.iter_mut().zip(&dl) {

@@ -123,7 +123,7 @@ impl OwnedShadow {
 /// lit only where the light reaches it; the sky method clips the intervals to the point).
 pub(super) fn composite(
     scene: &Scene,
-    views: &[Box<dyn SkyView + '_>],
+    views: &[std::sync::Arc<dyn SkyView + '_>],
     ray: &Ray,
     end: f64,
     shadows: &[OwnedShadow],
@@ -319,7 +319,7 @@ fn ray_jitter(ray: &Ray) -> f64 {
 /// holds each volume's scattering coefficient at `x`.
 fn light_sources(
     scene: &Scene,
-    views: &[Box<dyn SkyView + '_>],
+    views: &[std::sync::Arc<dyn SkyView + '_>],
     x: Vec3,
     dir: Vec3,
     jitter: f64,
