@@ -12,7 +12,9 @@
 //! the first time a lookup needs that sample and kept: a lookup then costs one exp per
 //! value. A frame needs the few samples around its sun's μ_s (the scene's points span
 //! fractions of a degree of it), so the store holds a few samples of the table's 40, in f32
-//! (ln L to ~10⁻⁷ of itself: the blend's value to ~10⁻⁷ relative).
+//! (ln L to ~10⁻⁷ of itself: the blend's value to ~10⁻⁷ relative; 4 MiB a sample of a
+//! spectral default table). The default scene's spectral frame: 28.2 → 11.2 s
+//! (BENCHMARKS.md, "The low sun's μ_s log blend made once per sample").
 
 use std::sync::OnceLock;
 
@@ -72,7 +74,9 @@ impl MuSLogs {
 impl CellLogs<'_> {
     /// The values blended along μ_s by `s` (this cell's filter) of the `out.len()`
     /// consecutive channels of `table` whose μ_s columns start at `base`, `column` their
-    /// index in the logarithms, into `out`.
+    /// index in the logarithms, into `out`: [`super::mu_s_blend::blend_logs`]'s rule, the
+    /// Hermite in ln L where both samples are lit (monotone, so between the samples' f32
+    /// logs and within exp's range), linear where not.
     #[inline]
     pub fn values(
         &self,
@@ -82,28 +86,17 @@ impl CellLogs<'_> {
         s: &MuSFilter,
         out: &mut [f64],
     ) {
+        let (d, c) = (&table.data, table.channels);
         for (k, o) in out.iter_mut().enumerate() {
-            *o = match self.log_value(table, base + k, column + k, s) {
-                (h, true) => exp_in_range(h),
-                (v, false) => v,
+            let ([la, ma], [lb, mb]) = (self.lower[column + k], self.upper[column + k]);
+            let (la, lb) = (la as f64, lb as f64);
+            *o = if la.is_finite() && lb.is_finite() {
+                exp_in_range(hermite(la, lb, ma as f64, mb as f64, s.t))
+            } else {
+                let a = d[base + k + s.s0 * c] as f64;
+                a + s.t * (d[base + k + s.s1 * c] as f64 - a)
             };
         }
-    }
-
-    /// The value of one channel blended along μ_s: (ln L, true) from the logarithms where
-    /// both samples are lit ([`super::mu_s_blend::blend_logs`]: the Hermite in log,
-    /// monotone, so between the samples' f32 logs and within exp's range), else (L, false)
-    /// linear.
-    #[inline]
-    fn log_value(&self, table: &Table4, base: usize, column: usize, s: &MuSFilter) -> (f64, bool) {
-        let ([la, ma], [lb, mb]) = (self.lower[column], self.upper[column]);
-        let (la, lb) = (la as f64, lb as f64);
-        if la.is_finite() && lb.is_finite() {
-            return (hermite(la, lb, ma as f64, mb as f64, s.t), true);
-        }
-        let (d, c) = (&table.data, table.channels);
-        let a = d[base + s.s0 * c] as f64;
-        (a + s.t * (d[base + s.s1 * c] as f64 - a), false)
     }
 }
 
