@@ -86,15 +86,13 @@ impl CellLogs<'_> {
         s: &MuSFilter,
         out: &mut [f64],
     ) {
-        let (d, c) = (&table.data, table.channels);
         for (k, o) in out.iter_mut().enumerate() {
             let ([la, ma], [lb, mb]) = (self.lower[column + k], self.upper[column + k]);
             let (la, lb) = (la as f64, lb as f64);
             *o = if la.is_finite() && lb.is_finite() {
                 exp_in_range(hermite(la, lb, ma as f64, mb as f64, s.t))
             } else {
-                let a = d[base + k + s.s0 * c] as f64;
-                a + s.t * (d[base + k + s.s1 * c] as f64 - a)
+                table.mu_s_linear(base + k, s)
             };
         }
     }

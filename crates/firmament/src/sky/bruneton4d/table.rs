@@ -348,6 +348,13 @@ impl Table4 {
         if s.geometric {
             return blend_at(&self.data, base, c, s);
         }
+        self.mu_s_linear(base, s)
+    }
+
+    /// Bruneton's linear blend along μ_s of the μ_s column whose first sample is at `base`.
+    #[inline]
+    pub(super) fn mu_s_linear(&self, base: usize, s: &MuSFilter) -> f64 {
+        let c = self.channels;
         let a = self.data[base + s.s0 * c] as f64;
         if s.t == 0.0 {
             return a;
