@@ -4,7 +4,7 @@
 // ½ stratocumulus, 1 cumulus) in the cumuliform kind. Kinds: CLOUD_CUMULUS,
 // CLOUD_ALTOSTRATUS, CLOUD_CIRRUS, CLOUD_UNIFORM.
 
-// Hermite smoothstep of x between e0 and e1 (profile::smoothstep).
+// Hermite smoothstep of x between e0 and e1 (math::smoothstep).
 fn cloud_smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
     let t = clamp((x - e0) / (e1 - e0), 0.0, 1.0);
     return t * t * (3.0 - 2.0 * t);

@@ -23,12 +23,13 @@ pub fn direction_from_zenith_azimuth(zenith_rad: f64, azimuth_rad: f64) -> Vec3 
 }
 
 /// GLSL's smoothstep: 0 below `e0`, 1 above `e1`, the cubic 3t² − 2t³ between (a step at
-/// `e0` when the edges coincide).
-#[inline]
+/// `e0` when the edges coincide). Inlined always, so that constant edges fold their
+/// reciprocal span into a constant (the clouds' profiles run for every sample of a march).
+#[inline(always)]
 pub fn smoothstep(e0: f64, e1: f64, x: f64) -> f64 {
     if e1 <= e0 {
         return if x < e0 { 0.0 } else { 1.0 };
     }
-    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+    let t = ((x - e0) * (1.0 / (e1 - e0))).clamp(0.0, 1.0);
     t * t * (3.0 - 2.0 * t)
 }

@@ -27,7 +27,7 @@ use super::noise::remap;
 use super::noise_volume::NoiseVolume;
 use super::planetary::PlanetaryWeather;
 use super::profile::CloudKind;
-use super::weather::WeatherMap;
+use super::weather::{WeatherCell, WeatherMap};
 use crate::math::Vec3;
 use crate::Result;
 
@@ -46,19 +46,45 @@ pub struct ViewFootprint {
     pub pixel_angle_rad: f64,
 }
 
-/// The weather at a point of the layer.
+/// The weather at a point of the layer: what decides whether there is room for cloud (the
+/// height, the local coverage and the type), and where to read the rest.
 #[derive(Clone, Copy, Debug)]
 struct Local {
     /// Normalised height in the layer.
     h: f64,
-    /// Local coverage c_loc, type and precipitation.
+    /// Local coverage c_loc and type.
     c: f64,
     t: f64,
-    precipitation: f64,
-    /// Planar coordinates with the wind (m) and the noise's warp (tiles).
+    /// Planar coordinates with the wind (m).
     x: f64,
     y: f64,
-    warp: [f64; 2],
+    /// Where the precipitation and the noise's warp are read.
+    rest: Rest,
+}
+
+/// The weather's precipitation and warp at a point, read only where there is room for
+/// cloud ([`Local`]).
+#[derive(Clone, Copy, Debug)]
+enum Rest {
+    /// The uniform layer: none.
+    Uniform,
+    /// The tiled map's sample there (precipitation and warp).
+    Tiled(WeatherCell),
+    /// The planet's precipitation, the tiled map's warp.
+    Planet(WeatherCell, f64),
+}
+
+impl Local {
+    /// The precipitation p and the noise's warp (tiles) at the point.
+    #[inline]
+    fn rest(&self, weather: Option<&WeatherMap>) -> (f64, [f64; 2]) {
+        let warp = |w: &WeatherMap, cell: &WeatherCell| [w.channel(cell, 3), w.channel(cell, 4)];
+        match (self.rest, weather) {
+            (Rest::Tiled(cell), Some(w)) => (w.channel(&cell, 2), warp(w, &cell)),
+            (Rest::Planet(cell, p), Some(w)) => (p, warp(w, &cell)),
+            _ => (0.0, [0.0; 2]),
+        }
+    }
 }
 
 /// A layer ready to be sampled.
@@ -190,8 +216,8 @@ impl CloudLayer {
         self.params.tiles_m[1] / 8.0
     }
 
-    /// Planar coordinates (m) of the point above `dir` (a unit vector from the planet's
-    /// centre): the gnomonic projection onto the tangent plane of the cube face the
+    /// Planar coordinates (m) of the point above `dir` (a vector from the planet's centre,
+    /// of any length: a point itself): the gnomonic projection onto the tangent plane of the cube face the
     /// direction falls on, scaled to the planet's radius (the +z face is the observer's: x
     /// east, y north, true distances near the observer's place), so that a flat weather map
     /// covers the planet with seams only at the faces' edges, 45° of arc away. Great circles
@@ -229,8 +255,8 @@ impl CloudLayer {
             return None;
         }
         let h = (r - rb) / (rt - rb);
-        let dir = point / r;
-        let (x, y) = self.planar(dir);
+        // The projection is the direction's: the point itself, unnormalised.
+        let (x, y) = self.planar(point);
         let (x, y) = (
             x + self.params.wind_offset_m[0],
             y + self.params.wind_offset_m[1],
@@ -240,29 +266,32 @@ impl CloudLayer {
                 h,
                 c: 1.0,
                 t: 0.0,
-                precipitation: 0.0,
                 x,
                 y,
-                warp: [0.0; 2],
+                rest: Rest::Uniform,
             });
         };
-        let [w, t, p, warp_x, warp_y] = weather.sample(x, y);
-        let (w, t, p, contrast) = match &self.planetary {
-            None => (w, t, p, WEATHER_CONTRAST),
+        let cell = weather.cell(x, y);
+        let (w, t, rest, contrast) = match &self.planetary {
+            None => (
+                weather.channel(&cell, 0),
+                weather.channel(&cell, 1),
+                Rest::Tiled(cell),
+                WEATHER_CONTRAST,
+            ),
             Some(planet) => {
-                let [wp, tp, pp] = planet.sample(dir);
+                let [wp, tp, pp] = planet.sample(point / r);
                 let w = (wp + PLANET_DETAIL * planet.detail(x, y)).clamp(0.0, 1.0);
-                (w, tp, pp, PLANET_CONTRAST)
+                (w, tp, Rest::Planet(cell, pp), PLANET_CONTRAST)
             }
         };
         Some(Local {
             h,
             c: (self.params.coverage + contrast * (w - 0.5)).clamp(0.0, 1.0),
             t,
-            precipitation: p,
             x,
             y,
-            warp: [warp_x, warp_y],
+            rest,
         })
     }
 
@@ -283,34 +312,39 @@ impl CloudLayer {
         let Some([base, detail]) = &self.noise else {
             return 1.0;
         };
-        let gain = 1.0 + PRECIPITATION_GAIN * local.precipitation;
+        // The shape is 0 unless base·profile > 1 − c, and base ≤ 1 (as the profile is).
+        if local.c <= 0.0 {
+            return 0.0;
+        }
         let profile = self.params.kind.density(local.h, local.t);
-        // The shape is 0 unless base·profile > 1 − c, and base ≤ 1.
         if profile <= 1.0 - local.c {
             return 0.0;
         }
+        let (precipitation, warp) = local.rest(self.weather.as_ref());
+        let gain = 1.0 + PRECIPITATION_GAIN * precipitation;
         let (weight, mean) = match &self.filter {
             Some((_, mean)) => (filter_weight(self.footprint(point), self.cell_m()), mean),
-            None => return gain * self.noise_density(&local, profile, base, detail, eroded),
+            None => return gain * self.noise_density(&local, warp, profile, base, detail, eroded),
         };
         if weight <= 0.0 {
-            return gain * self.noise_density(&local, profile, base, detail, eroded);
+            return gain * self.noise_density(&local, warp, profile, base, detail, eroded);
         }
         // The noise's density blended towards the mean scaled by χ (lod::MeanDensity).
         let mean = mean.get().effective(local.h, local.c, local.t);
         gain * if weight >= 1.0 {
             mean
         } else {
-            let noise = self.noise_density(&local, profile, base, detail, eroded);
+            let noise = self.noise_density(&local, warp, profile, base, detail, eroded);
             noise + weight * (mean - noise)
         }
     }
 
-    /// The noise's density (before precipitation's gain) at the weather `local` with the
-    /// type's `profile` there.
+    /// The noise's density (before precipitation's gain) at the weather `local` (its noise
+    /// coordinates moved by `warp`, tiles) with the type's `profile` there.
     fn noise_density(
         &self,
         local: &Local,
+        warp: [f64; 2],
         profile: f64,
         base: &NoiseVolume,
         detail: &NoiseVolume,
@@ -320,8 +354,8 @@ impl CloudLayer {
         let stretch = self.params.kind.horizontal_stretch();
         let z = local.h * (self.radii_m[1] - self.radii_m[0]);
         let (u, v) = (
-            local.x / shape_tile + local.warp[0],
-            local.y / shape_tile + local.warp[1],
+            local.x / shape_tile + warp[0],
+            local.y / shape_tile + warp[1],
         );
         let b = base.sample([u, v, z * stretch / shape_tile]);
         let shape = remap(b * profile, 1.0 - local.c, 1.0, 0.0, 1.0).max(0.0);
@@ -341,7 +375,7 @@ impl CloudLayer {
         match self.local(point) {
             None => true,
             Some(_) if self.weather.is_none() => false,
-            Some(l) => self.params.kind.density(l.h, l.t) <= 1.0 - l.c,
+            Some(l) => l.c <= 0.0 || self.params.kind.density(l.h, l.t) <= 1.0 - l.c,
         }
     }
 

@@ -8,6 +8,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::math::smoothstep;
+
 /// The kind of a cloud layer: its profile, its noise and its defaults.
 #[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
@@ -22,15 +24,8 @@ pub enum CloudKind {
     Uniform,
 }
 
-/// Hermite smoothstep of x between e0 and e1.
-#[inline]
-pub fn smoothstep(e0: f64, e1: f64, x: f64) -> f64 {
-    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
-}
-
 /// A bump rising over [a, b] and falling over [c, d].
-#[inline]
+#[inline(always)]
 fn bump(h: f64, a: f64, b: f64, c: f64, d: f64) -> f64 {
     smoothstep(a, b, h) * (1.0 - smoothstep(c, d, h))
 }

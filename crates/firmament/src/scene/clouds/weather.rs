@@ -169,6 +169,15 @@ impl WeatherMap {
     /// [w, t, p, warp x, warp y] at planar coordinates (x, y) (m), bilinear, repeating.
     #[inline]
     pub fn sample(&self, x: f64, y: f64) -> [f64; 5] {
+        let cell = self.cell(x, y);
+        std::array::from_fn(|k| self.channel(&cell, k))
+    }
+
+    /// The four texels around planar coordinates (x, y) (m) and the bilinear weights, for
+    /// [`WeatherMap::channel`]: a sample's channels read one at a time, so that a caller
+    /// that finds no room for cloud from w and t reads no more.
+    #[inline]
+    pub fn cell(&self, x: f64, y: f64) -> WeatherCell {
         let (w, h) = (self.width, self.height);
         let u = x / self.tile_m;
         let v = y / self.tile_m;
@@ -181,14 +190,32 @@ impl WeatherMap {
         let j0 = if cy < 0.0 { h - 1 } else { cy as usize };
         let i1 = if i0 + 1 == w { 0 } else { i0 + 1 };
         let j1 = if j0 + 1 == h { 0 } else { j0 + 1 };
-        let (a, b) = (self.texels[j0 * w + i0], self.texels[j0 * w + i1]);
-        let (c, d) = (self.texels[j1 * w + i0], self.texels[j1 * w + i1]);
-        std::array::from_fn(|k| {
-            let lo = a[k] as f64 + (b[k] as f64 - a[k] as f64) * tx;
-            let hi = c[k] as f64 + (d[k] as f64 - c[k] as f64) * tx;
-            lo + (hi - lo) * ty
-        })
+        WeatherCell {
+            texels: [j0 * w + i0, j0 * w + i1, j1 * w + i0, j1 * w + i1],
+            tx,
+            ty,
+        }
     }
+
+    /// Channel `k` (0 w, 1 t, 2 p, 3–4 the warp) of the bilinear sample at `cell`.
+    #[inline]
+    pub fn channel(&self, cell: &WeatherCell, k: usize) -> f64 {
+        let [i, j, m, n] = cell.texels;
+        let (a, b) = (self.texels[i][k] as f64, self.texels[j][k] as f64);
+        let (c, d) = (self.texels[m][k] as f64, self.texels[n][k] as f64);
+        let lo = a + (b - a) * cell.tx;
+        let hi = c + (d - c) * cell.tx;
+        lo + (hi - lo) * cell.ty
+    }
+}
+
+/// Where a bilinear sample of a [`WeatherMap`] falls: its four texels' indices (south-west,
+/// south-east, north-west, north-east) and the weights along x and y.
+#[derive(Clone, Copy, Debug)]
+pub struct WeatherCell {
+    texels: [usize; 4],
+    tx: f64,
+    ty: f64,
 }
 
 #[cfg(test)]
