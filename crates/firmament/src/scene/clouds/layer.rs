@@ -75,6 +75,18 @@ enum Rest {
 }
 
 impl Local {
+    /// The type's profile here when it leaves room for cloud (the shape is 0 unless
+    /// base·profile > 1 − c, with base and the profile ≤ 1), None where the density is 0
+    /// whatever the noise.
+    #[inline]
+    fn room(&self, kind: CloudKind) -> Option<f64> {
+        if self.c <= 0.0 {
+            return None;
+        }
+        let profile = kind.density(self.h, self.t);
+        (profile > 1.0 - self.c).then_some(profile)
+    }
+
     /// The precipitation p and the noise's warp (tiles) at the point.
     #[inline]
     fn rest(&self, weather: Option<&WeatherMap>) -> (f64, [f64; 2]) {
@@ -217,8 +229,8 @@ impl CloudLayer {
     }
 
     /// Planar coordinates (m) of the point above `dir` (a vector from the planet's centre,
-    /// of any length: a point itself): the gnomonic projection onto the tangent plane of the cube face the
-    /// direction falls on, scaled to the planet's radius (the +z face is the observer's: x
+    /// of any length: a point itself): the gnomonic projection onto the tangent plane of
+    /// the cube face the direction falls on, scaled to the planet's radius (the +z face is the observer's: x
     /// east, y north, true distances near the observer's place), so that a flat weather map
     /// covers the planet with seams only at the faces' edges, 45° of arc away. Great circles
     /// map to straight lines.
@@ -312,14 +324,9 @@ impl CloudLayer {
         let Some([base, detail]) = &self.noise else {
             return 1.0;
         };
-        // The shape is 0 unless base·profile > 1 − c, and base ≤ 1 (as the profile is).
-        if local.c <= 0.0 {
+        let Some(profile) = local.room(self.params.kind) else {
             return 0.0;
-        }
-        let profile = self.params.kind.density(local.h, local.t);
-        if profile <= 1.0 - local.c {
-            return 0.0;
-        }
+        };
         let (precipitation, warp) = local.rest(self.weather.as_ref());
         let gain = 1.0 + PRECIPITATION_GAIN * precipitation;
         let (weight, mean) = match &self.filter {
@@ -375,7 +382,7 @@ impl CloudLayer {
         match self.local(point) {
             None => true,
             Some(_) if self.weather.is_none() => false,
-            Some(l) => l.c <= 0.0 || self.params.kind.density(l.h, l.t) <= 1.0 - l.c,
+            Some(l) => l.room(self.params.kind).is_none(),
         }
     }
 
